@@ -1,0 +1,135 @@
+//! The chatter sequence: what one closing of the contact looks like.
+//!
+//! This is the engine's result and the contract every later stage reads
+//! (waveform, reports, checks). Field names match the JSON of
+//! `interfaces.md` §3. All values are SI; times are measured from t = 0,
+//! the instant the closing force is applied.
+
+use serde::Serialize;
+
+/// How a chatter sequence ended (model.md §4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Outcome {
+    /// The contact no longer releases: closed for good.
+    Stuck,
+    /// The next opening would be shorter than `min_open_time` or open less
+    /// than `min_gap`: the rest of the sequence is below resolution and the
+    /// contact is taken as closed from the last retained impact on.
+    Resolved,
+    /// The moving contact never reaches the fixed one.
+    NeverCloses,
+    /// The contact was touched but the final state is open.
+    EndsOpen,
+    /// Still chattering at `t_end`.
+    EndOfTime,
+}
+
+impl Outcome {
+    /// The contract name used in JSON and CSV.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Outcome::Stuck => "stuck",
+            Outcome::Resolved => "resolved",
+            Outcome::NeverCloses => "never_closes",
+            Outcome::EndsOpen => "ends_open",
+            Outcome::EndOfTime => "end_of_time",
+        }
+    }
+
+    /// Whether the sequence ended with the contact closed for good.
+    pub fn is_closed(self) -> bool {
+        matches!(self, Outcome::Stuck | Outcome::Resolved)
+    }
+}
+
+impl std::fmt::Display for Outcome {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// One contact between the moving and the fixed contact.
+///
+/// Velocities are positive toward the fixed contact, so an impact velocity
+/// is positive and a release velocity negative. Forces are the force the
+/// fixed contact exerts on the moving one, positive pushing it back.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Impact {
+    /// s, when the contacts touch.
+    pub impact_time: f64,
+    /// m/s, approach speed at the touch (> 0).
+    pub impact_velocity: f64,
+    /// s, when they separate; `None` for a contact that never releases
+    /// (or is still closed at `t_end`).
+    pub release_time: Option<f64>,
+    /// m/s, velocity at separation (< 0); `None` with `release_time`.
+    pub release_velocity: Option<f64>,
+    /// −release_velocity / impact_velocity; `None` without a release.
+    pub restitution: Option<f64>,
+    /// s, release_time − impact_time; `None` without a release.
+    pub contact_time: Option<f64>,
+    /// N, largest contact force during the contact. `None` for a rigid
+    /// surface, whose force is an impulse (except when it sticks: then the
+    /// static force).
+    pub peak_force: Option<f64>,
+    /// N, most negative (or smallest) contact force during the contact.
+    /// Negative values are the Kelvin–Voigt "sticky force" artefact.
+    pub min_force: Option<f64>,
+    /// m, largest opening between this release and the next impact;
+    /// `None` if the contact did not release.
+    pub max_gap_after: Option<f64>,
+}
+
+/// Electrical state of the contact over an interval.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ContactState {
+    Open,
+    Closed,
+}
+
+impl ContactState {
+    /// The contract name used in JSON and CSV.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ContactState::Open => "open",
+            ContactState::Closed => "closed",
+        }
+    }
+}
+
+/// A maximal time span with one contact state. Intervals tile [0, t_end]
+/// in order; `start <= end` always (a rigid surface gives closed intervals
+/// of zero length).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Interval {
+    pub state: ContactState,
+    /// s
+    pub start: f64,
+    /// s
+    pub end: f64,
+}
+
+/// The complete result of one closing.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Chatter {
+    pub outcome: Outcome,
+    /// s, the first touch; `None` if the contact never closes.
+    pub first_impact: Option<f64>,
+    /// s, start of the final closed interval; `None` if the sequence does
+    /// not end closed.
+    pub settle_time: Option<f64>,
+    /// Releases after the first impact that opened the contact.
+    pub bounce_count: usize,
+    pub impacts: Vec<Impact>,
+    pub intervals: Vec<Interval>,
+    /// m, for `never_closes`: how far short of the gap the moving contact
+    /// turns back (gap − largest reach). `None` otherwise.
+    pub shortfall: Option<f64>,
+    /// s, for a rigid surface whose bounces form a Zeno sequence: the time
+    /// at which the collapsed tail of ever shorter bounces accumulates.
+    pub accumulation_time: Option<f64>,
+    /// s, the simulated horizon.
+    pub t_end: f64,
+}

@@ -1,0 +1,16 @@
+//! # chatterspice
+//!
+//! Relay contact bounce from physics, into circuit simulation.
+//!
+//! The pipeline: a relay's moving contact is a damped oscillator driven
+//! onto a fixed contact whose surface law (rigid, Kelvin–Voigt or
+//! Hunt–Crossley) decides how it rebounds ([`mechanics`]); the engine
+//! returns the exact chatter sequence ([`chatter`]); later stages turn it
+//! into a contact resistance waveform, an ngspice netlist, a batch run and
+//! an analysis of the probed signals.
+
+pub mod chatter;
+pub mod mechanics;
+
+pub use chatter::{Chatter, ContactState, Impact, Interval, Outcome};
+pub use mechanics::{Mechanics, MechanicsError, Settings, Surface, simulate};

@@ -1,0 +1,158 @@
+//! The mechanics engine: the chatter of a closing relay contact, exactly.
+//!
+//! The moving contact is a damped one-degree-of-freedom oscillator
+//! `m ẍ + r ẋ + s x = f − p` pushed toward a fixed contact at `x = g`
+//! (Uchikoshi, Azuma & Kikuchi, "Rebound characteristics of the equivalent
+//! stiffness surface", 1973; `shared/spec/model.md`). What happens at
+//! `x ≥ g` is the surface law ([`Surface`]).
+//!
+//! The engine is event-driven. Between events the motion is one of:
+//! - a linear piece with constant force (free flight, or contact with a
+//!   Kelvin–Voigt surface), solved in closed form in every damping regime
+//!   ([`linear`]); impacts and releases are roots of that closed form,
+//!   bracketed between consecutive extrema and polished by safeguarded
+//!   Newton iteration ([`root`]);
+//! - a nonlinear contact (Hunt–Crossley), integrated by an adaptive
+//!   Runge–Kutta method with dense output and event location
+//!   ([`integrate`]).
+//!
+//! Sign conventions: `x` is the displacement toward the fixed contact
+//! (m), velocities are positive toward it, and contact forces are the
+//! force the fixed contact puts on the moving one, positive pushing back.
+
+pub mod engine;
+pub mod integrate;
+pub mod linear;
+pub mod root;
+pub mod surface;
+
+pub use engine::simulate;
+pub use surface::Surface;
+
+use thiserror::Error;
+
+/// The moving contact and its drive (model.md §1). SI units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Mechanics {
+    /// kg, effective moving mass `m`.
+    pub mass: f64,
+    /// N/m, suspension (contact-spring) stiffness `s`.
+    pub stiffness: f64,
+    /// N·s/m, structural damping `r` (may be 0).
+    pub damping: f64,
+    /// N, closing force `f`, a step at t = 0.
+    pub force: f64,
+    /// m, travel from rest to the fixed contact `g`.
+    pub gap: f64,
+    /// m, `x(0)`.
+    pub initial_position: f64,
+    /// m/s, `ẋ(0)`.
+    pub initial_velocity: f64,
+    /// N, return-spring preload `p` holding the armature on its rest stop;
+    /// with a step force it simply subtracts from `f`.
+    pub preload: f64,
+}
+
+/// When to stop and what is too small to matter (model.md §4).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Settings {
+    /// s, the simulated horizon.
+    pub t_end: f64,
+    /// s, an opening shorter than this ends the sequence as `resolved`.
+    pub min_open_time: f64,
+    /// m, an opening smaller than this ends the sequence as `resolved`.
+    pub min_gap: f64,
+}
+
+impl Default for Settings {
+    /// 20 ms horizon (a signal relay settles in ≤ 5 ms); 1 ns and 1 nm are
+    /// far below what any circuit or contact surface can resolve.
+    fn default() -> Self {
+        Settings {
+            t_end: 0.02,
+            min_open_time: 1e-9,
+            min_gap: 1e-9,
+        }
+    }
+}
+
+/// The paper's dimensionless groups (model.md §1–2).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Dimensionless {
+    /// rad/s, ωn = √(s/m); dimensionless time is τ = ωn t.
+    pub omega_n: f64,
+    /// ζ = r / (2√(m s)).
+    pub zeta: f64,
+    /// m, F = (f − p)/s, the static deflection under the closing force.
+    pub static_deflection: f64,
+    /// k0 = g/F.
+    pub k0: f64,
+    /// ζ0 = r0 / (2√(m s)) (Kelvin–Voigt only).
+    pub zeta0: Option<f64>,
+    /// β = 1 + s0/s (Kelvin–Voigt only).
+    pub beta: Option<f64>,
+    /// σ = ζ + ζ0 (Kelvin–Voigt only).
+    pub sigma: Option<f64>,
+    /// ζ' = σ/√β, the damping ratio of the in-contact oscillation.
+    pub zeta_prime: Option<f64>,
+    /// γ = (1 + k0 s0/s)/β: the in-contact equilibrium is γF.
+    pub gamma: Option<f64>,
+}
+
+impl Dimensionless {
+    /// The dimensionless view of a relay and surface.
+    pub fn of(m: &Mechanics, surface: &Surface) -> Dimensionless {
+        let omega_n = (m.stiffness / m.mass).sqrt();
+        let crit = 2.0 * (m.mass * m.stiffness).sqrt();
+        let zeta = m.damping / crit;
+        let f_net = m.force - m.preload;
+        let static_deflection = f_net / m.stiffness;
+        let k0 = m.gap / static_deflection;
+        let (zeta0, beta, sigma, zeta_prime, gamma) = match *surface {
+            Surface::KelvinVoigt { stiffness, damping } => {
+                let zeta0 = damping / crit;
+                let beta = 1.0 + stiffness / m.stiffness;
+                let sigma = zeta + zeta0;
+                let gamma = (1.0 + k0 * stiffness / m.stiffness) / beta;
+                (
+                    Some(zeta0),
+                    Some(beta),
+                    Some(sigma),
+                    Some(sigma / beta.sqrt()),
+                    Some(gamma),
+                )
+            }
+            _ => (None, None, None, None, None),
+        };
+        Dimensionless {
+            omega_n,
+            zeta,
+            static_deflection,
+            k0,
+            zeta0,
+            beta,
+            sigma,
+            zeta_prime,
+            gamma,
+        }
+    }
+}
+
+/// A parameter the engine cannot work with. `name` is the scenario key
+/// (`mechanics.mass`, `surface.restitution`, …) so that callers can point
+/// at the line to change.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum MechanicsError {
+    #[error("`{name}` = {value} is not valid: {requirement}")]
+    InvalidParameter {
+        name: &'static str,
+        value: f64,
+        requirement: &'static str,
+    },
+    #[error(
+        "the contact integrator could not meet its tolerance at t = {time} s \
+         (step fell to {step} s); the surface is too stiff for its damping — \
+         check `surface.stiffness` and `surface.chi`"
+    )]
+    StepSizeTooSmall { time: f64, step: f64 },
+}
