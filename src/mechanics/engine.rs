@@ -218,7 +218,17 @@ impl<'a> Engine<'a> {
                 let lowest = piece.first_extremum(false).map_or(x, |(_, xm)| xm);
                 let gap_opened = g - lowest;
                 last.max_gap_after = Some(gap_opened);
-                if dt < self.settings.min_open_time || gap_opened < self.settings.min_gap {
+                // Never resolve finer than f64 can: positions carry
+                // rounding of ~ε·|x_eq|, times of ~ε·t.
+                let min_gap = self
+                    .settings
+                    .min_gap
+                    .max(1e3 * f64::EPSILON * piece.x_eq.abs().max(g));
+                let min_open = self
+                    .settings
+                    .min_open_time
+                    .max(1e3 * f64::EPSILON * (t + dt));
+                if dt < min_open || gap_opened < min_gap {
                     let tail = match *self.surface {
                         Surface::Rigid { restitution } if restitution < 1.0 => {
                             Some(t + dt / (1.0 - restitution))
@@ -277,79 +287,22 @@ impl<'a> Engine<'a> {
     /// One contact starting at `t_hit` with speed `v_hit`; fills the force
     /// fields of the last impact.
     fn contact(&mut self, t_hit: f64, v_hit: f64) -> Result<ContactEnd, MechanicsError> {
-        let m = *self.m;
-        let g = m.gap;
-        let t_end = self.settings.t_end;
-        let last = self.impacts.len() - 1;
-        match *self.surface {
-            Surface::Rigid { restitution } => {
-                let v_out = -restitution * v_hit;
-                let x_eq = self.f_net / m.stiffness;
-                if v_out == 0.0 && x_eq >= g {
-                    // Held against the surface by the static overtravel force.
-                    let static_force = m.stiffness * (x_eq - g);
-                    self.impacts[last].peak_force = Some(static_force);
-                    self.impacts[last].min_force = Some(static_force);
-                    return Ok(ContactEnd::Stuck);
-                }
-                Ok(ContactEnd::Released {
-                    time: t_hit,
-                    velocity: v_out,
-                })
-            }
-            Surface::KelvinVoigt { stiffness, damping } => {
-                let piece = LinearPiece::new(
-                    m.mass,
-                    m.damping + damping,
-                    m.stiffness + stiffness,
-                    self.f_net + stiffness * g,
-                    g,
-                    v_hit,
-                );
-                let release = piece.crossing(g, false).filter(|dt| t_hit + dt > t_hit);
-                let horizon = release.map_or(f64::INFINITY, |dt| dt);
-                let (peak, min) = kv_force_extremes(&piece, g, stiffness, damping, horizon);
-                self.impacts[last].peak_force = Some(peak);
-                self.impacts[last].min_force = Some(min);
-                Ok(match release {
-                    None => ContactEnd::Stuck,
-                    Some(dt) if t_hit + dt > t_end => ContactEnd::Horizon,
-                    Some(dt) => ContactEnd::Released {
-                        time: t_hit + dt,
-                        velocity: piece.state(dt).1,
-                    },
-                })
-            }
-            Surface::HuntCrossley {
-                stiffness,
-                exponent,
-                chi,
-            } => {
-                let hc = HcContact {
-                    mass: m.mass,
-                    damping: m.damping,
-                    stiffness: m.stiffness,
-                    force: self.f_net,
-                    gap: g,
-                    surface_stiffness: stiffness,
-                    exponent,
-                    chi,
-                };
-                let out = hc.run(v_hit, t_end - t_hit)?;
-                self.impacts[last].peak_force = Some(out.peak_force);
-                self.impacts[last].min_force = Some(out.min_force);
-                Ok(match out.end {
-                    HcEnd::Released { after, velocity } if t_hit + after > t_hit => {
-                        ContactEnd::Released {
-                            time: t_hit + after,
-                            velocity,
-                        }
-                    }
-                    HcEnd::Released { .. } | HcEnd::Stuck { .. } => ContactEnd::Stuck,
-                    HcEnd::Horizon => ContactEnd::Horizon,
-                })
-            }
-        }
+        let budget = self.settings.t_end - t_hit;
+        let r = impact_response(self.m, self.surface, v_hit, budget)?;
+        let last = self.impacts.last_mut().expect("the impact was pushed");
+        last.peak_force = r.peak_force;
+        last.min_force = r.min_force;
+        Ok(match r.end {
+            ResponseEnd::Released {
+                contact_time,
+                velocity,
+            } => ContactEnd::Released {
+                time: t_hit + contact_time,
+                velocity,
+            },
+            ResponseEnd::Stuck => ContactEnd::Stuck,
+            ResponseEnd::Horizon => ContactEnd::Horizon,
+        })
     }
 
     /// The sequence ends with the contact open from `open_since`.
@@ -411,6 +364,186 @@ impl<'a> Engine<'a> {
     }
 }
 
+/// How a single contact ends.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ResponseEnd {
+    /// Released after `contact_time` s with `velocity` m/s (≤ 0).
+    Released { contact_time: f64, velocity: f64 },
+    /// Never releases.
+    Stuck,
+    /// Still in contact when the time budget ran out.
+    Horizon,
+}
+
+/// One contact, from touch to release: what the surface does to an impact.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImpactResponse {
+    pub end: ResponseEnd,
+    /// N, largest contact force (`None` for a rigid impulse).
+    pub peak_force: Option<f64>,
+    /// N, smallest contact force (`None` for a rigid impulse).
+    pub min_force: Option<f64>,
+}
+
+impl ImpactResponse {
+    /// −release velocity / impact velocity, if it released.
+    pub fn restitution(&self, v_hit: f64) -> Option<f64> {
+        match self.end {
+            ResponseEnd::Released { velocity, .. } => Some(-velocity / v_hit),
+            _ => None,
+        }
+    }
+
+    /// s, the contact time, if it released.
+    pub fn contact_time(&self) -> Option<f64> {
+        match self.end {
+            ResponseEnd::Released { contact_time, .. } => Some(contact_time),
+            _ => None,
+        }
+    }
+}
+
+/// The response of the surface to one impact at speed `v_hit` (m/s, > 0)
+/// with the relay's suspension and drive acting throughout, followed for
+/// at most `budget` seconds. This is the contact phase of the engine on
+/// its own: it gives the restitution and contact time as functions of
+/// impact speed (the paper's Figs. 5–8).
+pub fn impact_response(
+    m: &Mechanics,
+    surface: &Surface,
+    v_hit: f64,
+    budget: f64,
+) -> Result<ImpactResponse, MechanicsError> {
+    let g = m.gap;
+    let f_net = m.force - m.preload;
+    match *surface {
+        Surface::Rigid { restitution } => {
+            let v_out = -restitution * v_hit;
+            let x_eq = f_net / m.stiffness;
+            if v_out == 0.0 && x_eq >= g {
+                // Held against the surface by the static overtravel force.
+                let static_force = m.stiffness * (x_eq - g);
+                return Ok(ImpactResponse {
+                    end: ResponseEnd::Stuck,
+                    peak_force: Some(static_force),
+                    min_force: Some(static_force),
+                });
+            }
+            Ok(ImpactResponse {
+                end: ResponseEnd::Released {
+                    contact_time: 0.0,
+                    velocity: v_out,
+                },
+                peak_force: None,
+                min_force: None,
+            })
+        }
+        Surface::KelvinVoigt { stiffness, damping } => {
+            let piece = LinearPiece::new(
+                m.mass,
+                m.damping + damping,
+                m.stiffness + stiffness,
+                f_net + stiffness * g,
+                g,
+                v_hit,
+            );
+            let release = piece.crossing(g, false);
+            let horizon = release.unwrap_or(f64::INFINITY).min(budget.max(0.0));
+            let (peak, min) = kv_force_extremes(&piece, g, stiffness, damping, horizon);
+            Ok(ImpactResponse {
+                end: match release {
+                    None => ResponseEnd::Stuck,
+                    Some(dt) if dt > budget => ResponseEnd::Horizon,
+                    Some(dt) => ResponseEnd::Released {
+                        contact_time: dt,
+                        velocity: piece.state(dt).1,
+                    },
+                },
+                peak_force: Some(peak),
+                min_force: Some(min),
+            })
+        }
+        Surface::HuntCrossley {
+            stiffness,
+            exponent,
+            chi,
+        } => {
+            let hc = HcContact {
+                mass: m.mass,
+                damping: m.damping,
+                stiffness: m.stiffness,
+                force: f_net,
+                gap: g,
+                surface_stiffness: stiffness,
+                exponent,
+                chi,
+            };
+            let out = hc.run(v_hit, budget)?;
+            Ok(ImpactResponse {
+                end: match out.end {
+                    HcEnd::Released { after, velocity } => ResponseEnd::Released {
+                        contact_time: after,
+                        velocity,
+                    },
+                    HcEnd::Stuck { .. } => ResponseEnd::Stuck,
+                    HcEnd::Horizon => ResponseEnd::Horizon,
+                },
+                peak_force: Some(out.peak_force),
+                min_force: Some(out.min_force),
+            })
+        }
+    }
+}
+
+/// The critical (sticking) impact speed v_c (m/s): impacts slower than
+/// this never release (model.md §3, paper §3.5). Zero when the contact
+/// always releases (k0 ≥ 1, or a rigid surface with e > 0); infinite for a
+/// rigid surface with e = 0 and overtravel. Found by bisection on "does
+/// this impact release", to `rel_tol` relative.
+pub fn critical_impact_speed(
+    m: &Mechanics,
+    surface: &Surface,
+    rel_tol: f64,
+) -> Result<f64, MechanicsError> {
+    let releases = |v: f64| -> Result<bool, MechanicsError> {
+        let r = impact_response(m, surface, v, f64::INFINITY)?;
+        Ok(matches!(r.end, ResponseEnd::Released { .. }))
+    };
+    let x_eq = (m.force - m.preload) / m.stiffness;
+    if x_eq <= m.gap {
+        return Ok(0.0);
+    }
+    if let Surface::Rigid { restitution } = *surface {
+        return Ok(if restitution > 0.0 {
+            0.0
+        } else {
+            f64::INFINITY
+        });
+    }
+    // A speed scale: the overtravel crossed at the suspension's natural
+    // frequency. Grow until it releases, then bisect.
+    let mut hi = (x_eq - m.gap) * (m.stiffness / m.mass).sqrt();
+    let mut lo = 0.0;
+    let mut tries = 0;
+    while !releases(hi)? {
+        lo = hi;
+        hi *= 2.0;
+        tries += 1;
+        if tries > 200 {
+            return Ok(f64::INFINITY);
+        }
+    }
+    while hi - lo > rel_tol * hi {
+        let mid = 0.5 * (lo + hi);
+        if releases(mid)? {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Ok(0.5 * (lo + hi))
+}
+
 /// Releases after the first impact that opened the contact: every open
 /// interval but the one before the first impact.
 fn bounces(intervals: &[Interval]) -> usize {
@@ -445,15 +578,8 @@ fn kv_force_extremes(piece: &LinearPiece, g: f64, s0: f64, r0: f64, until: f64) 
     }
     // The force's own extrema decay like the motion: the first two (one
     // maximum, one minimum) bound every later one.
-    let mut t = 0.0;
-    for _ in 0..2 {
-        match piece.next_zero(rate, t) {
-            Some(z) if z < until => {
-                consider(force(z));
-                t = z;
-            }
-            _ => break,
-        }
+    for z in piece.zeros(rate).take(2).take_while(|&z| z < until) {
+        consider(force(z));
     }
     (peak, min)
 }

@@ -143,7 +143,8 @@ where
             if last {
                 h = t_stop - t;
             }
-            if !(h > 16.0 * f64::EPSILON * t.abs().max(h.abs())) && !last {
+            let too_small = h.is_nan() || h <= 16.0 * f64::EPSILON * t.abs().max(h.abs());
+            if too_small && !last {
                 return Err(MechanicsError::StepSizeTooSmall { time: t, step: h });
             }
             let k2 = f(t + C2 * h, &(y + k1 * (A21 * h)));

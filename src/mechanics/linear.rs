@@ -24,6 +24,26 @@
 
 use super::root;
 
+/// The zeros of a [`Combo`], in increasing order (see [`LinearPiece::zeros`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Zeros {
+    next: f64,
+    period: f64,
+}
+
+impl Iterator for Zeros {
+    type Item = f64;
+
+    fn next(&mut self) -> Option<f64> {
+        if !self.next.is_finite() {
+            return None;
+        }
+        let t = self.next;
+        self.next = t + self.period;
+        Some(t)
+    }
+}
+
 /// The motion `m ẍ + c ẋ + k x = F` from a given state at local time 0.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LinearPiece {
@@ -131,12 +151,19 @@ impl LinearPiece {
         (self.x_eq + y.p * e + y.q * g, v.p * e + v.q * g)
     }
 
-    /// The first zero of a combination strictly after local time `after`
-    /// (≥ 0), or `None` if it has no later zero. Zeros of `P·C + Q·S` are
-    /// known in closed form (see the module docs).
-    pub fn next_zero(&self, c: Combo, after: f64) -> Option<f64> {
+    /// The zeros of a combination in (0, ∞), in increasing order. Zeros of
+    /// `P·C + Q·S` are known in closed form (see the module docs): evenly
+    /// spaced by π/w when under-damped, at most one otherwise.
+    ///
+    /// A zero at t = 0 itself (up to the rounding of the phase, 64 ulps of
+    /// the period) is not reported: it is where the piece starts.
+    pub fn zeros(&self, c: Combo) -> Zeros {
+        let none = Zeros {
+            next: f64::INFINITY,
+            period: f64::INFINITY,
+        };
         if c.p == 0.0 && c.q == 0.0 {
-            return None;
+            return none;
         }
         if self.q > 0.0 {
             let w = self.q.sqrt();
@@ -144,40 +171,34 @@ impl LinearPiece {
             // wt = φ + π/2 + jπ.
             let phi = (c.q / w).atan2(c.p);
             let period = std::f64::consts::PI / w;
-            let first = (phi + std::f64::consts::FRAC_PI_2) / w;
-            // Smallest first + j·period past `after`. A zero within a
-            // hair of `after` is the one `after` already is (rounding), so
-            // the search starts a billionth of a period later.
-            let after = after + 1e-9 * period;
-            let j = ((after - first) / period).floor() + 1.0;
-            let mut t = first + j * period;
-            while t <= after {
+            let floor = 64.0 * f64::EPSILON * period;
+            let mut t = (phi + std::f64::consts::FRAC_PI_2) / w;
+            while t <= floor {
                 t += period;
             }
-            while t - period > after {
+            while t - period > floor {
                 t -= period;
             }
-            Some(t)
+            Zeros { next: t, period }
         } else {
             let t = if self.q < 0.0 {
                 let w = (-self.q).sqrt();
-                if c.q == 0.0 {
-                    return None;
-                }
                 let r = -c.p * w / c.q;
                 if !(r > 0.0 && r < 1.0) {
-                    return None;
+                    return none;
                 }
                 r.atanh() / w
             } else {
-                if c.q == 0.0 {
-                    return None;
-                }
                 -c.p / c.q
             };
-            // As above: a zero at `after` itself (up to rounding) is not
-            // a later one.
-            (t > after + 1e-9 * self.time_scale()).then_some(t)
+            if t > 64.0 * f64::EPSILON * self.time_scale() {
+                Zeros {
+                    next: t,
+                    period: f64::INFINITY,
+                }
+            } else {
+                none
+            }
         }
     }
 
@@ -191,19 +212,15 @@ impl LinearPiece {
     /// two segments with the right slope need looking at: the answer is
     /// exact, not a scan.
     pub fn crossing(&self, level: f64, upward: bool) -> Option<f64> {
-        let v = self.v_combo();
+        let mut extrema = self.zeros(self.v_combo());
         let mut t0 = 0.0;
         let mut x_start = self.x0;
+        // Velocity zeros are simple, so segments alternate direction. The
+        // first one's comes from the start state, never from sampling the
+        // velocity (which may underflow to 0 far into a decay).
+        let mut rising = self.initially_rising();
         for _ in 0..3 {
-            let t1 = self.next_zero(v, t0);
-            let slope_at = |t: f64| self.state(t).1;
-            // Direction of this segment: velocity at its middle, or just
-            // after its start when it is unbounded.
-            let probe = match t1 {
-                Some(t1) => 0.5 * (t0 + t1),
-                None => t0 + self.time_scale(),
-            };
-            let rising = slope_at(probe) > 0.0;
+            let t1 = extrema.next();
             if rising == upward {
                 let crosses = |x: f64| if upward { x > level } else { x < level };
                 let starts_before = if upward {
@@ -235,6 +252,7 @@ impl LinearPiece {
                 Some(t1) => {
                     t0 = t1;
                     x_start = self.state(t1).0;
+                    rising = !rising;
                 }
                 None => return None,
             }
@@ -242,20 +260,29 @@ impl LinearPiece {
         None
     }
 
+    /// Whether x increases just after local time 0: the sign of the
+    /// velocity, or of the acceleration when starting at rest.
+    fn initially_rising(&self) -> bool {
+        if self.v0 != 0.0 {
+            self.v0 > 0.0
+        } else {
+            self.x0 < self.x_eq
+        }
+    }
+
     /// The value of x at the first extremum strictly after local time 0
     /// that is a maximum (`upward`) or a minimum, and its time; `None` if
     /// the motion has no such extremum.
     pub fn first_extremum(&self, maximum: bool) -> Option<(f64, f64)> {
-        let v = self.v_combo();
-        let mut t0 = 0.0;
+        let mut extrema = self.zeros(self.v_combo());
+        let mut rising = self.initially_rising();
         for _ in 0..2 {
-            let t1 = self.next_zero(v, t0)?;
-            let mid = 0.5 * (t0 + t1);
-            let rising = self.state(mid).1 > 0.0;
+            let t1 = extrema.next()?;
+            // A segment rising to t1 ends at a maximum.
             if rising == maximum {
                 return Some((t1, self.state(t1).0));
             }
-            t0 = t1;
+            rising = !rising;
         }
         None
     }

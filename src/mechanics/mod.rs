@@ -27,7 +27,9 @@ pub mod linear;
 pub mod root;
 pub mod surface;
 
-pub use engine::simulate;
+pub use engine::{
+    ImpactResponse, ResponseEnd, critical_impact_speed, impact_response, simulate, validate,
+};
 pub use surface::Surface;
 
 use thiserror::Error;

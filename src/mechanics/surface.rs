@@ -50,7 +50,8 @@ impl Surface {
 /// `e` must lie in (0, 1]; e = 1 gives χ = 0. Returns `None` outside that
 /// range or for a non-positive velocity.
 pub fn hunt_crossley_chi(e: f64, reference_velocity: f64) -> Option<f64> {
-    if !(e > 0.0 && e <= 1.0) || !(reference_velocity > 0.0) || !reference_velocity.is_finite() {
+    let valid = e > 0.0 && e <= 1.0 && reference_velocity > 0.0 && reference_velocity.is_finite();
+    if !valid {
         return None;
     }
     if e == 1.0 {
@@ -62,7 +63,7 @@ pub fn hunt_crossley_chi(e: f64, reference_velocity: f64) -> Option<f64> {
     let mut hi = 1.0 / e;
     // Start below the pole where h is finite and positive.
     let mut k = 1.0;
-    while !(h(hi * (1.0 - 1e-3 * k)) > 0.0) {
+    while h(hi * (1.0 - 1e-3 * k)).is_nan() || h(hi * (1.0 - 1e-3 * k)) <= 0.0 {
         k *= 0.5;
         if k < 1e-12 {
             return None;
@@ -85,7 +86,7 @@ pub fn hunt_crossley_chi(e: f64, reference_velocity: f64) -> Option<f64> {
 /// speed `v` (m/s): the root e of `χ v (1 + e) = ln[(1 + χ v)/(1 − χ e v)]`.
 pub fn hunt_crossley_restitution(chi: f64, v: f64) -> Option<f64> {
     let u = chi * v;
-    if !(u >= 0.0) || !u.is_finite() {
+    if u.is_nan() || u < 0.0 || u.is_infinite() {
         return None;
     }
     if u == 0.0 {
