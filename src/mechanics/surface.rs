@@ -94,7 +94,11 @@ pub fn hunt_crossley_restitution(chi: f64, v: f64) -> Option<f64> {
     // g(e) = ln((1+u)/(1−e u)) − u(1+e) is negative at e = 0 and grows
     // to +∞ as e → 1/u (if 1/u < 1); the root is the one in (0, 1].
     let g = |e: f64| ((1.0 + u) / (1.0 - e * u)).ln() - u * (1.0 + e);
-    let hi = if u < 1.0 { 1.0 } else { (1.0 / u) * (1.0 - 1e-15) };
+    let hi = if u < 1.0 {
+        1.0
+    } else {
+        (1.0 / u) * (1.0 - 1e-15)
+    };
     if g(hi) <= 0.0 {
         return Some(hi);
     }
