@@ -21,6 +21,7 @@
 //! force the fixed contact puts on the moving one, positive pushing back.
 
 pub mod engine;
+pub mod hunt_crossley;
 pub mod integrate;
 pub mod linear;
 pub mod root;
