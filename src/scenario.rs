@@ -318,7 +318,7 @@ pub enum ScenarioError {
         #[source]
         source: Option<Box<toml::de::Error>>,
     },
-    #[error("{at}: `{key}` has a value of the wrong kind: {message}")]
+    #[error("{at}: bad value for `{key}`: {message}")]
     BadValue {
         at: Location,
         key: String,
@@ -591,7 +591,9 @@ impl<'t> KeyIndex<'t> {
 
     /// Turn a serde error (unknown key, missing key, wrong type) into one
     /// that names the dotted key.
-    fn shape_error(&self, source: toml::de::Error, origin: &Path) -> ScenarioError {
+    fn shape_error(&self, mut source: toml::de::Error, origin: &Path) -> ScenarioError {
+        // With the text, the error displays an excerpt with the key marked.
+        source.set_input(Some(self.text));
         let span = source.span();
         let at = Location {
             path: origin.to_owned(),

@@ -48,9 +48,9 @@ pub fn render(chatter: &Chatter) -> String {
         [
             "#",
             "impact",
-            "speed",
+            "v impact",
             "release",
-            "speed",
+            "v release",
             "e",
             "contact",
             "peak force",
