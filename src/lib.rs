@@ -11,6 +11,8 @@
 
 pub mod chatter;
 pub mod mechanics;
+pub mod report;
+pub mod scenario;
 
 pub use chatter::{Chatter, ContactState, Impact, Interval, Outcome};
 pub use mechanics::{Mechanics, MechanicsError, Settings, Surface, simulate};

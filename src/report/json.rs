@@ -1,0 +1,205 @@
+//! The bounce result as JSON: the contract of `interfaces.md` §3.
+//!
+//! The contract's fields come first and in its order (`outcome`,
+//! `first_impact`, `settle_time`, `bounce_count`, `impacts`, `intervals`),
+//! then the additions `shortfall`, `accumulation_time`, `t_end` and, when
+//! known, a `dimensionless` object with the paper's groups. Absent values
+//! are `null`, never omitted, so every document has the same keys. Floats
+//! are serde_json's shortest round-trip form.
+
+use serde::Serialize;
+
+use crate::chatter::Chatter;
+use crate::mechanics::Dimensionless;
+
+/// The bounce object, ready to serialize alone or to embed (as `bounce`)
+/// in a larger document such as `run`'s.
+#[derive(Debug, Serialize)]
+pub struct BounceJson<'a> {
+    #[serde(flatten)]
+    chatter: &'a Chatter,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    dimensionless: Option<DimensionlessJson>,
+}
+
+impl<'a> BounceJson<'a> {
+    pub fn new(chatter: &'a Chatter, dimensionless: Option<&Dimensionless>) -> Self {
+        BounceJson {
+            chatter,
+            dimensionless: dimensionless.map(DimensionlessJson::from),
+        }
+    }
+}
+
+/// [`Dimensionless`] under the names of model.md §1–3.
+#[derive(Debug, Serialize)]
+struct DimensionlessJson {
+    omega_n: f64,
+    zeta: f64,
+    static_deflection: f64,
+    k0: f64,
+    zeta0: Option<f64>,
+    beta: Option<f64>,
+    sigma: Option<f64>,
+    zeta_prime: Option<f64>,
+    gamma: Option<f64>,
+}
+
+impl From<&Dimensionless> for DimensionlessJson {
+    fn from(d: &Dimensionless) -> Self {
+        DimensionlessJson {
+            omega_n: d.omega_n,
+            zeta: d.zeta,
+            static_deflection: d.static_deflection,
+            k0: d.k0,
+            zeta0: d.zeta0,
+            beta: d.beta,
+            sigma: d.sigma,
+            zeta_prime: d.zeta_prime,
+            gamma: d.gamma,
+        }
+    }
+}
+
+/// Pretty-printed JSON with a trailing newline.
+pub fn render(chatter: &Chatter, dimensionless: Option<&Dimensionless>) -> String {
+    let mut text = serde_json::to_string_pretty(&BounceJson::new(chatter, dimensionless))
+        // Only maps with non-string keys or a failing writer can fail, and
+        // these types have neither.
+        .expect("a chatter result always serializes");
+    text.push('\n');
+    text
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mechanics::{Mechanics, Surface};
+    use crate::report::fixtures;
+
+    #[test]
+    fn never_closes_is_exactly_this() {
+        let expected = r#"{
+  "outcome": "never_closes",
+  "first_impact": null,
+  "settle_time": null,
+  "bounce_count": 0,
+  "impacts": [],
+  "intervals": [
+    {
+      "state": "open",
+      "start": 0.0,
+      "end": 0.02
+    }
+  ],
+  "shortfall": 0.000025,
+  "accumulation_time": null,
+  "t_end": 0.02
+}
+"#;
+        assert_eq!(render(&fixtures::never_closes(), None), expected);
+    }
+
+    #[test]
+    fn contract_keys_come_first_in_contract_order() {
+        let text = render(&fixtures::stuck(), None);
+        let top: Vec<&str> = text
+            .lines()
+            .filter(|l| l.starts_with("  \"") && !l.starts_with("   "))
+            .map(|l| l.trim().split('"').nth(1).unwrap())
+            .collect();
+        assert_eq!(
+            top,
+            [
+                "outcome",
+                "first_impact",
+                "settle_time",
+                "bounce_count",
+                "impacts",
+                "intervals",
+                "shortfall",
+                "accumulation_time",
+                "t_end"
+            ]
+        );
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        let impact = &v["impacts"][0];
+        for key in [
+            "impact_time",
+            "impact_velocity",
+            "release_time",
+            "release_velocity",
+            "restitution",
+            "contact_time",
+            "peak_force",
+            "min_force",
+            "max_gap_after",
+        ] {
+            assert!(impact.get(key).is_some(), "impact lacks {key}");
+        }
+        assert_eq!(v["impacts"][2]["release_time"], serde_json::Value::Null);
+        assert_eq!(v["intervals"][5]["state"], "closed");
+        assert_eq!(v["settle_time"], 0.0016);
+    }
+
+    /// The numbers written after `"key": ` in `text`, read back with
+    /// Rust's correctly rounded parser (serde_json's default parser is not
+    /// exact in the last bit, so it cannot judge a round trip).
+    fn numbers(text: &str, key: &str) -> Vec<f64> {
+        let tag = format!("\"{key}\": ");
+        text.lines()
+            .filter_map(|l| l.trim().strip_prefix(&tag))
+            .filter_map(|n| n.trim_end_matches(',').parse().ok())
+            .collect()
+    }
+
+    #[test]
+    fn floats_round_trip_exactly() {
+        let chatter = fixtures::stuck();
+        let text = render(&chatter, None);
+        let times: Vec<f64> = chatter.impacts.iter().map(|i| i.impact_time).collect();
+        assert_eq!(numbers(&text, "impact_time"), times);
+        let e: Vec<f64> = chatter
+            .impacts
+            .iter()
+            .filter_map(|i| i.restitution)
+            .collect();
+        assert_eq!(numbers(&text, "restitution"), e);
+        assert_eq!(e[0], 0.26 / 0.31, "a value with all 17 digits");
+    }
+
+    #[test]
+    fn output_is_deterministic() {
+        let c = fixtures::stuck();
+        assert_eq!(render(&c, None), render(&c.clone(), None));
+    }
+
+    #[test]
+    fn dimensionless_groups_are_added_when_given() {
+        let m = Mechanics {
+            mass: 2e-4,
+            stiffness: 800.0,
+            damping: 0.04,
+            force: 0.5,
+            gap: 4.5e-4,
+            initial_position: 0.0,
+            initial_velocity: 0.0,
+            preload: 0.0,
+        };
+        let s = Surface::KelvinVoigt {
+            stiffness: 8e4,
+            damping: 0.37536,
+        };
+        let d = Dimensionless::of(&m, &s);
+        let text = render(&fixtures::stuck(), Some(&d));
+        assert_eq!(numbers(&text, "omega_n"), [2000.0]);
+        assert_eq!(numbers(&text, "zeta"), [d.zeta]);
+        assert_eq!(numbers(&text, "k0"), [d.k0]);
+        assert_eq!(numbers(&text, "beta"), [101.0]);
+        assert_eq!(numbers(&text, "zeta_prime"), [d.zeta_prime.unwrap()]);
+        let rigid = Dimensionless::of(&m, &Surface::Rigid { restitution: 0.5 });
+        let v: serde_json::Value =
+            serde_json::from_str(&render(&fixtures::stuck(), Some(&rigid))).unwrap();
+        assert_eq!(v["dimensionless"]["beta"], serde_json::Value::Null);
+    }
+}

@@ -1,0 +1,1623 @@
+//! The scenario file: one TOML file that describes a relay, its contact
+//! surface and, optionally, the circuit it switches (`interfaces.md` §1).
+//! Every command starts here.
+//!
+//! Loading has three steps, and every error names the file, the line when
+//! there is one, and the dotted key (`mechanics.mass`, `probe[0].low`):
+//! 1. TOML syntax, parsed into a tree that remembers where each key is;
+//! 2. shape: serde structs with `deny_unknown_fields`, so a misspelt key
+//!    is an error instead of a silently ignored line;
+//! 3. physics: every number finite and in range, sections consistent
+//!    (a step `force` or a `[coil]`, the keys of one surface law).
+//!
+//! A validated [`Scenario`] converts into the library's inputs:
+//! [`Scenario::mechanics`], [`Scenario::surface`], [`Scenario::settings`].
+
+use std::fmt;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+use thiserror::Error;
+use toml::de::{DeTable, DeValue};
+
+use crate::mechanics::surface::hunt_crossley_chi;
+use crate::mechanics::{Mechanics, Settings, Surface};
+
+/// The text of the built-in scenario: a small signal relay switching an
+/// MCU input. Exposed so that a command can write it out for the user to
+/// edit.
+pub const DEFAULT_SCENARIO_TOML: &str = include_str!("../scenarios/default.toml");
+
+/// Where the built-in scenario lives in the source tree. Its relative
+/// `circuit.netlist` resolves against this directory.
+const DEFAULT_SCENARIO_ORIGIN: &str =
+    concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/default.toml");
+
+/// `[mechanics]`: the moving contact (model.md §1). SI units.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MechanicsSection {
+    /// kg
+    pub mass: f64,
+    /// N/m
+    pub stiffness: f64,
+    /// N·s/m, may be 0.
+    pub damping: f64,
+    /// N, the step closing force; `None` when `[coil]` drives the contact.
+    pub force: Option<f64>,
+    /// m
+    pub gap: f64,
+    /// m
+    #[serde(default)]
+    pub initial_position: f64,
+    /// m/s
+    #[serde(default)]
+    pub initial_velocity: f64,
+    /// N, return-spring force holding the armature on its rest stop.
+    #[serde(default)]
+    pub preload: f64,
+}
+
+/// `[coil]`: the magnetic drive of model.md §7, instead of a step force.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CoilSection {
+    /// Ω
+    pub resistance: f64,
+    pub turns: u32,
+    /// m²
+    pub pole_area: f64,
+    /// m, armature air gap at rest.
+    pub air_gap: f64,
+    /// m, the iron path as an equivalent air gap.
+    pub iron_gap: f64,
+}
+
+/// `surface.law`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SurfaceLaw {
+    Rigid,
+    KelvinVoigt,
+    HuntCrossley,
+}
+
+impl SurfaceLaw {
+    /// The name used in the scenario file.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            SurfaceLaw::Rigid => "rigid",
+            SurfaceLaw::KelvinVoigt => "kelvin-voigt",
+            SurfaceLaw::HuntCrossley => "hunt-crossley",
+        }
+    }
+
+    /// The `[surface]` keys (besides `law`) this law reads.
+    fn keys(self) -> &'static [&'static str] {
+        match self {
+            SurfaceLaw::Rigid => &["restitution"],
+            SurfaceLaw::KelvinVoigt => &["stiffness", "damping"],
+            SurfaceLaw::HuntCrossley => &[
+                "stiffness",
+                "exponent",
+                "chi",
+                "restitution",
+                "reference_velocity",
+            ],
+        }
+    }
+
+    /// The same keys, as a reader should see them in an error.
+    fn keys_described(self) -> &'static str {
+        match self {
+            SurfaceLaw::Rigid => "`restitution`",
+            SurfaceLaw::KelvinVoigt => "`stiffness` and `damping`",
+            SurfaceLaw::HuntCrossley => {
+                "`stiffness`, `exponent` and `chi` (or `restitution` with `reference_velocity`)"
+            }
+        }
+    }
+}
+
+impl fmt::Display for SurfaceLaw {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// `[surface]` as written: one law and the keys it needs (model.md §2).
+/// The keys are all optional here because which ones are required depends
+/// on `law`; validation checks them and [`Scenario::surface`] gives the
+/// resolved law.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SurfaceSection {
+    pub law: SurfaceLaw,
+    /// N/m (Kelvin–Voigt s0) or N/mⁿ (Hunt–Crossley k).
+    pub stiffness: Option<f64>,
+    /// N·s/m, Kelvin–Voigt r0.
+    pub damping: Option<f64>,
+    /// Rigid e, or Hunt–Crossley e at `reference_velocity`.
+    pub restitution: Option<f64>,
+    /// Hunt–Crossley n (default 1, the paper's linear spring).
+    pub exponent: Option<f64>,
+    /// s/m, Hunt–Crossley χ = λ/k.
+    pub chi: Option<f64>,
+    /// m/s, the impact speed at which the Hunt–Crossley `restitution` holds.
+    pub reference_velocity: Option<f64>,
+}
+
+/// `[contact]`: the contact as a resistor (model.md §5).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ContactSection {
+    /// Ω
+    pub r_closed: f64,
+    /// Ω
+    pub r_open: f64,
+    /// s, duration of each make or break edge.
+    pub edge_time: f64,
+}
+
+impl Default for ContactSection {
+    /// 50 mΩ is the low end of datasheet closed resistance, 1 GΩ is above
+    /// any datasheet's open minimum, and 10 ns edges are far shorter than
+    /// any bounce yet long enough for ngspice to step through.
+    fn default() -> Self {
+        ContactSection {
+            r_closed: 0.05,
+            r_open: 1.0e9,
+            edge_time: 1.0e-8,
+        }
+    }
+}
+
+/// `[simulation]`: the engine's [`Settings`].
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SimulationSection {
+    /// s
+    pub t_end: f64,
+    /// s
+    pub min_open_time: f64,
+    /// m
+    pub min_gap: f64,
+}
+
+impl Default for SimulationSection {
+    /// The engine's own defaults, so that the file and the library agree.
+    fn default() -> Self {
+        let s = Settings::default();
+        SimulationSection {
+            t_end: s.t_end,
+            min_open_time: s.min_open_time,
+            min_gap: s.min_gap,
+        }
+    }
+}
+
+/// `[circuit]`: the netlist the contact is placed into.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CircuitSection {
+    /// The netlist file. Relative paths in the file are resolved against
+    /// the scenario file's directory when it is loaded; the file need not
+    /// exist until a command runs the circuit.
+    pub netlist: PathBuf,
+    /// The subcircuit name the netlist instantiates for the contact.
+    #[serde(default = "default_subckt")]
+    pub subckt: String,
+    /// The subcircuit name the netlist instantiates for the coil.
+    #[serde(default = "default_coil_subckt")]
+    pub coil_subckt: String,
+}
+
+fn default_subckt() -> String {
+    "CONTACT".to_owned()
+}
+
+fn default_coil_subckt() -> String {
+    "COIL".to_owned()
+}
+
+/// `[[probe]]`: a measured signal and its Schmitt thresholds.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Probe {
+    /// An ngspice vector name, e.g. `v(in)`.
+    pub signal: String,
+    /// V
+    pub low: f64,
+    /// V
+    pub high: f64,
+}
+
+/// The file as serde sees it; [`Scenario`] adds the origin and the
+/// resolved surface law.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Document {
+    mechanics: MechanicsSection,
+    coil: Option<CoilSection>,
+    surface: SurfaceSection,
+    #[serde(default)]
+    contact: ContactSection,
+    #[serde(default)]
+    simulation: SimulationSection,
+    circuit: Option<CircuitSection>,
+    #[serde(default)]
+    probe: Vec<Probe>,
+}
+
+/// A loaded and validated scenario file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scenario {
+    /// The file it came from (for messages, and the base of relative paths).
+    pub origin: PathBuf,
+    pub mechanics: MechanicsSection,
+    pub coil: Option<CoilSection>,
+    pub surface: SurfaceSection,
+    pub contact: ContactSection,
+    pub simulation: SimulationSection,
+    pub circuit: Option<CircuitSection>,
+    /// The `[[probe]]` tables, in file order.
+    pub probes: Vec<Probe>,
+    /// Computed once during validation: converting a Hunt–Crossley
+    /// restitution into χ is a root solve that can fail.
+    resolved_surface: Surface,
+}
+
+/// A place in a scenario file: the file and, when known, the 1-based line.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Location {
+    pub path: PathBuf,
+    pub line: Option<usize>,
+}
+
+impl fmt::Display for Location {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.line {
+            Some(line) => write!(f, "{}:{line}", self.path.display()),
+            None => write!(f, "{}", self.path.display()),
+        }
+    }
+}
+
+/// Why a scenario file cannot be used. Each variant says where (`at`),
+/// which key, and what to change.
+#[derive(Debug, Error)]
+pub enum ScenarioError {
+    #[error("{}: cannot read the scenario file", path.display())]
+    Read {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{at}: not valid TOML (column {column}): {message}")]
+    Syntax {
+        at: Location,
+        column: usize,
+        message: String,
+        #[source]
+        source: Box<toml::de::Error>,
+    },
+    #[error("{at}: unknown key `{key}` (misspelt?); {expected}")]
+    UnknownKey {
+        at: Location,
+        key: String,
+        expected: String,
+        #[source]
+        source: Box<toml::de::Error>,
+    },
+    #[error("{at}: `{key}` is missing: {help}")]
+    MissingKey {
+        at: Location,
+        key: String,
+        help: String,
+        #[source]
+        source: Option<Box<toml::de::Error>>,
+    },
+    #[error("{at}: bad value for `{key}`: {message}")]
+    BadValue {
+        at: Location,
+        key: String,
+        message: String,
+        #[source]
+        source: Box<toml::de::Error>,
+    },
+    #[error("{at}: `{key}` = {value:?} {requirement}")]
+    Invalid {
+        at: Location,
+        key: String,
+        value: f64,
+        requirement: String,
+    },
+    #[error("{at}: `{key}` must not be empty: {help}")]
+    Empty {
+        at: Location,
+        key: String,
+        help: &'static str,
+    },
+    #[error("{at}: `{key}` and `{other}` cannot both be given: {advice}")]
+    Conflict {
+        at: Location,
+        key: String,
+        other: String,
+        advice: &'static str,
+    },
+    #[error(
+        "{at}: `{key}` is not a key of surface law \"{law}\", which takes {takes}; \
+         remove it or change `surface.law`"
+    )]
+    NotForLaw {
+        at: Location,
+        key: String,
+        law: SurfaceLaw,
+        takes: &'static str,
+    },
+    #[error(
+        "{}: the coil drive ([coil], model.md §7) is not simulated yet; \
+         replace [coil] with `mechanics.force`, the closing force in N",
+        path.display()
+    )]
+    CoilDriveUnsupported { path: PathBuf },
+}
+
+impl ScenarioError {
+    /// The dotted key the error is about, if it is about one.
+    pub fn key(&self) -> Option<&str> {
+        match self {
+            ScenarioError::UnknownKey { key, .. }
+            | ScenarioError::MissingKey { key, .. }
+            | ScenarioError::BadValue { key, .. }
+            | ScenarioError::Invalid { key, .. }
+            | ScenarioError::Empty { key, .. }
+            | ScenarioError::Conflict { key, .. }
+            | ScenarioError::NotForLaw { key, .. } => Some(key),
+            ScenarioError::Read { .. }
+            | ScenarioError::Syntax { .. }
+            | ScenarioError::CoilDriveUnsupported { .. } => None,
+        }
+    }
+}
+
+impl Scenario {
+    /// Read, parse and validate a scenario file.
+    pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Read {
+            path: path.to_owned(),
+            source,
+        })?;
+        Scenario::parse(&text, path)
+    }
+
+    /// Parse and validate scenario text. `origin` names it in errors, and
+    /// relative paths in it (`circuit.netlist`) are resolved against
+    /// `origin`'s directory.
+    pub fn parse(text: &str, origin: &Path) -> Result<Scenario, ScenarioError> {
+        let tree = DeTable::parse(text).map_err(|source| {
+            let start = source.span().map_or(0, |s| s.start);
+            let (line, column) = line_column(text, start);
+            ScenarioError::Syntax {
+                at: Location {
+                    path: origin.to_owned(),
+                    line: Some(line),
+                },
+                column,
+                message: source.message().trim_end().to_owned(),
+                source: Box::new(source),
+            }
+        })?;
+        let index = KeyIndex::new(&tree, text);
+        let document = Document::deserialize(toml::de::Deserializer::from(tree))
+            .map_err(|e| index.shape_error(e, origin))?;
+        let check = Check {
+            origin,
+            index: &index,
+        };
+        let resolved_surface = check.all(&document)?;
+
+        let base = origin.parent().unwrap_or(Path::new(""));
+        let circuit = document.circuit.map(|c| CircuitSection {
+            netlist: base.join(&c.netlist),
+            ..c
+        });
+        Ok(Scenario {
+            origin: origin.to_owned(),
+            mechanics: document.mechanics,
+            coil: document.coil,
+            surface: document.surface,
+            contact: document.contact,
+            simulation: document.simulation,
+            circuit,
+            probes: document.probe,
+            resolved_surface,
+        })
+    }
+
+    /// The built-in scenario (`scenarios/default.toml`, compiled in): a
+    /// small signal relay with a Kelvin–Voigt contact switching an MCU
+    /// input.
+    pub fn builtin_default() -> Scenario {
+        // The unit tests parse it, so a broken file never ships.
+        Scenario::parse(DEFAULT_SCENARIO_TOML, Path::new(DEFAULT_SCENARIO_ORIGIN))
+            .expect("the built-in scenario is valid")
+    }
+
+    /// The step-force mechanics for the engine. Fails for a coil-driven
+    /// scenario, which the engine does not simulate yet: silently running
+    /// it with some other force would give a plausible but wrong answer.
+    pub fn mechanics(&self) -> Result<Mechanics, ScenarioError> {
+        let m = &self.mechanics;
+        let force = m.force.ok_or_else(|| ScenarioError::CoilDriveUnsupported {
+            path: self.origin.clone(),
+        })?;
+        Ok(Mechanics {
+            mass: m.mass,
+            stiffness: m.stiffness,
+            damping: m.damping,
+            force,
+            gap: m.gap,
+            initial_position: m.initial_position,
+            initial_velocity: m.initial_velocity,
+            preload: m.preload,
+        })
+    }
+
+    /// The surface law, with a Hunt–Crossley restitution already converted
+    /// to χ.
+    pub fn surface(&self) -> Surface {
+        self.resolved_surface
+    }
+
+    /// The engine settings from `[simulation]`.
+    pub fn settings(&self) -> Settings {
+        let s = &self.simulation;
+        Settings {
+            t_end: s.t_end,
+            min_open_time: s.min_open_time,
+            min_gap: s.min_gap,
+        }
+    }
+}
+
+/// 1-based line and column of byte offset `at` in `text`.
+fn line_column(text: &str, at: usize) -> (usize, usize) {
+    let at = at.min(text.len());
+    let before = &text.as_bytes()[..at];
+    let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+    let line_start = before
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(0, |i| i + 1);
+    let column = String::from_utf8_lossy(&before[line_start..])
+        .chars()
+        .count()
+        + 1;
+    (line, column)
+}
+
+/// Every key of the parsed file with its dotted path and where it is, so
+/// that errors from serde (which know a byte span) and from validation
+/// (which know a key) can both name the key and the line.
+struct KeyIndex<'t> {
+    text: &'t str,
+    document_span: Range<usize>,
+    entries: Vec<KeyEntry>,
+}
+
+struct KeyEntry {
+    path: String,
+    key_span: Range<usize>,
+    value_span: Range<usize>,
+}
+
+impl<'t> KeyIndex<'t> {
+    fn new(tree: &toml::Spanned<DeTable<'_>>, text: &'t str) -> Self {
+        let mut entries = Vec::new();
+        Self::walk(tree.get_ref(), "", &mut entries);
+        KeyIndex {
+            text,
+            document_span: tree.span(),
+            entries,
+        }
+    }
+
+    fn walk(table: &DeTable<'_>, prefix: &str, out: &mut Vec<KeyEntry>) {
+        for (key, value) in table.iter() {
+            let path = join_key(prefix, key.get_ref());
+            out.push(KeyEntry {
+                path: path.clone(),
+                key_span: key.span(),
+                value_span: value.span(),
+            });
+            match value.get_ref() {
+                DeValue::Table(inner) => Self::walk(inner, &path, out),
+                DeValue::Array(items) => {
+                    for (i, item) in items.into_iter().enumerate() {
+                        let item_path = format!("{path}[{i}]");
+                        out.push(KeyEntry {
+                            path: item_path.clone(),
+                            key_span: item.span(),
+                            value_span: item.span(),
+                        });
+                        if let DeValue::Table(inner) = item.get_ref() {
+                            Self::walk(inner, &item_path, out);
+                        }
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+
+    /// The line of `key`, or of its nearest ancestor present in the file
+    /// (a missing key is reported at its section's header).
+    fn line_of_key(&self, key: &str) -> Option<usize> {
+        let mut key = key;
+        loop {
+            if let Some(e) = self.entries.iter().find(|e| e.path == key) {
+                return Some(line_column(self.text, e.key_span.start).0);
+            }
+            key = &key[..key.rfind(['.', '['])?];
+        }
+    }
+
+    /// The key an error span belongs to: exactly a key or value span if
+    /// one matches, else the innermost value containing it; "" for the
+    /// document itself.
+    fn key_at(&self, span: &Range<usize>) -> &str {
+        if *span == self.document_span {
+            return "";
+        }
+        // Children follow their parent in `entries`, and an array of one
+        // table can share its span with that table: search from the end
+        // so that the deepest key wins.
+        if let Some(e) = self
+            .entries
+            .iter()
+            .rev()
+            .find(|e| e.key_span == *span || e.value_span == *span)
+        {
+            return &e.path;
+        }
+        self.entries
+            .iter()
+            .filter(|e| e.value_span.start <= span.start && span.end <= e.value_span.end)
+            .min_by_key(|e| e.value_span.len())
+            .map_or("", |e| e.path.as_str())
+    }
+
+    /// Turn a serde error (unknown key, missing key, wrong type) into one
+    /// that names the dotted key.
+    fn shape_error(&self, mut source: toml::de::Error, origin: &Path) -> ScenarioError {
+        // With the text, the error displays an excerpt with the key marked.
+        source.set_input(Some(self.text));
+        let span = source.span();
+        let at = Location {
+            path: origin.to_owned(),
+            line: span.as_ref().map(|s| line_column(self.text, s.start).0),
+        };
+        let here = span.as_ref().map_or("", |s| self.key_at(s)).to_owned();
+        let message = source.message().trim_end().to_owned();
+        let source = Box::new(source);
+        // serde's own wording (`de::Error::unknown_field`, `missing_field`)
+        // is the only place the field name is available.
+        let unknown = message
+            .strip_prefix("unknown field `")
+            .and_then(|rest| rest.split_once("`, "));
+        if let Some((_, expected)) = unknown {
+            return ScenarioError::UnknownKey {
+                at,
+                key: here,
+                expected: expected.to_owned(),
+                source,
+            };
+        }
+        let missing = message
+            .strip_prefix("missing field `")
+            .and_then(|rest| rest.split_once('`'));
+        if let Some((name, _)) = missing {
+            let key = join_key(&here, name);
+            return ScenarioError::MissingKey {
+                at,
+                help: key_help(&key).to_owned(),
+                key,
+                source: Some(source),
+            };
+        }
+        ScenarioError::BadValue {
+            at,
+            key: here,
+            message,
+            source,
+        }
+    }
+}
+
+fn join_key(prefix: &str, name: &str) -> String {
+    if prefix.is_empty() {
+        name.to_owned()
+    } else {
+        format!("{prefix}.{name}")
+    }
+}
+
+/// What a required key means, for "missing" messages.
+fn key_help(key: &str) -> &'static str {
+    match key {
+        "mechanics" => "add a [mechanics] section: mass, stiffness, damping, force, gap",
+        "surface" => "add a [surface] section with `law` and its keys",
+        "mechanics.mass" => "the effective moving mass, in kg",
+        "mechanics.stiffness" => "the contact-spring stiffness, in N/m",
+        "mechanics.damping" => "the structural damping in N·s/m (0 is allowed)",
+        "mechanics.gap" => "the contact travel from rest to the fixed contact, in m",
+        "surface.law" => "one of \"rigid\", \"kelvin-voigt\", \"hunt-crossley\"",
+        "circuit.netlist" => "the netlist file, relative to the scenario file",
+        k if k.starts_with("coil.") => {
+            "the [coil] section needs resistance, turns, pole_area, air_gap, iron_gap"
+        }
+        k if k.starts_with("probe") => "each [[probe]] needs signal, low and high",
+        _ => "see interfaces.md §1 for the keys of each section",
+    }
+}
+
+/// Validation of a deserialized document, in file order.
+struct Check<'a> {
+    origin: &'a Path,
+    index: &'a KeyIndex<'a>,
+}
+
+impl Check<'_> {
+    fn at(&self, key: &str) -> Location {
+        Location {
+            path: self.origin.to_owned(),
+            line: self.index.line_of_key(key),
+        }
+    }
+
+    fn invalid(&self, key: &str, value: f64, requirement: impl Into<String>) -> ScenarioError {
+        ScenarioError::Invalid {
+            at: self.at(key),
+            key: key.to_owned(),
+            value,
+            requirement: requirement.into(),
+        }
+    }
+
+    /// `value` must be finite and satisfy `ok`; `requirement` says what to
+    /// change when it does not.
+    fn number(
+        &self,
+        key: &str,
+        value: f64,
+        ok: bool,
+        requirement: impl Into<String>,
+    ) -> Result<(), ScenarioError> {
+        if !value.is_finite() {
+            return Err(self.invalid(key, value, "must be a finite number (not nan or inf)"));
+        }
+        if !ok {
+            return Err(self.invalid(key, value, requirement));
+        }
+        Ok(())
+    }
+
+    fn missing(&self, key: &str, help: &str) -> ScenarioError {
+        ScenarioError::MissingKey {
+            at: self.at(key),
+            key: key.to_owned(),
+            help: help.to_owned(),
+            source: None,
+        }
+    }
+
+    fn not_empty(&self, key: &str, value: &str, help: &'static str) -> Result<(), ScenarioError> {
+        if value.trim().is_empty() {
+            return Err(ScenarioError::Empty {
+                at: self.at(key),
+                key: key.to_owned(),
+                help,
+            });
+        }
+        Ok(())
+    }
+
+    /// Everything; returns the resolved surface law.
+    fn all(&self, d: &Document) -> Result<Surface, ScenarioError> {
+        self.mechanics(&d.mechanics)?;
+        self.drive(&d.mechanics, d.coil.as_ref())?;
+        let surface = self.surface(&d.surface)?;
+        self.contact(&d.contact)?;
+        self.simulation(&d.simulation)?;
+        if let Some(circuit) = &d.circuit {
+            self.circuit(circuit)?;
+        }
+        for (i, probe) in d.probe.iter().enumerate() {
+            self.probe(i, probe)?;
+        }
+        Ok(surface)
+    }
+
+    fn mechanics(&self, m: &MechanicsSection) -> Result<(), ScenarioError> {
+        self.number(
+            "mechanics.mass",
+            m.mass,
+            m.mass > 0.0,
+            "must be > 0: the effective moving mass, in kg",
+        )?;
+        self.number(
+            "mechanics.stiffness",
+            m.stiffness,
+            m.stiffness > 0.0,
+            "must be > 0: the contact-spring stiffness, in N/m",
+        )?;
+        self.number(
+            "mechanics.damping",
+            m.damping,
+            m.damping >= 0.0,
+            "must be ≥ 0: damping removes energy, it cannot add it",
+        )?;
+        self.number(
+            "mechanics.gap",
+            m.gap,
+            m.gap > 0.0,
+            "must be > 0: the travel from rest to the fixed contact, in m",
+        )?;
+        self.number(
+            "mechanics.initial_position",
+            m.initial_position,
+            m.initial_position < m.gap,
+            format!(
+                "must be less than `mechanics.gap` = {:?} m: the contact has to start open",
+                m.gap
+            ),
+        )?;
+        self.number("mechanics.initial_velocity", m.initial_velocity, true, "")?;
+        self.number(
+            "mechanics.preload",
+            m.preload,
+            m.preload >= 0.0,
+            "must be ≥ 0: the return spring holds the armature on its rest stop",
+        )
+    }
+
+    /// Exactly one of a step force and a coil.
+    fn drive(&self, m: &MechanicsSection, coil: Option<&CoilSection>) -> Result<(), ScenarioError> {
+        match (m.force, coil) {
+            (Some(_), Some(_)) => Err(ScenarioError::Conflict {
+                at: self.at("mechanics.force"),
+                key: "mechanics.force".to_owned(),
+                other: "coil".to_owned(),
+                advice: "with [coil] the closing force comes from the coil current; \
+                         remove `mechanics.force` or the [coil] section",
+            }),
+            (None, None) => Err(self.missing(
+                "mechanics.force",
+                "give the step closing force in N, or a [coil] section that produces it",
+            )),
+            (Some(force), None) => self.number(
+                "mechanics.force",
+                force,
+                force > m.preload,
+                format!(
+                    "must exceed `mechanics.preload` = {:?} N, or the armature never leaves its rest stop",
+                    m.preload
+                ),
+            ),
+            (None, Some(c)) => self.coil(c, m.gap),
+        }
+    }
+
+    fn coil(&self, c: &CoilSection, gap: f64) -> Result<(), ScenarioError> {
+        self.number(
+            "coil.resistance",
+            c.resistance,
+            c.resistance > 0.0,
+            "must be > 0: the coil's DC resistance, in Ω",
+        )?;
+        if c.turns == 0 {
+            return Err(self.invalid(
+                "coil.turns",
+                0.0,
+                "must be at least 1: the number of turns of the coil",
+            ));
+        }
+        self.number(
+            "coil.pole_area",
+            c.pole_area,
+            c.pole_area > 0.0,
+            "must be > 0: the pole face area, in m²",
+        )?;
+        self.number(
+            "coil.air_gap",
+            c.air_gap,
+            c.air_gap > gap,
+            format!(
+                "must exceed `mechanics.gap` = {gap:?} m: a residual air gap must remain \
+                 when the contacts close"
+            ),
+        )?;
+        self.number(
+            "coil.iron_gap",
+            c.iron_gap,
+            c.iron_gap >= 0.0,
+            "must be ≥ 0: the iron path as an equivalent air gap, in m",
+        )
+    }
+
+    fn surface(&self, s: &SurfaceSection) -> Result<Surface, ScenarioError> {
+        let law = s.law;
+        let given = [
+            ("stiffness", s.stiffness),
+            ("damping", s.damping),
+            ("restitution", s.restitution),
+            ("exponent", s.exponent),
+            ("chi", s.chi),
+            ("reference_velocity", s.reference_velocity),
+        ];
+        for (name, value) in given {
+            if value.is_some() && !law.keys().contains(&name) {
+                let key = format!("surface.{name}");
+                return Err(ScenarioError::NotForLaw {
+                    at: self.at(&key),
+                    key,
+                    law,
+                    takes: law.keys_described(),
+                });
+            }
+        }
+        let need = |name: &str, help: &str| {
+            given
+                .iter()
+                .find(|(n, _)| *n == name)
+                .and_then(|(_, v)| *v)
+                .ok_or_else(|| self.missing(&format!("surface.{name}"), help))
+        };
+        match law {
+            SurfaceLaw::Rigid => {
+                let e = need(
+                    "restitution",
+                    "law \"rigid\" needs the restitution e in [0, 1]",
+                )?;
+                self.number(
+                    "surface.restitution",
+                    e,
+                    (0.0..=1.0).contains(&e),
+                    "must lie in [0, 1]: 0 is a dead impact, 1 a perfectly elastic one",
+                )?;
+                Ok(Surface::Rigid { restitution: e })
+            }
+            SurfaceLaw::KelvinVoigt => {
+                let stiffness = need(
+                    "stiffness",
+                    "law \"kelvin-voigt\" needs the surface stiffness s0 in N/m",
+                )?;
+                self.number(
+                    "surface.stiffness",
+                    stiffness,
+                    stiffness > 0.0,
+                    "must be > 0: the surface stiffness s0, in N/m",
+                )?;
+                let damping = need(
+                    "damping",
+                    "law \"kelvin-voigt\" needs the surface damping r0 in N·s/m (0 is allowed)",
+                )?;
+                self.number(
+                    "surface.damping",
+                    damping,
+                    damping >= 0.0,
+                    "must be ≥ 0: the surface damping r0, in N·s/m",
+                )?;
+                Ok(Surface::KelvinVoigt { stiffness, damping })
+            }
+            SurfaceLaw::HuntCrossley => self.hunt_crossley(s),
+        }
+    }
+
+    fn hunt_crossley(&self, s: &SurfaceSection) -> Result<Surface, ScenarioError> {
+        let stiffness = s.stiffness.ok_or_else(|| {
+            self.missing(
+                "surface.stiffness",
+                "law \"hunt-crossley\" needs the surface stiffness k in N/mⁿ",
+            )
+        })?;
+        self.number(
+            "surface.stiffness",
+            stiffness,
+            stiffness > 0.0,
+            "must be > 0: the surface stiffness k, in N/mⁿ",
+        )?;
+        // n = 1 is the paper's linear surface spring (model.md §2c).
+        let exponent = s.exponent.unwrap_or(1.0);
+        self.number(
+            "surface.exponent",
+            exponent,
+            exponent > 0.0,
+            "must be > 0: 1 for a linear spring, 1.5 for Hertz contact",
+        )?;
+        let chi = match (s.chi, s.restitution, s.reference_velocity) {
+            (Some(chi), None, None) => {
+                self.number(
+                    "surface.chi",
+                    chi,
+                    chi >= 0.0,
+                    "must be ≥ 0: χ = λ/k in s/m (0 is a lossless surface)",
+                )?;
+                chi
+            }
+            (Some(_), restitution, _) => {
+                let other = if restitution.is_some() {
+                    "surface.restitution"
+                } else {
+                    "surface.reference_velocity"
+                };
+                return Err(ScenarioError::Conflict {
+                    at: self.at("surface.chi"),
+                    key: "surface.chi".to_owned(),
+                    other: other.to_owned(),
+                    advice: "give χ directly, or as `restitution` at `reference_velocity`, not both",
+                });
+            }
+            (None, Some(e), Some(v)) => {
+                self.number(
+                    "surface.restitution",
+                    e,
+                    e > 0.0 && e <= 1.0,
+                    "must lie in (0, 1]: the restitution at `reference_velocity`",
+                )?;
+                self.number(
+                    "surface.reference_velocity",
+                    v,
+                    v > 0.0,
+                    "must be > 0: the impact speed, in m/s, at which `restitution` holds",
+                )?;
+                hunt_crossley_chi(e, v).ok_or_else(|| {
+                    self.invalid(
+                        "surface.restitution",
+                        e,
+                        format!(
+                            "cannot be reached at `reference_velocity` = {v:?} m/s; \
+                             give `chi` directly"
+                        ),
+                    )
+                })?
+            }
+            (None, Some(_), None) => {
+                return Err(self.missing(
+                    "surface.reference_velocity",
+                    "a Hunt–Crossley `restitution` holds at one impact speed; give it in m/s",
+                ));
+            }
+            (None, None, Some(_)) => {
+                return Err(self.missing(
+                    "surface.restitution",
+                    "`reference_velocity` needs the restitution e in (0, 1] that holds at it",
+                ));
+            }
+            (None, None, None) => {
+                return Err(self.missing(
+                    "surface.chi",
+                    "law \"hunt-crossley\" needs `chi` in s/m, or `restitution` with \
+                     `reference_velocity` in m/s",
+                ));
+            }
+        };
+        Ok(Surface::HuntCrossley {
+            stiffness,
+            exponent,
+            chi,
+        })
+    }
+
+    fn contact(&self, c: &ContactSection) -> Result<(), ScenarioError> {
+        self.number(
+            "contact.r_closed",
+            c.r_closed,
+            c.r_closed > 0.0,
+            "must be > 0: the closed contact resistance, in Ω (datasheets: 0.05–0.1)",
+        )?;
+        self.number(
+            "contact.r_open",
+            c.r_open,
+            c.r_open > c.r_closed,
+            format!(
+                "must exceed `contact.r_closed` = {:?} Ω: the open contact resistance, in Ω",
+                c.r_closed
+            ),
+        )?;
+        self.number(
+            "contact.edge_time",
+            c.edge_time,
+            c.edge_time > 0.0,
+            "must be > 0: the duration of each make or break edge, in s",
+        )
+    }
+
+    fn simulation(&self, s: &SimulationSection) -> Result<(), ScenarioError> {
+        self.number(
+            "simulation.t_end",
+            s.t_end,
+            s.t_end > 0.0,
+            "must be > 0: the simulated horizon, in s",
+        )?;
+        self.number(
+            "simulation.min_open_time",
+            s.min_open_time,
+            s.min_open_time >= 0.0,
+            "must be ≥ 0: the shortest opening worth resolving, in s",
+        )?;
+        self.number(
+            "simulation.min_gap",
+            s.min_gap,
+            s.min_gap >= 0.0,
+            "must be ≥ 0: the smallest opening worth resolving, in m",
+        )
+    }
+
+    fn circuit(&self, c: &CircuitSection) -> Result<(), ScenarioError> {
+        self.not_empty(
+            "circuit.netlist",
+            &c.netlist.to_string_lossy(),
+            "the netlist file, relative to the scenario file",
+        )?;
+        self.not_empty(
+            "circuit.subckt",
+            &c.subckt,
+            "the subcircuit name the netlist uses for the contact",
+        )?;
+        self.not_empty(
+            "circuit.coil_subckt",
+            &c.coil_subckt,
+            "the subcircuit name the netlist uses for the coil",
+        )
+    }
+
+    fn probe(&self, i: usize, p: &Probe) -> Result<(), ScenarioError> {
+        let key = |name: &str| format!("probe[{i}].{name}");
+        self.not_empty(
+            &key("signal"),
+            &p.signal,
+            "an ngspice vector name such as \"v(in)\"",
+        )?;
+        self.number(&key("high"), p.high, true, "")?;
+        self.number(
+            &key("low"),
+            p.low,
+            p.low < p.high,
+            format!(
+                "must be below `probe[{i}].high` = {:?} V: the Schmitt thresholds need low < high",
+                p.high
+            ),
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const ORIGIN: &str = "relays/test.toml";
+
+    const VALID: &str = r#"[mechanics]
+mass = 2.0e-4
+stiffness = 800.0
+damping = 0.04
+force = 0.5
+gap = 4.5e-4
+
+[surface]
+law = "kelvin-voigt"
+stiffness = 8.0e4
+damping = 0.37536
+
+[circuit]
+netlist = "net/input.cir"
+
+[[probe]]
+signal = "v(in)"
+low = 0.99
+high = 2.31
+"#;
+
+    const SURFACE: &str = "law = \"kelvin-voigt\"\nstiffness = 8.0e4\ndamping = 0.37536\n";
+
+    fn parse(text: &str) -> Result<Scenario, ScenarioError> {
+        Scenario::parse(text, Path::new(ORIGIN))
+    }
+
+    /// VALID with one piece of text replaced.
+    fn edit(old: &str, new: &str) -> String {
+        assert!(VALID.contains(old), "test edit `{old}` not in VALID");
+        VALID.replacen(old, new, 1)
+    }
+
+    /// VALID with the body of [surface] replaced.
+    fn with_surface(body: &str) -> String {
+        edit(SURFACE, &format!("{body}\n"))
+    }
+
+    /// The text must fail on `key`, with a message naming the file and key.
+    #[track_caller]
+    fn fails_on(text: &str, key: &str) -> ScenarioError {
+        let err = match parse(text) {
+            Ok(_) => panic!("expected an error on `{key}`, but it parsed:\n{text}"),
+            Err(e) => e,
+        };
+        let msg = err.to_string();
+        assert_eq!(err.key(), Some(key), "wrong key in: {msg}");
+        assert!(msg.contains(ORIGIN), "file not named in: {msg}");
+        assert!(msg.contains(&format!("`{key}`")), "key not named in: {msg}");
+        err
+    }
+
+    #[track_caller]
+    fn line_of(err: &ScenarioError) -> Option<usize> {
+        match err {
+            ScenarioError::Syntax { at, .. }
+            | ScenarioError::UnknownKey { at, .. }
+            | ScenarioError::MissingKey { at, .. }
+            | ScenarioError::BadValue { at, .. }
+            | ScenarioError::Invalid { at, .. }
+            | ScenarioError::Empty { at, .. }
+            | ScenarioError::Conflict { at, .. }
+            | ScenarioError::NotForLaw { at, .. } => at.line,
+            ScenarioError::Read { .. } | ScenarioError::CoilDriveUnsupported { .. } => None,
+        }
+    }
+
+    #[test]
+    fn valid_file_converts_to_library_types() {
+        let s = parse(VALID).unwrap();
+        let m = s.mechanics().unwrap();
+        assert_eq!(m.mass, 2.0e-4);
+        assert_eq!(m.force, 0.5);
+        assert_eq!(m.gap, 4.5e-4);
+        assert_eq!(
+            s.surface(),
+            Surface::KelvinVoigt {
+                stiffness: 8.0e4,
+                damping: 0.37536
+            }
+        );
+        assert_eq!(s.probes.len(), 1);
+        assert_eq!(s.probes[0].signal, "v(in)");
+    }
+
+    #[test]
+    fn optional_keys_take_their_documented_defaults() {
+        let s = parse(VALID).unwrap();
+        let m = s.mechanics().unwrap();
+        assert_eq!(
+            (m.initial_position, m.initial_velocity, m.preload),
+            (0.0, 0.0, 0.0)
+        );
+        assert_eq!(s.contact, ContactSection::default());
+        assert_eq!(
+            (s.contact.r_closed, s.contact.r_open, s.contact.edge_time),
+            (0.05, 1e9, 1e-8)
+        );
+        assert_eq!(s.settings(), Settings::default());
+        assert_eq!(
+            (
+                s.simulation.t_end,
+                s.simulation.min_open_time,
+                s.simulation.min_gap
+            ),
+            (0.02, 1e-9, 1e-9)
+        );
+        let c = s.circuit.unwrap();
+        assert_eq!(
+            (c.subckt.as_str(), c.coil_subckt.as_str()),
+            ("CONTACT", "COIL")
+        );
+    }
+
+    #[test]
+    fn sections_other_than_mechanics_and_surface_are_optional() {
+        let text = VALID.split("[circuit]").next().unwrap();
+        let s = parse(text).unwrap();
+        assert!(s.circuit.is_none());
+        assert!(s.probes.is_empty());
+    }
+
+    #[test]
+    fn explicit_settings_are_used() {
+        let text =
+            format!("{VALID}\n[simulation]\nt_end = 0.005\nmin_open_time = 0.0\nmin_gap = 1e-12\n");
+        let s = parse(&text).unwrap().settings();
+        assert_eq!((s.t_end, s.min_open_time, s.min_gap), (0.005, 0.0, 1e-12));
+    }
+
+    #[test]
+    fn integers_are_accepted_where_numbers_are_expected() {
+        let s = parse(&edit("stiffness = 800.0", "stiffness = 800")).unwrap();
+        assert_eq!(s.mechanics.stiffness, 800.0);
+    }
+
+    #[test]
+    fn netlist_resolves_against_the_scenario_directory() {
+        let s = parse(VALID).unwrap();
+        assert_eq!(
+            s.circuit.unwrap().netlist,
+            Path::new("relays").join("net/input.cir")
+        );
+        let abs = edit("\"net/input.cir\"", "\"/opt/net.cir\"");
+        assert_eq!(
+            parse(&abs).unwrap().circuit.unwrap().netlist,
+            Path::new("/opt/net.cir")
+        );
+    }
+
+    #[test]
+    fn builtin_default_is_the_documented_relay() {
+        let s = Scenario::builtin_default();
+        let m = s.mechanics().unwrap();
+        assert_eq!(
+            (m.mass, m.stiffness, m.damping, m.force, m.gap),
+            (2e-4, 800.0, 0.04, 0.5, 4.5e-4)
+        );
+        assert_eq!(
+            s.surface(),
+            Surface::KelvinVoigt {
+                stiffness: 8e4,
+                damping: 0.37536
+            }
+        );
+        assert_eq!(s.settings().t_end, 0.02);
+        let netlist = s.circuit.unwrap().netlist;
+        assert!(
+            netlist.ends_with("scenarios/../netlists/mcu_input.cir"),
+            "{netlist:?}"
+        );
+        assert_eq!(
+            s.probes,
+            vec![Probe {
+                signal: "v(in)".into(),
+                low: 0.99,
+                high: 2.31
+            }]
+        );
+    }
+
+    #[test]
+    fn example_scenarios_parse() {
+        let examples = [
+            ("rigid", include_str!("../examples/scenarios/rigid.toml")),
+            (
+                "kelvin-voigt",
+                include_str!("../examples/scenarios/kelvin-voigt.toml"),
+            ),
+            (
+                "hunt-crossley",
+                include_str!("../examples/scenarios/hunt-crossley.toml"),
+            ),
+        ];
+        for (law, text) in examples {
+            let s = Scenario::parse(text, Path::new("examples/scenarios/x.toml"))
+                .unwrap_or_else(|e| panic!("{law}: {e}"));
+            assert_eq!(s.surface.law.as_str(), law);
+        }
+    }
+
+    // Shape errors: syntax, typos, missing keys, wrong kinds of value.
+
+    #[test]
+    fn syntax_error_names_the_line() {
+        let err = parse(&edit("gap = 4.5e-4", "gap = = 4.5e-4")).unwrap_err();
+        assert!(matches!(err, ScenarioError::Syntax { .. }), "{err:?}");
+        assert_eq!(line_of(&err), Some(6));
+        assert!(err.to_string().starts_with("relays/test.toml:6:"), "{err}");
+    }
+
+    #[test]
+    fn misspelt_key_is_an_error_naming_key_and_line() {
+        let err = fails_on(&edit("mass = 2.0e-4", "mas = 2.0e-4"), "mechanics.mas");
+        assert!(matches!(err, ScenarioError::UnknownKey { .. }));
+        assert_eq!(line_of(&err), Some(2));
+        assert!(
+            err.to_string().contains("`mass`"),
+            "suggests the valid keys: {err}"
+        );
+    }
+
+    #[test]
+    fn unknown_section_and_unknown_probe_key_are_errors() {
+        fails_on(&format!("{VALID}\n[mechancis]\nmass = 1.0\n"), "mechancis");
+        let err = fails_on(
+            &edit("high = 2.31", "high = 2.31\nhigh_v = 3"),
+            "probe[0].high_v",
+        );
+        assert_eq!(line_of(&err), Some(20));
+    }
+
+    #[test]
+    fn missing_required_keys_are_named() {
+        let err = fails_on(&edit("mass = 2.0e-4\n", ""), "mechanics.mass");
+        assert!(matches!(err, ScenarioError::MissingKey { .. }));
+        fails_on(&edit("damping = 0.04\n", ""), "mechanics.damping");
+        fails_on(&edit("gap = 4.5e-4\n", ""), "mechanics.gap");
+        fails_on(&edit("law = \"kelvin-voigt\"\n", ""), "surface.law");
+        fails_on(&edit("low = 0.99\n", ""), "probe[0].low");
+        fails_on(
+            &edit("netlist = \"net/input.cir\"\n", ""),
+            "circuit.netlist",
+        );
+        let no_surface = edit(&format!("[surface]\n{SURFACE}"), "");
+        fails_on(&no_surface, "surface");
+    }
+
+    #[test]
+    fn wrong_kind_of_value_is_named() {
+        let err = fails_on(&edit("mass = 2.0e-4", "mass = \"heavy\""), "mechanics.mass");
+        assert!(matches!(err, ScenarioError::BadValue { .. }));
+        assert_eq!(line_of(&err), Some(2));
+    }
+
+    #[test]
+    fn unknown_surface_law_lists_the_laws() {
+        let err = fails_on(
+            &with_surface("law = \"hertz\"\nstiffness = 1.0"),
+            "surface.law",
+        );
+        let msg = err.to_string();
+        assert!(
+            msg.contains("hunt-crossley") && msg.contains("rigid"),
+            "{msg}"
+        );
+    }
+
+    // Physics: every rule.
+
+    #[test]
+    fn mechanics_rules() {
+        let cases = [
+            ("mass = 2.0e-4", "mass = -2.0e-4", "mechanics.mass"),
+            ("mass = 2.0e-4", "mass = 0.0", "mechanics.mass"),
+            ("mass = 2.0e-4", "mass = nan", "mechanics.mass"),
+            ("mass = 2.0e-4", "mass = inf", "mechanics.mass"),
+            (
+                "stiffness = 800.0",
+                "stiffness = 0.0",
+                "mechanics.stiffness",
+            ),
+            (
+                "stiffness = 800.0",
+                "stiffness = -inf",
+                "mechanics.stiffness",
+            ),
+            ("damping = 0.04", "damping = -0.01", "mechanics.damping"),
+            ("gap = 4.5e-4", "gap = 0.0", "mechanics.gap"),
+            ("force = 0.5", "force = nan", "mechanics.force"),
+            ("force = 0.5", "force = 0.0", "mechanics.force"),
+            (
+                "gap = 4.5e-4",
+                "gap = 4.5e-4\ninitial_position = 4.5e-4",
+                "mechanics.initial_position",
+            ),
+            (
+                "gap = 4.5e-4",
+                "gap = 4.5e-4\ninitial_velocity = inf",
+                "mechanics.initial_velocity",
+            ),
+            (
+                "gap = 4.5e-4",
+                "gap = 4.5e-4\npreload = -0.1",
+                "mechanics.preload",
+            ),
+            (
+                "gap = 4.5e-4",
+                "gap = 4.5e-4\npreload = 0.5",
+                "mechanics.force",
+            ),
+        ];
+        for (old, new, key) in cases {
+            fails_on(&edit(old, new), key);
+        }
+        let err = fails_on(&edit("mass = 2.0e-4", "mass = nan"), "mechanics.mass");
+        assert!(err.to_string().contains("finite"), "{err}");
+        assert_eq!(line_of(&err), Some(2));
+    }
+
+    #[test]
+    fn a_zero_damping_and_a_negative_start_are_allowed() {
+        let text = edit("damping = 0.04", "damping = 0.0\ninitial_position = -1e-4");
+        assert!(parse(&text).is_ok());
+    }
+
+    const COIL: &str = "\n[coil]\nresistance = 70.0\nturns = 3000\npole_area = 2.0e-5\nair_gap = 6.0e-4\niron_gap = 5.0e-5\n";
+
+    #[test]
+    fn force_and_coil_are_mutually_exclusive_and_one_is_required() {
+        let err = fails_on(&format!("{VALID}{COIL}"), "mechanics.force");
+        assert!(matches!(err, ScenarioError::Conflict { .. }), "{err:?}");
+        let err = fails_on(&edit("force = 0.5\n", ""), "mechanics.force");
+        assert!(matches!(err, ScenarioError::MissingKey { .. }), "{err:?}");
+    }
+
+    #[test]
+    fn coil_scenario_parses_but_is_not_simulated_yet() {
+        let s = parse(&format!("{}{COIL}", edit("force = 0.5\n", ""))).unwrap();
+        assert_eq!(s.coil.as_ref().unwrap().turns, 3000);
+        let err = s.mechanics().unwrap_err();
+        assert!(matches!(err, ScenarioError::CoilDriveUnsupported { .. }));
+        assert!(err.to_string().contains("mechanics.force"), "{err}");
+    }
+
+    #[test]
+    fn coil_rules() {
+        let base = format!("{}{COIL}", edit("force = 0.5\n", ""));
+        let cases = [
+            ("resistance = 70.0", "resistance = 0.0", "coil.resistance"),
+            ("turns = 3000", "turns = 0", "coil.turns"),
+            ("turns = 3000", "turns = -3", "coil.turns"),
+            ("pole_area = 2.0e-5", "pole_area = nan", "coil.pole_area"),
+            ("air_gap = 6.0e-4", "air_gap = 4.0e-4", "coil.air_gap"),
+            ("iron_gap = 5.0e-5", "iron_gap = -1e-6", "coil.iron_gap"),
+        ];
+        for (old, new, key) in cases {
+            assert!(base.contains(old));
+            fails_on(&base.replacen(old, new, 1), key);
+        }
+    }
+
+    #[test]
+    fn rigid_surface_rules() {
+        let s = parse(&with_surface("law = \"rigid\"\nrestitution = 0.8")).unwrap();
+        assert_eq!(s.surface(), Surface::Rigid { restitution: 0.8 });
+        for e in ["0.0", "1.0"] {
+            assert!(
+                parse(&with_surface(&format!(
+                    "law = \"rigid\"\nrestitution = {e}"
+                )))
+                .is_ok()
+            );
+        }
+        fails_on(
+            &with_surface("law = \"rigid\"\nrestitution = 1.5"),
+            "surface.restitution",
+        );
+        fails_on(
+            &with_surface("law = \"rigid\"\nrestitution = -0.1"),
+            "surface.restitution",
+        );
+        fails_on(&with_surface("law = \"rigid\""), "surface.restitution");
+        let err = fails_on(
+            &with_surface("law = \"rigid\"\nrestitution = 0.8\nstiffness = 1e5"),
+            "surface.stiffness",
+        );
+        assert!(matches!(err, ScenarioError::NotForLaw { .. }), "{err:?}");
+    }
+
+    #[test]
+    fn kelvin_voigt_surface_rules() {
+        let kv = |body: &str| with_surface(&format!("law = \"kelvin-voigt\"\n{body}"));
+        assert!(parse(&kv("stiffness = 1e5\ndamping = 0.0")).is_ok());
+        fails_on(&kv("stiffness = 0.0\ndamping = 0.3"), "surface.stiffness");
+        fails_on(&kv("stiffness = 1e5\ndamping = -0.3"), "surface.damping");
+        fails_on(&kv("damping = 0.3"), "surface.stiffness");
+        fails_on(&kv("stiffness = 1e5"), "surface.damping");
+        let err = fails_on(
+            &kv("stiffness = 1e5\ndamping = 0.3\nrestitution = 0.8"),
+            "surface.restitution",
+        );
+        assert!(err.to_string().contains("kelvin-voigt"), "{err}");
+        fails_on(
+            &kv("stiffness = 1e5\ndamping = 0.3\nchi = 0.1"),
+            "surface.chi",
+        );
+    }
+
+    #[test]
+    fn hunt_crossley_surface_rules() {
+        let hc =
+            |body: &str| with_surface(&format!("law = \"hunt-crossley\"\nstiffness = 1e6\n{body}"));
+        let s = parse(&hc("chi = 0.2")).unwrap();
+        assert_eq!(
+            s.surface(),
+            Surface::HuntCrossley {
+                stiffness: 1e6,
+                exponent: 1.0,
+                chi: 0.2
+            }
+        );
+        let s = parse(&hc(
+            "exponent = 1.5\nrestitution = 0.85\nreference_velocity = 0.3",
+        ))
+        .unwrap();
+        let expected_chi = hunt_crossley_chi(0.85, 0.3).unwrap();
+        assert_eq!(
+            s.surface(),
+            Surface::HuntCrossley {
+                stiffness: 1e6,
+                exponent: 1.5,
+                chi: expected_chi
+            }
+        );
+        assert!(parse(&hc("chi = 0.0")).is_ok());
+        assert!(parse(&hc("restitution = 1.0\nreference_velocity = 0.3")).is_ok());
+
+        fails_on(
+            &with_surface("law = \"hunt-crossley\"\nstiffness = -1.0\nchi = 0.2"),
+            "surface.stiffness",
+        );
+        fails_on(
+            &with_surface("law = \"hunt-crossley\"\nchi = 0.2"),
+            "surface.stiffness",
+        );
+        fails_on(&hc("chi = 0.2\nexponent = 0.0"), "surface.exponent");
+        fails_on(&hc("chi = -0.2"), "surface.chi");
+        fails_on(&hc("chi = nan"), "surface.chi");
+        let err = fails_on(&hc("chi = 0.2\nrestitution = 0.8"), "surface.chi");
+        assert!(matches!(err, ScenarioError::Conflict { .. }), "{err:?}");
+        fails_on(&hc("chi = 0.2\nreference_velocity = 0.3"), "surface.chi");
+        fails_on(&hc("restitution = 0.8"), "surface.reference_velocity");
+        fails_on(&hc("reference_velocity = 0.3"), "surface.restitution");
+        fails_on(&hc(""), "surface.chi");
+        fails_on(
+            &hc("restitution = 0.0\nreference_velocity = 0.3"),
+            "surface.restitution",
+        );
+        fails_on(
+            &hc("restitution = 1.5\nreference_velocity = 0.3"),
+            "surface.restitution",
+        );
+        fails_on(
+            &hc("restitution = 0.8\nreference_velocity = 0.0"),
+            "surface.reference_velocity",
+        );
+        fails_on(&hc("chi = 0.2\ndamping = 0.1"), "surface.damping");
+    }
+
+    #[test]
+    fn contact_rules() {
+        let with = |body: &str| format!("{VALID}\n[contact]\n{body}\n");
+        assert!(parse(&with("r_closed = 0.1")).is_ok());
+        fails_on(&with("r_closed = 0.0"), "contact.r_closed");
+        fails_on(&with("r_closed = 10.0\nr_open = 10.0"), "contact.r_open");
+        fails_on(&with("r_open = inf"), "contact.r_open");
+        fails_on(&with("edge_time = 0.0"), "contact.edge_time");
+    }
+
+    #[test]
+    fn simulation_rules() {
+        let with = |body: &str| format!("{VALID}\n[simulation]\n{body}\n");
+        fails_on(&with("t_end = 0.0"), "simulation.t_end");
+        fails_on(&with("t_end = inf"), "simulation.t_end");
+        fails_on(&with("min_open_time = -1e-9"), "simulation.min_open_time");
+        fails_on(&with("min_gap = -1e-9"), "simulation.min_gap");
+    }
+
+    #[test]
+    fn circuit_and_probe_rules() {
+        fails_on(
+            &edit("netlist = \"net/input.cir\"", "netlist = \"\""),
+            "circuit.netlist",
+        );
+        fails_on(
+            &edit(
+                "netlist = \"net/input.cir\"",
+                "netlist = \"a.cir\"\nsubckt = \"\"",
+            ),
+            "circuit.subckt",
+        );
+        fails_on(
+            &edit("signal = \"v(in)\"", "signal = \" \""),
+            "probe[0].signal",
+        );
+        let err = fails_on(&edit("low = 0.99", "low = 2.31"), "probe[0].low");
+        assert_eq!(line_of(&err), Some(18));
+        fails_on(&edit("high = 2.31", "high = nan"), "probe[0].high");
+        let second = format!("{VALID}\n[[probe]]\nsignal = \"v(out)\"\nlow = 3.0\nhigh = 1.0\n");
+        let err = fails_on(&second, "probe[1].low");
+        assert_eq!(line_of(&err), Some(23));
+    }
+
+    #[test]
+    fn missing_file_names_the_path() {
+        let err = Scenario::load(Path::new("no/such/scenario.toml")).unwrap_err();
+        assert!(matches!(err, ScenarioError::Read { .. }));
+        assert!(err.to_string().contains("no/such/scenario.toml"), "{err}");
+    }
+}
