@@ -11,6 +11,7 @@
 
 pub mod chatter;
 pub mod mechanics;
+pub mod rawfile;
 
 pub use chatter::{Chatter, ContactState, Impact, Interval, Outcome};
 pub use mechanics::{Mechanics, MechanicsError, Settings, Surface, simulate};
