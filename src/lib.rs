@@ -12,6 +12,7 @@
 pub mod chatter;
 pub mod mechanics;
 pub mod rawfile;
+pub mod spice;
 
 pub use chatter::{Chatter, ContactState, Impact, Interval, Outcome};
 pub use mechanics::{Mechanics, MechanicsError, Settings, Surface, simulate};
