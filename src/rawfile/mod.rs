@@ -768,24 +768,33 @@ fn read_binary(
             declared.min(rest.len() / row)
         };
         let data = &rest[..whole * row];
-        let mut columns = Vec::with_capacity(nvars);
-        for (j, var) in plot.variables.iter().enumerate() {
-            let len = if open_ended {
-                whole
-            } else {
-                lengths[j].min(whole)
-            };
-            let values = data.chunks_exact(row).take(len);
-            let off = j * width;
-            columns.push(if !complex || real_in_complex_plot(var, j) {
-                Column::Real(values.map(|r| f64_at(r, off)).collect())
-            } else {
-                Column::Complex(
-                    values
-                        .map(|r| Complex64::new(f64_at(r, off), f64_at(r, off + 8)))
-                        .collect(),
-                )
-            });
+        let mut columns = empty_columns(&plot);
+        let lens: Vec<usize> = if open_ended {
+            vec![whole; nvars]
+        } else {
+            lengths.iter().map(|&l| l.min(whole)).collect()
+        };
+        for (col, &len) in columns.iter_mut().zip(&lens) {
+            reserve(col, len);
+        }
+        // Transpose block by block: a block of rows stays in L1 while each
+        // column takes its values from it, so the data is read from memory
+        // once, not once per vector.
+        const BLOCK_BYTES: usize = 16 * 1024;
+        let block_rows = (BLOCK_BYTES / row).max(1);
+        for (b, block) in data.chunks(block_rows * row).enumerate() {
+            let first = b * block_rows;
+            for (j, col) in columns.iter_mut().enumerate() {
+                let take = lens[j].saturating_sub(first);
+                let rows = block.chunks_exact(row).take(take);
+                let off = j * width;
+                match col {
+                    Column::Real(v) => v.extend(rows.map(|r| f64_at(r, off))),
+                    Column::Complex(v) => {
+                        v.extend(rows.map(|r| Complex64::new(f64_at(r, off), f64_at(r, off + 8))))
+                    }
+                }
+            }
         }
         plot.columns = columns;
         (whole, whole * row)
@@ -858,6 +867,14 @@ fn read_binary_unpadded(
     (columns, read, pos)
 }
 
+fn reserve(c: &mut Column, len: usize) {
+    match c {
+        Column::Real(v) => v.reserve_exact(len),
+        Column::Complex(v) => v.reserve_exact(len),
+    }
+}
+
+#[inline]
 fn f64_at(bytes: &[u8], off: usize) -> f64 {
     let mut b = [0u8; 8];
     b.copy_from_slice(&bytes[off..off + 8]);
