@@ -27,6 +27,22 @@ pub enum ExportError {
     Csv(#[from] csv::Error),
 }
 
+impl ExportError {
+    /// The reader of the output went away (`chatterspice raw f | head`):
+    /// not an error worth reporting.
+    pub fn is_broken_pipe(&self) -> bool {
+        let io = match self {
+            ExportError::Write(e) => Some(e),
+            ExportError::Csv(e) => match e.kind() {
+                csv::ErrorKind::Io(e) => Some(e),
+                _ => None,
+            },
+            ExportError::NoSuchPlot { .. } => None,
+        };
+        io.is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe)
+    }
+}
+
 /// Plot `index`, or the last plot (the main analysis after an `.op`).
 pub fn select_plot(raw: &RawFile, index: Option<usize>) -> Result<&Plot, ExportError> {
     let count = raw.plots.len();
