@@ -768,34 +768,55 @@ fn read_binary(
             declared.min(rest.len() / row)
         };
         let data = &rest[..whole * row];
-        let mut columns = empty_columns(&plot);
         let lens: Vec<usize> = if open_ended {
             vec![whole; nvars]
         } else {
             lengths.iter().map(|&l| l.min(whole)).collect()
         };
-        for (col, &len) in columns.iter_mut().zip(&lens) {
-            reserve(col, len);
-        }
-        // Transpose block by block: a block of rows stays in L1 while each
-        // column takes its values from it, so the data is read from memory
-        // once, not once per vector.
-        const BLOCK_BYTES: usize = 16 * 1024;
-        let block_rows = (BLOCK_BYTES / row).max(1);
-        for (b, block) in data.chunks(block_rows * row).enumerate() {
-            let first = b * block_rows;
-            for (j, col) in columns.iter_mut().enumerate() {
-                let take = lens[j].saturating_sub(first);
-                let rows = block.chunks_exact(row).take(take);
-                let off = j * width;
-                match col {
-                    Column::Real(v) => v.extend(rows.map(|r| f64_at(r, off))),
-                    Column::Complex(v) => {
-                        v.extend(rows.map(|r| Complex64::new(f64_at(r, off), f64_at(r, off + 8))))
+        // One pass over the rows, each value written straight to its place
+        // in its column (sized up front, so no capacity checks): the input
+        // is read once, and the output pages are touched in order.
+        let columns = if !complex {
+            let mut cols: Vec<Vec<f64>> = lens.iter().map(|&l| vec![0.0; l]).collect();
+            for (i, r) in data.chunks_exact(row).enumerate() {
+                for (col, cell) in cols.iter_mut().zip(r.chunks_exact(8)) {
+                    if let Some(d) = col.get_mut(i) {
+                        *d = le_f64(cell, 0);
                     }
                 }
             }
-        }
+            cols.into_iter().map(Column::Real).collect()
+        } else {
+            let mut cols: Vec<Column> = plot
+                .variables
+                .iter()
+                .enumerate()
+                .map(|(j, v)| {
+                    if real_in_complex_plot(v, j) {
+                        Column::Real(vec![0.0; lens[j]])
+                    } else {
+                        Column::Complex(vec![Complex64::new(0.0, 0.0); lens[j]])
+                    }
+                })
+                .collect();
+            for (i, r) in data.chunks_exact(row).enumerate() {
+                for (col, cell) in cols.iter_mut().zip(r.chunks_exact(16)) {
+                    match col {
+                        Column::Real(v) => {
+                            if let Some(d) = v.get_mut(i) {
+                                *d = le_f64(cell, 0);
+                            }
+                        }
+                        Column::Complex(v) => {
+                            if let Some(d) = v.get_mut(i) {
+                                *d = Complex64::new(le_f64(cell, 0), le_f64(cell, 8));
+                            }
+                        }
+                    }
+                }
+            }
+            cols
+        };
         plot.columns = columns;
         (whole, whole * row)
     } else {
@@ -867,11 +888,14 @@ fn read_binary_unpadded(
     (columns, read, pos)
 }
 
-fn reserve(c: &mut Column, len: usize) {
-    match c {
-        Column::Real(v) => v.reserve_exact(len),
-        Column::Complex(v) => v.reserve_exact(len),
+/// The f64 at `off` in a cell of at least `off + 8` bytes.
+#[inline]
+fn le_f64(cell: &[u8], off: usize) -> f64 {
+    let mut b = [0u8; 8];
+    if let Some(src) = cell.get(off..off + 8) {
+        b.copy_from_slice(src);
     }
+    f64::from_le_bytes(b)
 }
 
 #[inline]
