@@ -18,7 +18,13 @@ fn ngspice() -> Option<Ngspice> {
             panic!("REQUIRE_NGSPICE=1 but ngspice is unusable: {e}")
         }
         Err(e) => {
-            eprintln!("note: skipping a test that needs ngspice: {e}");
+            // Written to the stderr handle, not eprintln!, which the test
+            // harness captures: the skip must be visible.
+            use std::io::Write;
+            let _ = writeln!(
+                std::io::stderr(),
+                "note: skipping a test that needs ngspice (set REQUIRE_NGSPICE=1 to fail instead): {e}"
+            );
             None
         }
     }
