@@ -1,1 +1,76 @@
-fn main() {}
+//! The mechanics engine's speed: one whole chatter sequence per iteration.
+//!
+//! `cargo bench --bench mechanics`. Targets (issue 2): the model.md
+//! reference sequence (Kelvin–Voigt, 18 contacts) ≤ 5 µs median; a
+//! Hunt–Crossley sequence ≤ 50 µs.
+
+use std::hint::black_box;
+
+use chatterspice::mechanics::surface::hunt_crossley_chi;
+use chatterspice::{Mechanics, Settings, Surface, simulate};
+use criterion::{Criterion, criterion_group, criterion_main};
+
+fn reference() -> (Mechanics, Surface, Settings) {
+    (
+        Mechanics {
+            mass: 1.0,
+            stiffness: 1.0,
+            damping: 0.1,
+            force: 1.0,
+            gap: 0.9,
+            initial_position: 0.0,
+            initial_velocity: 0.0,
+            preload: 0.0,
+        },
+        Surface::KelvinVoigt {
+            stiffness: 100.0,
+            damping: 2.0 * 0.4692,
+        },
+        Settings {
+            t_end: 100.0,
+            ..Settings::default()
+        },
+    )
+}
+
+/// The default relay's suspension on a Hertzian Hunt–Crossley contact with
+/// e = 0.85 at 0.3 m/s.
+fn hunt_crossley() -> (Mechanics, Surface, Settings) {
+    let (m, _, _) = reference();
+    let m = Mechanics {
+        mass: 2e-4,
+        stiffness: 800.0,
+        damping: 0.04,
+        force: 0.5,
+        gap: 4.5e-4,
+        ..m
+    };
+    let s = Surface::HuntCrossley {
+        stiffness: 1e9,
+        exponent: 1.5,
+        chi: hunt_crossley_chi(0.85, 0.3).expect("valid restitution"),
+    };
+    (m, s, Settings::default())
+}
+
+fn bench(c: &mut Criterion) {
+    let (m, s, st) = reference();
+    let n = simulate(&m, &s, &st).unwrap().impacts.len();
+    assert_eq!(n, 18);
+    c.bench_function("kelvin_voigt_reference_18_contacts", |b| {
+        b.iter(|| simulate(black_box(&m), black_box(&s), black_box(&st)).unwrap())
+    });
+    let (m, s, st) = hunt_crossley();
+    let r = simulate(&m, &s, &st).unwrap();
+    eprintln!(
+        "hunt-crossley sequence: {} contacts, outcome {}",
+        r.impacts.len(),
+        r.outcome
+    );
+    c.bench_function("hunt_crossley_sequence", |b| {
+        b.iter(|| simulate(black_box(&m), black_box(&s), black_box(&st)).unwrap())
+    });
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -12,6 +12,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use chatterspice::mechanics::Dimensionless;
+use chatterspice::rawfile::{RawFile, export};
 use chatterspice::report::{self, Format};
 use chatterspice::scenario::Scenario;
 use chatterspice::simulate;
@@ -28,12 +29,15 @@ pub struct Cli {
 pub enum Command {
     /// Mechanics only: the chatter sequence of one closing.
     Bounce(BounceArgs),
+    /// Print a SPICE raw file: one plot as CSV, or a JSON summary of every plot.
+    Raw(RawArgs),
 }
 
 impl Command {
     pub fn run(&self) -> Result<()> {
         match self {
             Command::Bounce(args) => bounce(args),
+            Command::Raw(args) => raw(args),
         }
     }
 }
@@ -57,6 +61,26 @@ pub struct BounceArgs {
     /// Replace FILE if it already exists.
     #[arg(long, requires = "output")]
     pub force: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct RawArgs {
+    /// The raw file (ngspice binary or ASCII).
+    pub file: PathBuf,
+    /// Plot to print as CSV, numbered from 0 in file order [default: the last].
+    #[arg(long)]
+    pub plot: Option<usize>,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = RawFormat::Csv)]
+    pub format: RawFormat,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RawFormat {
+    /// One plot: a header of vector names, one row per point.
+    Csv,
+    /// A summary of every plot: name, flags, variables, points.
+    Json,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -140,5 +164,28 @@ fn emit(text: &str, output: Option<&Path>, force: bool) -> Result<()> {
                 result => result.context("cannot write to standard output"),
             }
         }
+    }
+}
+
+fn raw(args: &RawArgs) -> Result<()> {
+    let raw = RawFile::read(&args.file)?;
+    for w in &raw.warnings {
+        eprintln!("warning: {}: {w}", args.file.display());
+    }
+    // Checked for JSON too, so a wrong index is never silently ignored.
+    let selected = export::select_plot(&raw, args.plot)
+        .with_context(|| format!("in {}", args.file.display()))?;
+    let mut out = io::BufWriter::new(io::stdout().lock());
+    let written = match args.format {
+        RawFormat::Csv => export::plot_csv(selected, &mut out),
+        RawFormat::Json => out
+            .write_all(export::summary_json(&raw).as_bytes())
+            .map_err(export::ExportError::Write),
+    }
+    .and_then(|()| out.flush().map_err(export::ExportError::Write));
+    match written {
+        // The reader stopped early (`| head`): not our failure.
+        Err(e) if e.is_broken_pipe() => Ok(()),
+        result => Ok(result?),
     }
 }

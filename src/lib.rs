@@ -11,8 +11,10 @@
 
 pub mod chatter;
 pub mod mechanics;
+pub mod rawfile;
 pub mod report;
 pub mod scenario;
+pub mod spice;
 
 pub use chatter::{Chatter, ContactState, Impact, Interval, Outcome};
 pub use mechanics::{Mechanics, MechanicsError, Settings, Surface, simulate};

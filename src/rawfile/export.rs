@@ -1,0 +1,237 @@
+//! What `chatterspice raw FILE` prints: one plot as CSV, or a JSON summary
+//! of every plot.
+//!
+//! CSV: the header row is the vector names; a complex vector becomes two
+//! columns `NAME.re`, `NAME.im` (the AC frequency axis stays one real
+//! column). Values use Rust's `{:e}` formatting: the shortest string that
+//! reads back to the identical `f64` (`1e-3`, `1.5e0`, `0e0`), so output is
+//! byte-identical across runs and platforms and loses nothing. A vector
+//! shorter than the plot (`unpadded`) leaves its cells empty.
+
+use std::fmt::Write as _;
+use std::io::Write;
+
+use serde::Serialize;
+use thiserror::Error;
+
+use super::{Plot, RawFile, Vector};
+
+/// Why a plot could not be rendered.
+#[derive(Debug, Error)]
+pub enum ExportError {
+    #[error("there is no plot {index}: the file has {count} plot(s), numbered 0 to {last}", last = .count.saturating_sub(1))]
+    NoSuchPlot { index: usize, count: usize },
+    #[error("cannot write the output: {0}")]
+    Write(#[from] std::io::Error),
+    #[error("cannot write the CSV output: {0}")]
+    Csv(#[from] csv::Error),
+}
+
+impl ExportError {
+    /// The reader of the output went away (`chatterspice raw f | head`):
+    /// not an error worth reporting.
+    pub fn is_broken_pipe(&self) -> bool {
+        let io = match self {
+            ExportError::Write(e) => Some(e),
+            ExportError::Csv(e) => match e.kind() {
+                csv::ErrorKind::Io(e) => Some(e),
+                _ => None,
+            },
+            ExportError::NoSuchPlot { .. } => None,
+        };
+        io.is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe)
+    }
+}
+
+/// Plot `index`, or the last plot (the main analysis after an `.op`).
+pub fn select_plot(raw: &RawFile, index: Option<usize>) -> Result<&Plot, ExportError> {
+    let count = raw.plots.len();
+    let index = index.unwrap_or(count.saturating_sub(1));
+    raw.plots
+        .get(index)
+        .ok_or(ExportError::NoSuchPlot { index, count })
+}
+
+/// The CSV cell text of a value (see the module doc).
+pub fn format_value(x: f64) -> String {
+    format!("{x:e}")
+}
+
+/// Writes `plot` as CSV.
+pub fn plot_csv<W: Write>(plot: &Plot, out: W) -> Result<(), ExportError> {
+    let mut w = csv::Writer::from_writer(out);
+    let vectors: Vec<Vector<'_>> = (0..plot.variables.len())
+        .filter_map(|i| plot.vector(i))
+        .collect();
+    let mut header = Vec::new();
+    for (var, vec) in plot.variables.iter().zip(&vectors) {
+        match vec {
+            Vector::Real(_) => header.push(var.name.clone()),
+            Vector::Complex(_) => {
+                header.push(format!("{}.re", var.name));
+                header.push(format!("{}.im", var.name));
+            }
+        }
+    }
+    w.write_record(&header)?;
+
+    let mut record = csv::ByteRecord::new();
+    let mut cell = String::new();
+    let mut push = |record: &mut csv::ByteRecord, x: Option<f64>| {
+        cell.clear();
+        if let Some(x) = x {
+            // Writing into a String cannot fail.
+            let _ = write!(cell, "{x:e}");
+        }
+        record.push_field(cell.as_bytes());
+    };
+    for i in 0..plot.points() {
+        record.clear();
+        for vec in &vectors {
+            match vec {
+                Vector::Real(v) => push(&mut record, v.get(i).copied()),
+                Vector::Complex(v) => {
+                    let c = v.get(i);
+                    push(&mut record, c.map(|c| c.re));
+                    push(&mut record, c.map(|c| c.im));
+                }
+            }
+        }
+        w.write_byte_record(&record)?;
+    }
+    w.flush()?;
+    Ok(())
+}
+
+#[derive(Serialize)]
+struct Summary<'a> {
+    plots: Vec<PlotSummary<'a>>,
+    warnings: Vec<String>,
+}
+
+#[derive(Serialize)]
+struct PlotSummary<'a> {
+    index: usize,
+    name: &'a str,
+    title: &'a str,
+    date: &'a str,
+    commands: &'a [String],
+    flags: FlagsSummary<'a>,
+    points: usize,
+    declared_points: usize,
+    variables: Vec<VariableSummary<'a>>,
+}
+
+#[derive(Serialize)]
+struct FlagsSummary<'a> {
+    complex: bool,
+    padded: bool,
+    other: &'a [String],
+}
+
+#[derive(Serialize)]
+struct VariableSummary<'a> {
+    index: usize,
+    name: &'a str,
+    #[serde(rename = "type")]
+    kind: &'a str,
+    complex: bool,
+    points: usize,
+    attributes: &'a [String],
+}
+
+/// A pretty-printed JSON summary of every plot: name, flags, variables and
+/// point counts, plus the reader's warnings. Ends with a newline.
+pub fn summary_json(raw: &RawFile) -> String {
+    let plots = raw
+        .plots
+        .iter()
+        .enumerate()
+        .map(|(index, p)| PlotSummary {
+            index,
+            name: &p.name,
+            title: &p.title,
+            date: &p.date,
+            commands: &p.commands,
+            flags: FlagsSummary {
+                complex: p.flags.complex,
+                padded: p.flags.padded,
+                other: &p.flags.other,
+            },
+            points: p.points(),
+            declared_points: p.declared_points,
+            variables: p
+                .variables
+                .iter()
+                .enumerate()
+                .map(|(i, v)| {
+                    let vec = p.vector(i);
+                    VariableSummary {
+                        index: i,
+                        name: &v.name,
+                        kind: &v.kind,
+                        complex: matches!(vec, Some(Vector::Complex(_))),
+                        points: vec.map_or(0, |v| v.len()),
+                        attributes: &v.attributes,
+                    }
+                })
+                .collect(),
+        })
+        .collect();
+    let summary = Summary {
+        plots,
+        warnings: raw.warnings.iter().map(ToString::to_string).collect(),
+    };
+    // Plain structs of strings and numbers always serialize.
+    let mut s = serde_json::to_string_pretty(&summary).unwrap_or_default();
+    s.push('\n');
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ac() -> RawFile {
+        let text = "Title: t\nDate: d\nPlotname: AC Analysis\nFlags: complex\n\
+                    No. Variables: 2\nNo. Points: 2\nVariables:\n\
+                    \t0\tfrequency\tfrequency\tgrid=3\n\t1\tv(out)\tvoltage\nValues:\n\
+                    0\t\t1e2,3e-300\n\t0.5,-0.25\n1\t\t1e3,1\n\t0.1,-0.2\n";
+        RawFile::parse(text.as_bytes()).unwrap()
+    }
+
+    #[test]
+    fn csv_splits_complex_and_keeps_frequency_real() {
+        let raw = ac();
+        let mut out = Vec::new();
+        plot_csv(&raw.plots[0], &mut out).unwrap();
+        assert_eq!(
+            String::from_utf8(out).unwrap(),
+            "frequency,v(out).re,v(out).im\n1e2,5e-1,-2.5e-1\n1e3,1e-1,-2e-1\n"
+        );
+    }
+
+    #[test]
+    fn values_round_trip() {
+        for x in [0.1, -2.2250738585072014e-308, 1.0 / 3.0, 6.02214076e23] {
+            assert_eq!(format_value(x).parse::<f64>().unwrap(), x);
+        }
+    }
+
+    #[test]
+    fn missing_plot_says_what_exists() {
+        let raw = ac();
+        let err = select_plot(&raw, Some(3)).unwrap_err().to_string();
+        assert!(err.contains("1 plot(s), numbered 0 to 0"), "{err}");
+        assert_eq!(select_plot(&raw, None).unwrap().name, "AC Analysis");
+    }
+
+    #[test]
+    fn summary_lists_variables() {
+        let json: serde_json::Value = serde_json::from_str(&summary_json(&ac())).unwrap();
+        assert_eq!(json["plots"][0]["variables"][1]["name"], "v(out)");
+        assert_eq!(json["plots"][0]["variables"][1]["complex"], true);
+        assert_eq!(json["plots"][0]["variables"][0]["complex"], false);
+        assert_eq!(json["plots"][0]["points"], 2);
+    }
+}

@@ -1,0 +1,484 @@
+//! The real runner: ngspice in batch mode, one process and one work
+//! directory per run.
+//!
+//! Which binary: an explicit path, else `CHATTERSPICE_NGSPICE`, else
+//! `ngspice` on `PATH`. [`Ngspice::locate`] probes it once (`ngspice -v`)
+//! for its version, so a missing install fails before any run with the
+//! command that fixes it.
+//!
+//! A run writes `deck.cir` and the includes into a fresh temporary
+//! directory (under the system temp dir unless told otherwise — never the
+//! user's directories), runs `ngspice -b -r out.raw deck.cir` there
+//! without a shell, and collects stdout and stderr line by line on two
+//! threads into one log, in arrival order. The main thread waits for the
+//! child with a deadline; at the deadline it kills (SIGKILL) and reaps it.
+
+use std::collections::VecDeque;
+use std::ffi::OsStr;
+use std::io::{self, Read};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, ExitStatus, Stdio};
+use std::sync::mpsc;
+use std::thread;
+use std::time::{Duration, Instant};
+
+use super::classify::{self, Exit};
+use super::{RunContext, RunOutput, RunRequest, Runner, SpiceError, log_tail};
+use crate::rawfile::{RawFile, RawWarning};
+
+/// The environment variable naming the ngspice binary.
+pub const ENV_VAR: &str = "CHATTERSPICE_NGSPICE";
+/// File names inside the work directory.
+pub const DECK_NAME: &str = "deck.cir";
+pub const RAW_NAME: &str = "out.raw";
+
+/// ngspice, located and probed.
+#[derive(Debug, Clone)]
+pub struct Ngspice {
+    program: PathBuf,
+    version: Option<String>,
+    workdir_parent: Option<PathBuf>,
+}
+
+impl Ngspice {
+    /// Finds ngspice: `explicit`, else `$CHATTERSPICE_NGSPICE`, else `PATH`;
+    /// then asks it for its version.
+    pub fn locate(explicit: Option<&Path>) -> Result<Ngspice, SpiceError> {
+        let requested = match explicit {
+            Some(p) => p.to_path_buf(),
+            None => match std::env::var_os(ENV_VAR) {
+                Some(p) if !p.is_empty() => PathBuf::from(p),
+                _ => PathBuf::from("ngspice"),
+            },
+        };
+        let program = resolve(&requested)?;
+        let version = probe_version(&program)?;
+        Ok(Ngspice {
+            program,
+            version,
+            workdir_parent: None,
+        })
+    }
+
+    /// [`Ngspice::locate`] with no explicit path.
+    pub fn find() -> Result<Ngspice, SpiceError> {
+        Ngspice::locate(None)
+    }
+
+    /// Create work directories under `dir` instead of the system temp dir.
+    pub fn workdir_parent(mut self, dir: impl Into<PathBuf>) -> Ngspice {
+        self.workdir_parent = Some(dir.into());
+        self
+    }
+
+    pub fn program(&self) -> &Path {
+        &self.program
+    }
+
+    /// e.g. `"39"`; `None` if `-v` printed no `ngspice-N` banner.
+    pub fn version(&self) -> Option<&str> {
+        self.version.as_deref()
+    }
+}
+
+/// A bare name is looked up on `PATH` here, so "not found" is decided (and
+/// reported) before any work directory exists.
+fn resolve(program: &Path) -> Result<PathBuf, SpiceError> {
+    if program.components().count() > 1 || program.is_absolute() {
+        return if program.is_file() {
+            Ok(program.to_path_buf())
+        } else {
+            Err(SpiceError::NotFound {
+                program: program.to_path_buf(),
+                source: io::Error::new(io::ErrorKind::NotFound, "no such file"),
+            })
+        };
+    }
+    let path = std::env::var_os("PATH").unwrap_or_default();
+    std::env::split_paths(&path)
+        .map(|dir| dir.join(program))
+        .find(|candidate| candidate.is_file())
+        .ok_or_else(|| SpiceError::NotFound {
+            program: program.to_path_buf(),
+            source: io::Error::new(io::ErrorKind::NotFound, "not on PATH"),
+        })
+}
+
+fn probe_version(program: &Path) -> Result<Option<String>, SpiceError> {
+    let mut cmd = Command::new(program);
+    cmd.arg("-v");
+    let finished =
+        run_child(cmd, Duration::from_secs(20)).map_err(|source| SpiceError::NotFound {
+            program: program.to_path_buf(),
+            source,
+        })?;
+    Ok(parse_version(&finished.log))
+}
+
+/// `** ngspice-39 : Circuit level ...` → `39`.
+pub fn parse_version(banner: &str) -> Option<String> {
+    let i = banner.find("ngspice-")?;
+    let v: String = banner[i + "ngspice-".len()..]
+        .chars()
+        .take_while(|c| !c.is_whitespace())
+        .collect();
+    (!v.is_empty()).then_some(v)
+}
+
+impl Runner for Ngspice {
+    fn run(&self, req: &RunRequest) -> Result<RunOutput, SpiceError> {
+        for (name, _) in &req.includes {
+            if !is_plain_name(name) {
+                return Err(SpiceError::IncludeName { name: name.clone() });
+            }
+        }
+        let parent = self
+            .workdir_parent
+            .clone()
+            .unwrap_or_else(std::env::temp_dir);
+        let dir = tempfile::Builder::new()
+            .prefix("chatterspice-")
+            .tempdir_in(&parent)
+            .map_err(|source| SpiceError::WorkDir {
+                parent: parent.clone(),
+                source,
+            })?;
+        let write = |name: &str, text: &str| {
+            let path = dir.path().join(name);
+            std::fs::write(&path, text).map_err(|source| SpiceError::Write { path, source })
+        };
+        write(DECK_NAME, &req.deck)?;
+        for (name, text) in &req.includes {
+            write(name, text)?;
+        }
+
+        let mut cmd = Command::new(&self.program);
+        cmd.args(["-b", "-r", RAW_NAME, DECK_NAME])
+            .current_dir(dir.path());
+        let started = Instant::now();
+        let result = run_child(cmd, req.timeout);
+        let elapsed = started.elapsed();
+
+        let workdir = dir.path().to_path_buf();
+        let kept = req.keep_workdir;
+        // Keep or remove the directory now, so every error below says which.
+        let dir_guard = if kept {
+            let _ = dir.keep();
+            None
+        } else {
+            Some(dir)
+        };
+        let context = |log: &str| {
+            Box::new(RunContext {
+                workdir: workdir.clone(),
+                kept,
+                log_tail: log_tail(log),
+            })
+        };
+
+        let finished = result.map_err(|source| SpiceError::Process {
+            program: self.program.clone(),
+            source,
+            context: context(""),
+        })?;
+        let log = finished.log;
+        let Some(status) = finished.status else {
+            return Err(SpiceError::Timeout {
+                limit: req.timeout,
+                context: context(&log),
+            });
+        };
+        if let Some(failure) = classify::classify(exit_of(status), &log) {
+            return Err(SpiceError::Failed {
+                failure,
+                context: context(&log),
+            });
+        }
+        let raw_path = workdir.join(RAW_NAME);
+        let bytes = match std::fs::read(&raw_path) {
+            Ok(b) => b,
+            Err(e) if e.kind() == io::ErrorKind::NotFound => {
+                return Err(SpiceError::MissingRaw {
+                    context: context(&log),
+                });
+            }
+            Err(source) => {
+                return Err(SpiceError::BadRaw {
+                    source: crate::rawfile::RawError::Io {
+                        path: raw_path,
+                        source,
+                    },
+                    context: context(&log),
+                });
+            }
+        };
+        let raw = RawFile::parse(&bytes).map_err(|source| SpiceError::BadRaw {
+            source,
+            context: context(&log),
+        })?;
+        drop(bytes);
+        if let Some(warning) = raw
+            .warnings
+            .iter()
+            .find(|w| matches!(w, RawWarning::Truncated { .. }))
+        {
+            // ngspice exited cleanly, so a cut file means a write failure
+            // (disk full?), not a result to analyse.
+            return Err(SpiceError::TruncatedRaw {
+                warning: warning.clone(),
+                context: context(&log),
+            });
+        }
+        let mut warnings = classify::warnings(&log);
+        warnings.extend(raw.warnings.iter().map(ToString::to_string));
+        drop(dir_guard);
+        Ok(RunOutput {
+            raw,
+            log,
+            version: self.version.clone(),
+            elapsed,
+            workdir: kept.then_some(workdir),
+            warnings,
+        })
+    }
+}
+
+fn is_plain_name(name: &str) -> bool {
+    let p = Path::new(name);
+    !name.is_empty()
+        && p.file_name() == Some(OsStr::new(name))
+        && name != DECK_NAME
+        && name != RAW_NAME
+}
+
+#[cfg(unix)]
+fn exit_of(status: ExitStatus) -> Exit {
+    use std::os::unix::process::ExitStatusExt;
+    match (status.code(), status.signal()) {
+        (Some(c), _) => Exit::Code(c),
+        (None, Some(s)) => Exit::Signal(s),
+        (None, None) => Exit::Code(-1),
+    }
+}
+
+#[cfg(not(unix))]
+fn exit_of(status: ExitStatus) -> Exit {
+    Exit::Code(status.code().unwrap_or(-1))
+}
+
+// ---------------------------------------------------------------------------
+// Child process with concurrent output capture and a deadline
+
+pub(crate) struct Finished {
+    /// `None` when the deadline killed the child.
+    pub status: Option<ExitStatus>,
+    pub log: String,
+}
+
+/// Runs `cmd` (stdin closed), collecting stdout and stderr as one log,
+/// killing and reaping it after `timeout`.
+pub(crate) fn run_child(mut cmd: Command, timeout: Duration) -> io::Result<Finished> {
+    cmd.stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    let started = Instant::now();
+    let mut child = cmd.spawn()?;
+    let (tx, rx) = mpsc::channel::<Option<String>>();
+    let mut open_streams = 0;
+    if let Some(out) = child.stdout.take() {
+        spawn_reader(out, tx.clone());
+        open_streams += 1;
+    }
+    if let Some(err) = child.stderr.take() {
+        spawn_reader(err, tx.clone());
+        open_streams += 1;
+    }
+    drop(tx);
+
+    let deadline = started + timeout;
+    let mut log = LogBuffer::default();
+    let status = loop {
+        if let Some(status) = child.try_wait()? {
+            break Some(status);
+        }
+        let now = Instant::now();
+        if now >= deadline {
+            kill_and_reap(&mut child)?;
+            break None;
+        }
+        let wait = (deadline - now).min(Duration::from_millis(20));
+        match rx.recv_timeout(wait) {
+            Ok(Some(line)) => log.push(line),
+            Ok(None) => open_streams -= 1,
+            Err(mpsc::RecvTimeoutError::Timeout) => {}
+            Err(mpsc::RecvTimeoutError::Disconnected) => thread::sleep(wait),
+        }
+    };
+    // The pipes close when the child is gone; a grandchild could hold them
+    // open, so the drain has its own short deadline.
+    let drain_until = Instant::now() + Duration::from_secs(2);
+    while open_streams > 0 {
+        let now = Instant::now();
+        if now >= drain_until {
+            break;
+        }
+        match rx.recv_timeout(drain_until - now) {
+            Ok(Some(line)) => log.push(line),
+            Ok(None) => open_streams -= 1,
+            Err(_) => break,
+        }
+    }
+    Ok(Finished {
+        status,
+        log: log.finish(),
+    })
+}
+
+fn kill_and_reap(child: &mut Child) -> io::Result<()> {
+    match child.kill() {
+        Ok(()) => {}
+        // Exited between try_wait and kill: still reap below.
+        Err(e) if e.kind() == io::ErrorKind::InvalidInput => {}
+        Err(e) => return Err(e),
+    }
+    child.wait().map(|_| ())
+}
+
+/// Sends complete lines (split at `\n` or `\r`, progress lines dropped),
+/// then `None` at end of stream.
+fn spawn_reader(mut stream: impl Read + Send + 'static, tx: mpsc::Sender<Option<String>>) {
+    thread::spawn(move || {
+        let mut buf = [0u8; 8192];
+        let mut pending: Vec<u8> = Vec::new();
+        let send = |line: &[u8]| {
+            let text = String::from_utf8_lossy(line);
+            // ngspice's transient progress ("Reference value : 1.2e-06"),
+            // thousands of `\r`-separated updates that say nothing.
+            if text.trim_start().starts_with("Reference value") {
+                return true;
+            }
+            tx.send(Some(text.into_owned())).is_ok()
+        };
+        loop {
+            let n = match stream.read(&mut buf) {
+                Ok(0) => break,
+                Ok(n) => n,
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+                Err(_) => break,
+            };
+            for &b in &buf[..n] {
+                if b == b'\n' || b == b'\r' {
+                    if !send(&pending) {
+                        return;
+                    }
+                    pending.clear();
+                } else {
+                    pending.push(b);
+                }
+            }
+        }
+        if !pending.is_empty() {
+            send(&pending);
+        }
+        let _ = tx.send(None);
+    });
+}
+
+/// The log, bounded: the first `HEAD` bytes (parse errors are there) and
+/// the last `TAIL` bytes (analysis failures are there) of a run that talks
+/// for hours.
+#[derive(Default)]
+struct LogBuffer {
+    head: String,
+    tail: VecDeque<String>,
+    tail_bytes: usize,
+    dropped: usize,
+    /// Collapses the blank lines that `\r\n` endings and ngspice's spacing make.
+    last_blank: bool,
+}
+
+impl LogBuffer {
+    const HEAD: usize = 256 * 1024;
+    const TAIL: usize = 256 * 1024;
+
+    fn push(&mut self, line: String) {
+        let blank = line.trim().is_empty();
+        if blank && self.last_blank {
+            return;
+        }
+        self.last_blank = blank;
+        if self.tail.is_empty() && self.head.len() + line.len() < Self::HEAD {
+            self.head.push_str(&line);
+            self.head.push('\n');
+            return;
+        }
+        self.tail_bytes += line.len() + 1;
+        self.tail.push_back(line);
+        while self.tail_bytes > Self::TAIL {
+            match self.tail.pop_front() {
+                Some(l) => {
+                    self.tail_bytes -= l.len() + 1;
+                    self.dropped += 1;
+                }
+                None => break,
+            }
+        }
+    }
+
+    fn finish(self) -> String {
+        let mut log = self.head;
+        if self.dropped > 0 {
+            log.push_str(&format!("[... {} log lines dropped ...]\n", self.dropped));
+        }
+        for line in self.tail {
+            log.push_str(&line);
+            log.push('\n');
+        }
+        log
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn version_from_banner() {
+        let banner = "******\n** ngspice-39 : Circuit level simulation program\n";
+        assert_eq!(parse_version(banner).as_deref(), Some("39"));
+        assert_eq!(
+            parse_version("** ngspice-44.2 : x").as_deref(),
+            Some("44.2")
+        );
+        assert_eq!(parse_version("something else"), None);
+    }
+
+    #[test]
+    fn include_names_must_be_plain() {
+        assert!(is_plain_name("contact.inc"));
+        for bad in ["", "../x", "/etc/passwd", "a/b", DECK_NAME, RAW_NAME, ".."] {
+            assert!(!is_plain_name(bad), "{bad}");
+        }
+    }
+
+    #[test]
+    fn log_buffer_keeps_head_and_tail() {
+        let mut log = LogBuffer::default();
+        for i in 0..100_000 {
+            log.push(format!("line {i} with some padding to make it longer"));
+        }
+        let text = log.finish();
+        assert!(text.len() < LogBuffer::HEAD + LogBuffer::TAIL + 100);
+        assert!(text.starts_with("line 0 "));
+        assert!(text.ends_with("line 99999 with some padding to make it longer\n"));
+        assert!(text.contains("log lines dropped"));
+    }
+
+    #[test]
+    fn missing_program_says_how_to_install() {
+        let err = Ngspice::locate(Some(Path::new("/nonexistent/ngspice"))).unwrap_err();
+        let msg = err.to_string();
+        assert!(msg.contains("apt-get install -y ngspice"), "{msg}");
+        assert!(msg.contains("CHATTERSPICE_NGSPICE"), "{msg}");
+    }
+}
