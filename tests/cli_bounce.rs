@@ -80,9 +80,9 @@ fn default_json_follows_the_contract() {
     assert_eq!(intervals[0]["start"], 0.0);
     assert_eq!(intervals.last().unwrap()["state"], "closed");
     assert_eq!(intervals.last().unwrap()["end"], 0.02);
-    // k0 = g/F = 4.5e-4 / (0.5/800) = 0.72.
+    // k0 = g/F = 1.4e-4 / (1.0/5000) = 0.7.
     let k0 = v["dimensionless"]["k0"].as_f64().unwrap();
-    assert!((k0 - 0.72).abs() < 1e-12, "{k0}");
+    assert!((k0 - 0.7).abs() < 1e-12, "{k0}");
 }
 
 #[test]
