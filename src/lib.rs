@@ -15,6 +15,7 @@ pub mod rawfile;
 pub mod report;
 pub mod scenario;
 pub mod spice;
+pub mod waveform;
 
 pub use chatter::{Chatter, ContactState, Impact, Interval, Outcome};
 pub use mechanics::{Mechanics, MechanicsError, Settings, Surface, simulate};
