@@ -203,7 +203,7 @@ impl<'a> Engine<'a> {
             // Flight from (t, x, v).
             let piece = self.flight(x, v);
             let hit = piece.crossing(g, true);
-            let Some(dt) = hit.filter(|dt| t + dt > t) else {
+            let Some(hit) = hit.filter(|c| t + c.time > t) else {
                 return Ok(if self.impacts.is_empty() {
                     let reach = piece
                         .first_extremum(true)
@@ -213,9 +213,14 @@ impl<'a> Engine<'a> {
                     self.finish_open(Outcome::EndsOpen, open_since, None)
                 });
             };
-            // The largest opening of this flight (after a release).
+            let dt = hit.time;
+            // The largest opening of this flight (after a release): the
+            // minimum the flight turned at, found on the way to the impact.
             if let Some(last) = self.impacts.last_mut() {
-                let lowest = piece.first_extremum(false).map_or(x, |(_, xm)| xm);
+                let lowest = match hit.turned_at {
+                    Some((_, x_turn)) => x_turn,
+                    None => piece.first_extremum(false).map_or(x, |(_, xm)| xm),
+                };
                 let gap_opened = g - lowest;
                 last.max_gap_after = Some(gap_opened);
                 // Never resolve finer than f64 can: positions carry
@@ -242,7 +247,7 @@ impl<'a> Engine<'a> {
             if t_hit > t_end {
                 return Ok(self.finish_open(Outcome::EndOfTime, open_since, None));
             }
-            let (_, v_hit) = piece.state(dt);
+            let v_hit = hit.velocity;
             self.intervals.push(Interval {
                 state: ContactState::Open,
                 start: open_since,
@@ -448,15 +453,24 @@ pub fn impact_response(
                 v_hit,
             );
             let release = piece.crossing(g, false);
-            let horizon = release.unwrap_or(f64::INFINITY).min(budget.max(0.0));
-            let (peak, min) = kv_force_extremes(&piece, g, stiffness, damping, horizon);
+            let budget = budget.max(0.0);
+            // Where the force is last looked at: (time, x, ẋ).
+            let until = match release {
+                Some(c) if c.time <= budget => Some((c.time, g, c.velocity)),
+                _ if budget.is_finite() => {
+                    let (x, v) = piece.state(budget);
+                    Some((budget, x, v))
+                }
+                _ => None,
+            };
+            let (peak, min) = kv_force_extremes(&piece, g, stiffness, damping, until);
             Ok(ImpactResponse {
                 end: match release {
                     None => ResponseEnd::Stuck,
-                    Some(dt) if dt > budget => ResponseEnd::Horizon,
-                    Some(dt) => ResponseEnd::Released {
-                        contact_time: dt,
-                        velocity: piece.state(dt).1,
+                    Some(c) if c.time > budget => ResponseEnd::Horizon,
+                    Some(c) => ResponseEnd::Released {
+                        contact_time: c.time,
+                        velocity: c.velocity,
                     },
                 },
                 peak_force: Some(peak),
@@ -555,31 +569,45 @@ fn bounces(intervals: &[Interval]) -> usize {
 }
 
 /// Largest and smallest Kelvin–Voigt force `s0 (x − g) + r0 ẋ` over a
-/// contact piece on local times [0, `until`] (`until` may be ∞ for a
-/// contact that sticks). The force is a constant plus a combination of y
-/// and ẏ, so its extrema are the closed-form zeros of its rate
-/// `s0 ẏ + r0 ÿ = (s0 − 2a r0) ẏ − r0 ωn² y`.
-fn kv_force_extremes(piece: &LinearPiece, g: f64, s0: f64, r0: f64, until: f64) -> (f64, f64) {
-    let force = |t: f64| {
-        let (x, v) = piece.state(t);
-        s0 * (x - g) + r0 * v
-    };
+/// contact piece from local time 0 to `until` = (time, x, ẋ), the end
+/// state the caller already has (`None` for a contact that sticks: the
+/// force tends to its static value). The force is a constant plus a
+/// combination of y and ẏ, so its extrema are the closed-form zeros of its
+/// rate `s0 ẏ + r0 ÿ = (s0 − 2a r0) ẏ − r0 ωn² y`.
+fn kv_force_extremes(
+    piece: &LinearPiece,
+    g: f64,
+    s0: f64,
+    r0: f64,
+    until: Option<(f64, f64, f64)>,
+) -> (f64, f64) {
+    let force = |x: f64, v: f64| s0 * (x - g) + r0 * v;
     let rate = piece.combo(-r0 * piece.omega2, s0 - 2.0 * piece.a * r0);
-    let mut peak = force(0.0);
+    let mut peak = force(piece.x0, piece.v0);
     let mut min = peak;
     let mut consider = |f: f64| {
         peak = peak.max(f);
         min = min.min(f);
     };
-    if until.is_finite() {
-        consider(force(until));
-    } else {
-        consider(s0 * (piece.x_eq - g));
-    }
+    let t_until = match until {
+        Some((t, x, v)) => {
+            consider(force(x, v));
+            t
+        }
+        None => {
+            consider(s0 * (piece.x_eq - g));
+            f64::INFINITY
+        }
+    };
     // The force's own extrema decay like the motion: the first two (one
     // maximum, one minimum) bound every later one.
-    for z in piece.zeros(rate).take(2).take_while(|&z| z < until) {
-        consider(force(z));
+    let at_rest = s0 * (piece.x_eq - g);
+    for (_, varying) in piece
+        .zeros(rate, piece.combo(s0, r0))
+        .take(2)
+        .take_while(|&(z, _)| z < t_until)
+    {
+        consider(at_rest + varying);
     }
     (peak, min)
 }

@@ -24,23 +24,38 @@
 
 use super::root;
 
-/// The zeros of a [`Combo`], in increasing order (see [`LinearPiece::zeros`]).
+/// The zeros of a [`Combo`], in increasing order, each with the value a
+/// second combination takes there (see [`LinearPiece::zeros`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Zeros {
     next: f64,
     period: f64,
+    value: f64,
+    /// What the value is multiplied by from one zero to the next.
+    factor: f64,
+}
+
+impl Zeros {
+    const NONE: Zeros = Zeros {
+        next: f64::INFINITY,
+        period: f64::INFINITY,
+        value: 0.0,
+        factor: 0.0,
+    };
 }
 
 impl Iterator for Zeros {
-    type Item = f64;
+    /// (local time s, value of the second combination there).
+    type Item = (f64, f64);
 
-    fn next(&mut self) -> Option<f64> {
+    fn next(&mut self) -> Option<(f64, f64)> {
         if !self.next.is_finite() {
             return None;
         }
-        let t = self.next;
-        self.next = t + self.period;
-        Some(t)
+        let out = (self.next, self.value);
+        self.next += self.period;
+        self.value *= self.factor;
+        Some(out)
     }
 }
 
@@ -59,6 +74,26 @@ pub struct LinearPiece {
     pub omega2: f64,
     /// 1/s², q = ωn² − a² (> 0 oscillatory).
     pub q: f64,
+    /// 1/s, w = √|q|, the decay e^(−aπ/w) over half a period (1 unless
+    /// under-damped), and the y and ẏ combinations: every evaluation needs
+    /// them, so [`LinearPiece::new`] works them out once.
+    w: f64,
+    half_period_decay: f64,
+    y: Combo,
+    v: Combo,
+}
+
+/// A level crossing found by [`LinearPiece::crossing`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Crossing {
+    /// s, local time of the crossing.
+    pub time: f64,
+    /// m/s, the velocity at `time`.
+    pub velocity: f64,
+    /// (s, m): the extremum (local time, position) at which the motion
+    /// turned toward the level, or `None` if it crossed in the first
+    /// monotone segment without turning.
+    pub turned_at: Option<(f64, f64)>,
 }
 
 /// A combination `P·E(t) + Q·G(t)` of the two basis functions.
@@ -73,26 +108,42 @@ impl LinearPiece {
     pub fn new(mass: f64, damping: f64, stiffness: f64, force: f64, x0: f64, v0: f64) -> Self {
         let a = damping / (2.0 * mass);
         let omega2 = stiffness / mass;
+        let x_eq = force / stiffness;
+        let q = omega2 - a * a;
+        let y0 = x0 - x_eq;
+        let w = q.abs().sqrt();
         LinearPiece {
             x0,
             v0,
-            x_eq: force / stiffness,
+            x_eq,
             a,
             omega2,
-            q: omega2 - a * a,
+            q,
+            w,
+            half_period_decay: if q > 0.0 {
+                (-a * std::f64::consts::PI / w).exp()
+            } else {
+                1.0
+            },
+            y: Combo {
+                p: y0,
+                q: v0 + a * y0,
+            },
+            v: Combo {
+                p: v0,
+                q: -(a * v0 + omega2 * y0),
+            },
         }
     }
 
     /// (E(t), G(t)), the damped basis, evaluated without overflow.
     pub fn basis(&self, t: f64) -> (f64, f64) {
-        let a = self.a;
+        let (a, w) = (self.a, self.w);
         if self.q > 0.0 {
-            let w = self.q.sqrt();
             let d = (-a * t).exp();
             let (s, c) = (w * t).sin_cos();
             (d * c, d * s / w)
         } else if self.q < 0.0 {
-            let w = (-self.q).sqrt();
             let wt = w * t;
             if wt < 1.0 {
                 let d = (-a * t).exp();
@@ -111,20 +162,12 @@ impl LinearPiece {
 
     /// y = x − x_eq as a combination.
     pub fn y_combo(&self) -> Combo {
-        let y0 = self.x0 - self.x_eq;
-        Combo {
-            p: y0,
-            q: self.v0 + self.a * y0,
-        }
+        self.y
     }
 
     /// ẏ = ẋ as a combination.
     pub fn v_combo(&self) -> Combo {
-        let y0 = self.x0 - self.x_eq;
-        Combo {
-            p: self.v0,
-            q: -(self.a * self.v0 + self.omega2 * y0),
-        }
+        self.v
     }
 
     /// α·y + β·ẏ as a combination.
@@ -145,47 +188,75 @@ impl LinearPiece {
 
     /// (x, ẋ) at local time `t`.
     pub fn state(&self, t: f64) -> (f64, f64) {
-        let (e, g) = self.basis(t);
-        let y = self.y_combo();
-        let v = self.v_combo();
-        (self.x_eq + y.p * e + y.q * g, v.p * e + v.q * g)
+        let (y, v) = self.y_and_v(t);
+        (self.x_eq + y, v)
     }
 
-    /// The zeros of a combination in (0, ∞), in increasing order. Zeros of
+    /// (y, ẏ) at local time `t`, from one evaluation of the basis.
+    fn y_and_v(&self, t: f64) -> (f64, f64) {
+        let (e, g) = self.basis(t);
+        let (y, v) = (self.y, self.v);
+        (y.p * e + y.q * g, v.p * e + v.q * g)
+    }
+
+    /// ÿ = ẍ, from the equation of motion (no evaluation needed).
+    fn acceleration(&self, y: f64, v: f64) -> f64 {
+        -2.0 * self.a * v - self.omega2 * y
+    }
+
+    /// The zeros of a combination `c` in (0, ∞), in increasing order,
+    /// each with the value of the combination `d` there. Zeros of
     /// `P·C + Q·S` are known in closed form (see the module docs): evenly
     /// spaced by π/w when under-damped, at most one otherwise.
     ///
+    /// When under-damped, `P cos wt + (Q/w) sin wt = R cos(wt − φ)` and
+    /// the zeros are at wt = φ + π/2 + jπ, where (cos wt, sin wt) =
+    /// (−1)ʲ (−Q/(wR), P/R): so `d` there is
+    /// (−1)ʲ e^(−at) (P·Q_d − Q·P_d)/(wR), one `exp` for the first zero and
+    /// a factor −e^(−aπ/w) from each to the next, with no trigonometry.
+    ///
     /// A zero at t = 0 itself (up to the rounding of the phase, 64 ulps of
     /// the period) is not reported: it is where the piece starts.
-    pub fn zeros(&self, c: Combo) -> Zeros {
-        let none = Zeros {
-            next: f64::INFINITY,
-            period: f64::INFINITY,
-        };
+    pub fn zeros(&self, c: Combo, d: Combo) -> Zeros {
         if c.p == 0.0 && c.q == 0.0 {
-            return none;
+            return Zeros::NONE;
         }
         if self.q > 0.0 {
-            let w = self.q.sqrt();
-            // P cos wt + (Q/w) sin wt = R cos(wt − φ): zeros at
-            // wt = φ + π/2 + jπ.
-            let phi = (c.q / w).atan2(c.p);
+            let w = self.w;
+            let qw = c.q / w;
+            let phi = qw.atan2(c.p);
             let period = std::f64::consts::PI / w;
             let floor = 64.0 * f64::EPSILON * period;
             let mut t = (phi + std::f64::consts::FRAC_PI_2) / w;
+            // (−1)ʲ for the zero finally chosen.
+            let mut sign = 1.0;
             while t <= floor {
                 t += period;
+                sign = -sign;
             }
             while t - period > floor {
                 t -= period;
+                sign = -sign;
             }
-            Zeros { next: t, period }
+            let r2 = c.p * c.p + qw * qw;
+            let r = if r2.is_normal() {
+                r2.sqrt()
+            } else {
+                c.p.hypot(qw)
+            };
+            let value = sign * (-self.a * t).exp() * (c.p * d.q - c.q * d.p) / (w * r);
+            Zeros {
+                next: t,
+                period,
+                value,
+                factor: -self.half_period_decay,
+            }
         } else {
             let t = if self.q < 0.0 {
-                let w = (-self.q).sqrt();
+                let w = self.w;
                 let r = -c.p * w / c.q;
                 if !(r > 0.0 && r < 1.0) {
-                    return none;
+                    return Zeros::NONE;
                 }
                 r.atanh() / w
             } else {
@@ -195,9 +266,11 @@ impl LinearPiece {
                 Zeros {
                     next: t,
                     period: f64::INFINITY,
+                    value: self.eval(d, t),
+                    factor: 1.0,
                 }
             } else {
-                none
+                Zeros::NONE
             }
         }
     }
@@ -211,8 +284,8 @@ impl LinearPiece {
     /// envelope decays, or is constant when undamped), so at most the first
     /// two segments with the right slope need looking at: the answer is
     /// exact, not a scan.
-    pub fn crossing(&self, level: f64, upward: bool) -> Option<f64> {
-        let mut extrema = self.zeros(self.v_combo());
+    pub fn crossing(&self, level: f64, upward: bool) -> Option<Crossing> {
+        let mut extrema = self.zeros(self.v, self.y);
         let mut t0 = 0.0;
         let mut x_start = self.x0;
         // Velocity zeros are simple, so segments alternate direction. The
@@ -230,15 +303,21 @@ impl LinearPiece {
                 };
                 if starts_before {
                     let end = match t1 {
-                        Some(t1) => Some(t1),
+                        Some((t1, y1)) => Some((t1, self.x_eq + y1)),
                         None => self.unbounded_bracket(t0, level, upward),
                     };
-                    if let Some(t_end) = end {
-                        let x_end = self.state(t_end).0;
+                    if let Some((t_end, x_end)) = end {
                         // Strictly past the level: touching it with zero
                         // speed at an extremum is a graze, not an impact.
                         if crosses(x_end) {
-                            return Some(self.polish(t0, t_end, level));
+                            let between_extrema = t1.is_some() && (t0 > 0.0 || self.v0 == 0.0);
+                            let (time, velocity) =
+                                self.polish((t0, x_start), (t_end, x_end), level, between_extrema);
+                            return Some(Crossing {
+                                time,
+                                velocity,
+                                turned_at: (t0 > 0.0).then_some((t0, x_start)),
+                            });
                         }
                     }
                 }
@@ -249,9 +328,9 @@ impl LinearPiece {
                 }
             }
             match t1 {
-                Some(t1) => {
+                Some((t1, y1)) => {
                     t0 = t1;
-                    x_start = self.state(t1).0;
+                    x_start = self.x_eq + y1;
                     rising = !rising;
                 }
                 None => return None,
@@ -274,13 +353,13 @@ impl LinearPiece {
     /// that is a maximum (`upward`) or a minimum, and its time; `None` if
     /// the motion has no such extremum.
     pub fn first_extremum(&self, maximum: bool) -> Option<(f64, f64)> {
-        let mut extrema = self.zeros(self.v_combo());
+        let mut extrema = self.zeros(self.v, self.y);
         let mut rising = self.initially_rising();
         for _ in 0..2 {
-            let t1 = extrema.next()?;
+            let (t1, y1) = extrema.next()?;
             // A segment rising to t1 ends at a maximum.
             if rising == maximum {
-                return Some((t1, self.state(t1).0));
+                return Some((t1, self.x_eq + y1));
             }
             rising = !rising;
         }
@@ -293,9 +372,9 @@ impl LinearPiece {
     }
 
     /// For the last, unbounded monotone segment: a time by which x has
-    /// passed `level`, found by doubling, or `None` if it never does
-    /// (x approaches x_eq without reaching `level`).
-    fn unbounded_bracket(&self, t0: f64, level: f64, upward: bool) -> Option<f64> {
+    /// passed `level` and x there, found by doubling, or `None` if it
+    /// never does (x approaches x_eq without reaching `level`).
+    fn unbounded_bracket(&self, t0: f64, level: f64, upward: bool) -> Option<(f64, f64)> {
         let reaches = if upward {
             self.x_eq > level
         } else {
@@ -309,24 +388,55 @@ impl LinearPiece {
             let t = t0 + dt;
             let x = self.state(t).0;
             if (upward && x >= level) || (!upward && x <= level) {
-                return Some(t);
+                return Some((t, x));
             }
             dt *= 2.0;
         }
         None
     }
 
-    /// The crossing of `level` in the monotone segment [lo, hi], polished
-    /// by safeguarded Newton iteration (the derivative is the exact
-    /// velocity).
-    fn polish(&self, lo: f64, hi: f64, level: f64) -> f64 {
-        root::newton_bracketed(
+    /// The crossing of `level` in the monotone segment between `lo` and
+    /// `hi` (local time, position), and the velocity there, by safeguarded
+    /// Halley iteration: the exact velocity and acceleration are the
+    /// derivatives.
+    ///
+    /// Between two extrema x runs like half a cosine, so inverting that
+    /// (an `acos`) starts Halley within a few per cent of the root;
+    /// elsewhere the start is the secant point.
+    fn polish(
+        &self,
+        (t_lo, x_lo): (f64, f64),
+        (t_hi, x_hi): (f64, f64),
+        level: f64,
+        between_extrema: bool,
+    ) -> (f64, f64) {
+        let frac = (level - x_lo) / (x_hi - x_lo);
+        let start = if between_extrema {
+            t_lo + (t_hi - t_lo) * (1.0 - 2.0 * frac).acos() / std::f64::consts::PI
+        } else {
+            t_lo + (t_hi - t_lo) * frac
+        };
+        // x − level = y − (level − x_eq), with y kept apart from x_eq so
+        // that a small y keeps its relative precision.
+        let offset = level - self.x_eq;
+        let root = root::halley_bracketed(
             |t| {
-                let (x, v) = self.state(t);
-                (x - level, v)
+                let (y, v) = self.y_and_v(t);
+                (y - offset, v, self.acceleration(y, v))
             },
-            lo,
-            hi,
-        )
+            (t_lo, x_lo - level),
+            (t_hi, x_hi - level),
+            start,
+        );
+        match root.last {
+            // Converged steps are tiny, so a Taylor step from the last
+            // evaluation (ẏ' = ÿ, ÿ' = −2a ÿ − ωn² ẏ) is exact to rounding.
+            Some(j) if (root.t - j.t).abs() <= 1e-6 * self.time_scale() => {
+                let h = root.t - j.t;
+                let jerk = -2.0 * self.a * j.d2 - self.omega2 * j.d1;
+                (root.t, j.d1 + h * (j.d2 + 0.5 * h * jerk))
+            }
+            _ => (root.t, self.state(root.t).1),
+        }
     }
 }

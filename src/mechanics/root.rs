@@ -40,55 +40,106 @@ pub fn bisect(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64, tol: f64) -> Opt
     Some(0.5 * (lo + hi))
 }
 
+/// A function's value and first two derivatives at `t`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Jet {
+    pub t: f64,
+    pub f: f64,
+    pub d1: f64,
+    pub d2: f64,
+}
+
+/// The result of [`halley_bracketed`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Root {
+    /// The root.
+    pub t: f64,
+    /// The last evaluation, within a converged step of `t` (`None` if an
+    /// end of the bracket was an exact zero): a caller can extrapolate
+    /// from it to `t` instead of evaluating once more.
+    pub last: Option<Jet>,
+}
+
 /// A root of `f` in `[lo, hi]`, which must bracket a sign change, by
-/// Newton iteration safeguarded with bisection: a Newton step is taken
-/// only when it lands inside the current bracket and shrinks faster than
-/// bisection would. `f` returns the value and its derivative. Converges to
-/// a few ulps of the root (the bracket never widens, so it cannot
-/// diverge); returns the better end if the bracket is not a sign change.
-pub fn newton_bracketed(f: impl Fn(f64) -> (f64, f64), mut lo: f64, mut hi: f64) -> f64 {
-    let (flo, _) = f(lo);
-    let (fhi, _) = f(hi);
-    if flo == 0.0 {
-        return lo;
+/// Halley iteration safeguarded with bisection. `f_lo` and `f_hi` are the
+/// values at the ends, which the caller already has; `start` is a first
+/// guess (the midpoint is used if it lies outside the bracket); `f`
+/// returns the value and its first two derivatives.
+///
+/// A Halley step is taken only when it lands inside the current bracket
+/// and shrinks faster than bisection would, so the bracket never widens
+/// and the iteration cannot diverge. It stops at a step within a few ulps
+/// of `t`, or once the cubic convergence rate seen on the last two steps
+/// predicts that the next step would be (so a good start costs two or
+/// three evaluations). If the ends have the same sign, returns the end
+/// nearer zero.
+pub fn halley_bracketed(
+    f: impl Fn(f64) -> (f64, f64, f64),
+    (mut lo, f_lo): (f64, f64),
+    (mut hi, f_hi): (f64, f64),
+    start: f64,
+) -> Root {
+    let at_end = |t| Root { t, last: None };
+    if f_lo == 0.0 {
+        return at_end(lo);
     }
-    if fhi == 0.0 {
-        return hi;
+    if f_hi == 0.0 {
+        return at_end(hi);
     }
-    if flo.signum() == fhi.signum() {
-        return if flo.abs() < fhi.abs() { lo } else { hi };
+    if f_lo.signum() == f_hi.signum() {
+        return at_end(if f_lo.abs() < f_hi.abs() { lo } else { hi });
     }
-    let rising = flo < 0.0;
-    let mut t = 0.5 * (lo + hi);
+    let rising = f_lo < 0.0;
+    let mut t = if start > lo && start < hi {
+        start
+    } else {
+        0.5 * (lo + hi)
+    };
     let mut step_before = hi - lo;
-    let mut step = step_before;
-    let (mut ft, mut dft) = f(t);
+    // The last step, if it was a Halley step (for the convergence rate).
+    let mut halley_before = f64::NAN;
+    let mut last = None;
     for _ in 0..300 {
+        let (ft, d1, d2) = f(t);
+        let jet = Jet { t, f: ft, d1, d2 };
+        last = Some(jet);
         if ft == 0.0 {
-            return t;
+            break;
         }
-        let newton = if dft != 0.0 { t - ft / dft } else { f64::NAN };
-        let fast = (2.0 * ft).abs() <= (step_before * dft).abs();
-        step_before = step;
-        if newton > lo && newton < hi && fast {
-            step = t - newton;
-            t = newton;
-        } else {
-            step = 0.5 * (hi - lo);
-            t = lo + step;
-        }
-        let tol = 4.0 * f64::EPSILON * t.abs().max(f64::MIN_POSITIVE);
-        if step.abs() <= tol || hi - lo <= tol {
-            return t;
-        }
-        (ft, dft) = f(t);
         if (ft < 0.0) == rising {
             lo = t;
         } else {
             hi = t;
         }
+        let tol = 4.0 * f64::EPSILON * t.abs().max(f64::MIN_POSITIVE);
+        let step = -2.0 * ft * d1 / (2.0 * d1 * d1 - ft * d2);
+        let next = t + step;
+        if step.abs() <= tol {
+            return Root {
+                t: next.clamp(lo, hi),
+                last,
+            };
+        }
+        if next > lo && next < hi && 2.0 * step.abs() <= step_before.abs() {
+            // Cubic convergence: the next step would be about
+            // step·(step/step_before)³.
+            let ratio = step / halley_before;
+            if (step * ratio * ratio * ratio).abs() <= tol {
+                return Root { t: next, last };
+            }
+            halley_before = step;
+            step_before = step;
+            t = next;
+        } else {
+            halley_before = f64::NAN;
+            step_before = 0.5 * (hi - lo);
+            t = lo + step_before;
+            if hi - lo <= tol {
+                return Root { t, last };
+            }
+        }
     }
-    t
+    Root { t, last }
 }
 
 #[cfg(test)]
@@ -96,16 +147,31 @@ mod tests {
     use super::*;
 
     #[test]
-    fn newton_finds_cosine_root_to_ulps() {
-        let r = newton_bracketed(|t| (t.cos(), -t.sin()), 1.0, 2.0);
-        assert!((r - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+    fn halley_finds_cosine_root_to_ulps() {
+        let f = |t: f64| (t.cos(), -t.sin(), -t.cos());
+        for start in [1.0, 1.2, 1.9, 7.0] {
+            let r = halley_bracketed(f, (1.0, 1f64.cos()), (2.0, 2f64.cos()), start);
+            assert!((r.t - std::f64::consts::FRAC_PI_2).abs() < 1e-15, "{start}");
+            assert!((r.last.unwrap().t - r.t).abs() < 1e-4);
+        }
     }
 
     #[test]
-    fn newton_survives_a_flat_start_and_decreasing_function() {
-        // x³ has a zero derivative at its root: Newton alone crawls.
-        let r = newton_bracketed(|t| (-(t - 0.3).powi(3), -3.0 * (t - 0.3).powi(2)), 0.0, 1.0);
-        assert!((r - 0.3).abs() < 1e-5, "{r}");
+    fn halley_survives_a_flat_root_and_decreasing_function() {
+        // x³ has zero derivatives at its root: Halley alone crawls.
+        let f = |t: f64| {
+            let d = t - 0.3;
+            (-d * d * d, -3.0 * d * d, -6.0 * d)
+        };
+        let r = halley_bracketed(f, (0.0, f(0.0).0), (1.0, f(1.0).0), 0.9);
+        assert!((r.t - 0.3).abs() < 1e-5, "{}", r.t);
+    }
+
+    #[test]
+    fn halley_returns_an_exact_end() {
+        let f = |t: f64| (t - 1.0, 1.0, 0.0);
+        let r = halley_bracketed(f, (0.0, -1.0), (1.0, 0.0), 0.5);
+        assert_eq!(r, Root { t: 1.0, last: None });
     }
 
     #[test]
