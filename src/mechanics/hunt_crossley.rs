@@ -146,7 +146,11 @@ impl HcContact {
                     min_force,
                 });
             }
-            if sticks_possible && self.energy_margin(&step.y1) < -stick_margin {
+            // Stuck is declared only once moving out again (past the
+            // deepest penetration, so the force peak has been seen): the
+            // reported peak force then does not depend on step sizes.
+            let moving_out = step.y1[1] < 0.0;
+            if sticks_possible && moving_out && self.energy_margin(&step.y1) < -stick_margin {
                 return Ok(HcOutcome {
                     end: HcEnd::Stuck { after: step.t1 },
                     peak_force: self.refine_peak(&peak),
