@@ -34,6 +34,10 @@ pub const DEFAULT_SCENARIO_TOML: &str = include_str!("../scenarios/default.toml"
 const DEFAULT_SCENARIO_ORIGIN: &str =
     concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/default.toml");
 
+/// The built-in scenario's circuit (`netlists/mcu_input.cir`), compiled in
+/// so that `run` with no scenario works wherever the binary is.
+pub const DEFAULT_NETLIST: &str = include_str!("../netlists/mcu_input.cir");
+
 /// `[mechanics]`: the moving contact (model.md §1). SI units.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -266,6 +270,9 @@ pub struct Scenario {
     /// Computed once during validation: converting a Hunt–Crossley
     /// restitution into χ is a root solve that can fail.
     resolved_surface: Surface,
+    /// The built-in scenario carries its netlist's text, used when the
+    /// file is not on disk (an installed binary).
+    embedded_netlist: Option<&'static str>,
 }
 
 /// A place in a scenario file: the file and, when known, the 1-based line.
@@ -362,6 +369,18 @@ pub enum ScenarioError {
         path.display()
     )]
     CoilDriveUnsupported { path: PathBuf },
+    #[error(
+        "{}: cannot read the netlist named by `circuit.netlist` in {} \
+         (relative paths are relative to the scenario file)",
+        path.display(),
+        scenario.display()
+    )]
+    NetlistRead {
+        path: PathBuf,
+        scenario: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
 }
 
 impl ScenarioError {
@@ -378,6 +397,7 @@ impl ScenarioError {
             ScenarioError::Read { .. }
             | ScenarioError::Syntax { .. }
             | ScenarioError::CoilDriveUnsupported { .. } => None,
+            ScenarioError::NetlistRead { .. } => Some("circuit.netlist"),
         }
     }
 }
@@ -433,6 +453,7 @@ impl Scenario {
             circuit,
             probes: document.probe,
             resolved_surface,
+            embedded_netlist: None,
         })
     }
 
@@ -441,8 +462,30 @@ impl Scenario {
     /// input.
     pub fn builtin_default() -> Scenario {
         // The unit tests parse it, so a broken file never ships.
-        Scenario::parse(DEFAULT_SCENARIO_TOML, Path::new(DEFAULT_SCENARIO_ORIGIN))
-            .expect("the built-in scenario is valid")
+        let scenario = Scenario::parse(DEFAULT_SCENARIO_TOML, Path::new(DEFAULT_SCENARIO_ORIGIN))
+            .expect("the built-in scenario is valid");
+        Scenario {
+            embedded_netlist: Some(DEFAULT_NETLIST),
+            ..scenario
+        }
+    }
+
+    /// The `[circuit]` netlist: its path (for messages and relative
+    /// includes) and its text. `None` when the scenario has no `[circuit]`.
+    pub fn netlist(&self) -> Option<Result<(PathBuf, String), ScenarioError>> {
+        let circuit = self.circuit.as_ref()?;
+        let path = circuit.netlist.clone();
+        Some(
+            match (std::fs::read_to_string(&path), self.embedded_netlist) {
+                (Ok(text), _) => Ok((path, text)),
+                (Err(_), Some(text)) => Ok((path, text.to_owned())),
+                (Err(source), None) => Err(ScenarioError::NetlistRead {
+                    path,
+                    scenario: self.origin.clone(),
+                    source,
+                }),
+            },
+        )
     }
 
     /// The step-force mechanics for the engine. Fails for a coil-driven
@@ -1163,8 +1206,41 @@ high = 2.31
             | ScenarioError::Empty { at, .. }
             | ScenarioError::Conflict { at, .. }
             | ScenarioError::NotForLaw { at, .. } => at.line,
-            ScenarioError::Read { .. } | ScenarioError::CoilDriveUnsupported { .. } => None,
+            ScenarioError::Read { .. }
+            | ScenarioError::CoilDriveUnsupported { .. }
+            | ScenarioError::NetlistRead { .. } => None,
         }
+    }
+
+    #[test]
+    fn the_netlist_is_read_from_beside_the_scenario_or_named_when_missing() {
+        let dir = tempfile::tempdir().unwrap();
+        let origin = dir.path().join("relay.toml");
+        let s = Scenario::parse(VALID, &origin).unwrap();
+        let err = s.netlist().unwrap().unwrap_err();
+        assert_eq!(err.key(), Some("circuit.netlist"));
+        assert!(err.to_string().contains("net/input.cir"), "{err}");
+
+        std::fs::create_dir(dir.path().join("net")).unwrap();
+        std::fs::write(dir.path().join("net/input.cir"), "title\n.end\n").unwrap();
+        let (path, text) = s.netlist().unwrap().unwrap();
+        assert_eq!(path, dir.path().join("net/input.cir"));
+        assert_eq!(text, "title\n.end\n");
+
+        let no_circuit = edit("[circuit]\nnetlist = \"net/input.cir\"\n", "");
+        assert!(parse(&no_circuit).unwrap().netlist().is_none());
+    }
+
+    #[test]
+    fn the_builtin_default_carries_its_netlist() {
+        let (path, text) = Scenario::builtin_default().netlist().unwrap().unwrap();
+        assert!(
+            path.ends_with("netlists/mcu_input.cir"),
+            "{}",
+            path.display()
+        );
+        assert_eq!(text, DEFAULT_NETLIST);
+        assert!(text.contains(" CONTACT"));
     }
 
     #[test]
