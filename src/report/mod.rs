@@ -54,6 +54,35 @@ pub enum WriteError {
     },
 }
 
+/// Write several report files into `dir`, creating it if needed. Unless
+/// `overwrite`, nothing is written when any of the files already exists:
+/// the error names the first, and the directory is left as it was (apart
+/// from being created), so a second run never clobbers half of a first.
+/// Each file is written with [`write_new_file`].
+pub fn write_bundle(
+    dir: &Path,
+    files: &[(String, Vec<u8>)],
+    overwrite: bool,
+) -> Result<(), WriteError> {
+    std::fs::create_dir_all(dir).map_err(|source| WriteError::Io {
+        path: dir.to_owned(),
+        source,
+    })?;
+    if !overwrite {
+        if let Some(path) = files
+            .iter()
+            .map(|(name, _)| dir.join(name))
+            .find(|p| p.symlink_metadata().is_ok())
+        {
+            return Err(WriteError::Exists { path });
+        }
+    }
+    for (name, contents) in files {
+        write_new_file(&dir.join(name), contents, overwrite)?;
+    }
+    Ok(())
+}
+
 /// Write `contents` to `path` all at once: into a temporary file in the
 /// same directory, then renamed over `path`, so that a reader (or a crash)
 /// never sees half a report. Unless `overwrite`, an existing `path` is an
@@ -123,6 +152,28 @@ mod tests {
         write_new_file(&path, b"new", true).unwrap();
         assert_eq!(std::fs::read_to_string(&path).unwrap(), "new");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn a_bundle_is_all_or_nothing_when_a_file_exists() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("run");
+        let files = [
+            ("report.json".to_owned(), b"{}".to_vec()),
+            ("plot.svg".to_owned(), b"<svg/>".to_vec()),
+        ];
+        write_bundle(&out, &files, false).unwrap();
+        assert_eq!(std::fs::read(out.join("plot.svg")).unwrap(), b"<svg/>");
+
+        std::fs::remove_file(out.join("report.json")).unwrap();
+        std::fs::write(out.join("plot.svg"), "mine").unwrap();
+        let err = write_bundle(&out, &files, false).unwrap_err();
+        assert!(err.to_string().contains("plot.svg"), "{err}");
+        assert!(!out.join("report.json").exists(), "wrote part of the bundle");
+        assert_eq!(std::fs::read_to_string(out.join("plot.svg")).unwrap(), "mine");
+
+        write_bundle(&out, &files, true).unwrap();
+        assert_eq!(std::fs::read(out.join("report.json")).unwrap(), b"{}");
     }
 
     #[test]
