@@ -9,6 +9,7 @@
 //! into a contact resistance waveform, an ngspice netlist, a batch run and
 //! an analysis of the probed signals.
 
+pub mod analysis;
 pub mod chatter;
 pub mod mechanics;
 pub mod rawfile;

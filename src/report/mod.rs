@@ -13,6 +13,7 @@
 
 pub mod csv;
 pub mod json;
+pub mod svg;
 pub mod table;
 
 use std::io::Write;

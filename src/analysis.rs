@@ -1,0 +1,1073 @@
+//! Analysis: what the probed signals did while the contact bounced.
+//!
+//! The stage between the raw file and the reports. Everything here is a
+//! pure function of sampled waveforms: `time` (s, the transient plot's
+//! scale) and `values` (V or A) of one vector.
+//!
+//! # Samples and interpolation
+//! ngspice writes its accepted time points, whose spacing its truncation
+//! error control adapts to the circuit. Nothing is known between two
+//! points, so a threshold crossing is located by **linear interpolation**
+//! between the two samples that bracket it, and integrals use the
+//! trapezoid rule over the same straight lines. That is the best the data
+//! allows; the error of a crossing is about Δt²·|v''| / (8·|v'|) for a
+//! sample spacing Δt, and nil where the simulator kept the signal linear
+//! (e.g. on a PWL ramp between breakpoints). Repeated instants (a step
+//! stored as two points at one time) are accepted: nothing divides by a
+//! time step.
+//!
+//! # Schmitt edges (`interfaces.md` §3)
+//! A probe has two thresholds `low < high`. The level is **high** once the
+//! signal reaches `high` (v ≥ high) and stays so until it reaches `low`
+//! (v ≤ low), and the other way round: noise around one threshold does not
+//! toggle it. An *edge* is a change of level; its time is the
+//! interpolated crossing of the threshold that caused it.
+//!
+//! The level at the first sample is high (v ≥ high), low (v ≤ low) or
+//! [`Level::Undetermined`] in between. An undetermined level becomes
+//! defined when the signal first reaches a threshold, and that first
+//! reach is **not** an edge: the input had no defined level before, so
+//! nothing changed for a logic input reading it. A start at a rail (the
+//! normal case: a pulled-up input at supply) is a defined level.
+//!
+//! `glitches` = edges − 1 when there is at least one edge, else 0: the
+//! edges beyond the one a clean switch would give.
+//!
+//! # Currents
+//! For a current probe (`i(v1)`, `@r1[i]`, or a vector the raw file types
+//! as `current`) the analysis adds the peak |i| and the charge ∫ i dt,
+//! over the whole record and per closure of the contact (the closed
+//! intervals of the chatter sequence, see [`closures`]).
+//!
+//! # Comparison with an ideal contact
+//! [`compare`] sets a probe's analysis beside the same circuit's with a
+//! single clean make at the first impact and reports what the bounce
+//! added. Every difference is *bounced − ideal*.
+
+use serde::Serialize;
+use thiserror::Error;
+
+use crate::chatter::{Chatter, ContactState};
+use crate::rawfile::{Plot, Vector};
+use crate::scenario::Probe;
+
+/// Why a signal could not be analysed.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum AnalysisError {
+    #[error(
+        "`{signal}` is not a vector of the plot \"{plot}\"; change the probe's `signal` to one of: {}",
+        available.join(", ")
+    )]
+    MissingSignal {
+        signal: String,
+        plot: String,
+        /// The plot's vector names, sorted.
+        available: Vec<String>,
+    },
+    #[error(
+        "`{signal}` in the plot \"{plot}\" is complex; edges need a transient analysis (`.tran`)"
+    )]
+    ComplexSignal { signal: String, plot: String },
+    #[error(
+        "the plot \"{plot}\" has {} as its scale, not time; analyse the transient plot (`.tran`)",
+        scale.as_deref().map_or_else(|| "no vector".to_owned(), |s| format!("`{s}`"))
+    )]
+    NotTransient { plot: String, scale: Option<String> },
+    #[error("`{signal}` has no samples; the simulation wrote no points")]
+    Empty { signal: String },
+    #[error(
+        "`{signal}` has {values} samples but time has {time}; \
+         the raw file's vectors must have one value per time point"
+    )]
+    LengthMismatch {
+        signal: String,
+        time: usize,
+        values: usize,
+    },
+    #[error(
+        "`{signal}` is {value} at t = {time:e} s (sample {index}); \
+         the simulation diverged there, check the circuit and the ngspice log"
+    )]
+    NotFinite {
+        signal: String,
+        index: usize,
+        /// s; NaN itself when the time is what is not finite.
+        time: f64,
+        value: f64,
+    },
+    #[error(
+        "time goes back from {previous:e} s to {time:e} s at sample {index}; \
+         the scale must not decrease (is this the transient plot?)"
+    )]
+    TimeGoesBack {
+        index: usize,
+        previous: f64,
+        time: f64,
+    },
+    #[error(
+        "probe `{signal}`: thresholds low = {low} and high = {high} need low < high, both finite; \
+         change the probe's `low`/`high`"
+    )]
+    Thresholds { signal: String, low: f64, high: f64 },
+    #[error(
+        "closure {index} of `{signal}` runs from {start:e} s to {end:e} s; \
+         a closure needs finite start <= end"
+    )]
+    BadClosure {
+        signal: String,
+        index: usize,
+        start: f64,
+        end: f64,
+    },
+    #[error(
+        "closure {index} ({start:e} s to {end:e} s) lies outside the record of `{signal}` \
+         ({record_start:e} s to {record_end:e} s); simulate up to the sequence's end"
+    )]
+    ClosureOutsideRecord {
+        signal: String,
+        index: usize,
+        start: f64,
+        end: f64,
+        record_start: f64,
+        record_end: f64,
+    },
+    #[error(
+        "cannot compare `{bounced}` with `{ideal}`: the ideal run must analyse the same signal \
+         with the same thresholds"
+    )]
+    NotComparable { bounced: String, ideal: String },
+}
+
+/// What a probed vector measures, deciding units and the current analysis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ProbeKind {
+    /// V
+    Voltage,
+    /// A
+    Current,
+    /// Anything else (a behavioural quantity, a power...): unit unknown.
+    Other,
+}
+
+impl ProbeKind {
+    /// Classify a signal by its name, the way ngspice spells vectors:
+    /// `v(...)` is a voltage, `i(...)` and a device's `@dev[i]` a current.
+    /// Otherwise the raw file's type field (`raw_type`, e.g. `"current"`
+    /// for `v1#branch`) decides, when known.
+    pub fn classify(signal: &str, raw_type: Option<&str>) -> ProbeKind {
+        let name = signal.trim().to_ascii_lowercase();
+        let call = |f: &str| name.starts_with(f) && name.ends_with(')');
+        if call("v(") {
+            return ProbeKind::Voltage;
+        }
+        if call("i(") || (name.starts_with('@') && name.ends_with("[i]")) {
+            return ProbeKind::Current;
+        }
+        match raw_type.map(str::to_ascii_lowercase).as_deref() {
+            Some("voltage") => ProbeKind::Voltage,
+            Some("current") => ProbeKind::Current,
+            _ => ProbeKind::Other,
+        }
+    }
+
+    /// The SI unit symbol, empty for [`ProbeKind::Other`].
+    pub fn unit(self) -> &'static str {
+        match self {
+            ProbeKind::Voltage => "V",
+            ProbeKind::Current => "A",
+            ProbeKind::Other => "",
+        }
+    }
+}
+
+/// The Schmitt level of a signal.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Level {
+    Low,
+    High,
+    /// Between the thresholds and neither reached yet.
+    Undetermined,
+}
+
+/// Which way an edge goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Direction {
+    /// Low to high: the signal crossed `high` going up.
+    Rising,
+    /// High to low: the signal crossed `low` going down.
+    Falling,
+}
+
+/// One Schmitt transition.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Edge {
+    /// s, the interpolated crossing of the threshold.
+    pub time: f64,
+    pub direction: Direction,
+    /// s, time to the next edge: the width of the pulse this edge starts.
+    /// `None` for the last edge, whose level lasts to the end of the record.
+    pub width: Option<f64>,
+}
+
+/// The Schmitt trigger's view of a signal.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Schmitt {
+    /// Level at the first sample.
+    pub initial_state: Level,
+    /// Level at the last sample.
+    pub final_state: Level,
+    /// In time order, alternating in direction.
+    pub edges: Vec<Edge>,
+}
+
+/// The current of one closure of the contact.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ClosureCurrent {
+    /// s, the closure's window as given, clipped to the record.
+    pub start: f64,
+    /// s
+    pub end: f64,
+    /// A, the largest |i| in the window (≥ 0).
+    pub peak: f64,
+    /// s, when `peak` occurs (the earliest such instant).
+    pub peak_time: f64,
+    /// C, ∫ i dt over the window (signed, like the current).
+    pub charge: f64,
+}
+
+/// Peak and charge of a current probe.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CurrentAnalysis {
+    /// A, the largest |i| of the whole record (≥ 0).
+    pub peak: f64,
+    /// s, when `peak` occurs.
+    pub peak_time: f64,
+    /// C, ∫ i dt over the whole record.
+    pub charge: f64,
+    /// C, the sum of the closures' charges.
+    pub closed_charge: f64,
+    /// One entry per closure given, in the order given.
+    pub per_closure: Vec<ClosureCurrent>,
+}
+
+/// Everything the analysis says about one probe. The first seven fields
+/// are the contract of `interfaces.md` §3, in its order; absent values are
+/// `null` in JSON, never omitted.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ProbeAnalysis {
+    pub signal: String,
+    /// Number of Schmitt edges.
+    pub edges: usize,
+    /// edges − 1 when edges ≥ 1, else 0.
+    pub glitches: usize,
+    /// s, time of the first edge.
+    pub first_edge: Option<f64>,
+    /// s, time of the last edge: where the signal settled.
+    pub last_edge: Option<f64>,
+    /// Smallest sample (V, A, ...).
+    pub min: f64,
+    /// Largest sample.
+    pub max: f64,
+    pub kind: ProbeKind,
+    /// The thresholds used, in the signal's unit.
+    pub low: f64,
+    pub high: f64,
+    pub initial_state: Level,
+    pub final_state: Level,
+    /// The last sample.
+    pub final_value: f64,
+    /// s, the shortest time between two consecutive edges (the shortest
+    /// glitch); `None` with fewer than two edges.
+    pub shortest_pulse: Option<f64>,
+    /// Every edge, in time order.
+    pub transitions: Vec<Edge>,
+    /// For a current probe: peak and charge; `None` otherwise.
+    pub current: Option<CurrentAnalysis>,
+}
+
+/// What the bounce added to a probe, compared with a run of the same
+/// circuit whose contact makes once, cleanly, at the first impact.
+/// Every difference is *bounced − ideal*: positive means the bounce added.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Comparison {
+    pub signal: String,
+    /// Edges the bounce added (negative if it removed some).
+    pub extra_edges: i64,
+    /// Glitches the bounce added.
+    pub extra_glitches: i64,
+    /// s, the bounced run's last edge minus the ideal's: how much later the
+    /// signal settles. `None` unless both runs have an edge.
+    pub settle_delay: Option<f64>,
+    /// Whether both runs end at the same level; if not, `settle_delay`
+    /// compares edges that mean different things.
+    pub same_final_state: bool,
+    /// Difference of the largest samples.
+    pub max_difference: f64,
+    /// Difference of the smallest samples (negative: the bounce went lower).
+    pub min_difference: f64,
+    /// A, difference of the peak |i| (currents only).
+    pub peak_difference: Option<f64>,
+    /// C, difference of the whole-record charge (currents only).
+    pub charge_difference: Option<f64>,
+}
+
+/// The closed intervals of a chatter sequence as `(start, end)` in s, the
+/// closures [`analyze`] integrates a current over. The first begins at the
+/// first impact. The contact waveform lags each by up to one edge time
+/// (its edges start at the events); widen the windows for that if the
+/// break edge's charge matters.
+pub fn closures(chatter: &Chatter) -> Vec<(f64, f64)> {
+    chatter
+        .intervals
+        .iter()
+        .filter(|i| i.state == ContactState::Closed)
+        .map(|i| (i.start, i.end))
+        .collect()
+}
+
+/// Analyse `probe` in `plot`, which must be a transient plot (its scale is
+/// `time`). `closures` (s) are only used when the signal is a current.
+pub fn analyze(
+    plot: &Plot,
+    probe: &Probe,
+    closures: &[(f64, f64)],
+) -> Result<ProbeAnalysis, AnalysisError> {
+    let scale = plot.variables.first();
+    let time = match (scale, plot.scale()) {
+        (Some(var), Some(Vector::Real(t))) if var.kind.eq_ignore_ascii_case("time") => t,
+        _ => {
+            return Err(AnalysisError::NotTransient {
+                plot: plot.name.clone(),
+                scale: scale.map(|v| v.name.clone()),
+            });
+        }
+    };
+    let Some(index) = plot.index_of(&probe.signal) else {
+        let mut available: Vec<String> = plot.variables.iter().map(|v| v.name.clone()).collect();
+        available.sort();
+        return Err(AnalysisError::MissingSignal {
+            signal: probe.signal.clone(),
+            plot: plot.name.clone(),
+            available,
+        });
+    };
+    let values = match plot.vector(index) {
+        Some(Vector::Real(v)) => v,
+        _ => {
+            return Err(AnalysisError::ComplexSignal {
+                signal: probe.signal.clone(),
+                plot: plot.name.clone(),
+            });
+        }
+    };
+    let kind = ProbeKind::classify(&probe.signal, Some(&plot.variables[index].kind));
+    analyze_samples(probe, kind, time, values, closures)
+}
+
+/// Analyse sampled data: `time` (s, non-decreasing) and `values` of
+/// `probe.signal`, in the unit of `probe.low`/`probe.high`. The current
+/// analysis over `closures` (s) is done when `kind` is a current.
+pub fn analyze_samples(
+    probe: &Probe,
+    kind: ProbeKind,
+    time: &[f64],
+    values: &[f64],
+    closures: &[(f64, f64)],
+) -> Result<ProbeAnalysis, AnalysisError> {
+    let schmitt = schmitt(&probe.signal, time, values, probe.low, probe.high)?;
+    let (min, max) = values
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        });
+    let current = match kind {
+        ProbeKind::Current => Some(current(&probe.signal, time, values, closures)?),
+        _ => None,
+    };
+    let edges = &schmitt.edges;
+    Ok(ProbeAnalysis {
+        signal: probe.signal.clone(),
+        edges: edges.len(),
+        glitches: edges.len().saturating_sub(1),
+        first_edge: edges.first().map(|e| e.time),
+        last_edge: edges.last().map(|e| e.time),
+        min,
+        max,
+        kind,
+        low: probe.low,
+        high: probe.high,
+        initial_state: schmitt.initial_state,
+        final_state: schmitt.final_state,
+        final_value: values[values.len() - 1],
+        shortest_pulse: edges.iter().filter_map(|e| e.width).min_by(f64::total_cmp),
+        transitions: schmitt.edges,
+        current,
+    })
+}
+
+/// Check what every analysis relies on: as many values as times, at least
+/// one sample, everything finite, time never decreasing.
+pub fn check_samples(signal: &str, time: &[f64], values: &[f64]) -> Result<(), AnalysisError> {
+    if time.len() != values.len() {
+        return Err(AnalysisError::LengthMismatch {
+            signal: signal.to_owned(),
+            time: time.len(),
+            values: values.len(),
+        });
+    }
+    if time.is_empty() {
+        return Err(AnalysisError::Empty {
+            signal: signal.to_owned(),
+        });
+    }
+    for (index, (&t, &v)) in time.iter().zip(values).enumerate() {
+        if !t.is_finite() {
+            return Err(AnalysisError::NotFinite {
+                signal: "time".to_owned(),
+                index,
+                time: t,
+                value: t,
+            });
+        }
+        if index > 0 && t < time[index - 1] {
+            return Err(AnalysisError::TimeGoesBack {
+                index,
+                previous: time[index - 1],
+                time: t,
+            });
+        }
+        if !v.is_finite() {
+            return Err(AnalysisError::NotFinite {
+                signal: signal.to_owned(),
+                index,
+                time: t,
+                value: v,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The Schmitt edges of `values` over `time` with thresholds `low < high`
+/// (see the module overview for the rules and the undetermined start).
+pub fn schmitt(
+    signal: &str,
+    time: &[f64],
+    values: &[f64],
+    low: f64,
+    high: f64,
+) -> Result<Schmitt, AnalysisError> {
+    if !(low.is_finite() && high.is_finite() && low < high) {
+        return Err(AnalysisError::Thresholds {
+            signal: signal.to_owned(),
+            low,
+            high,
+        });
+    }
+    check_samples(signal, time, values)?;
+    let level_of = |v: f64| {
+        if v >= high {
+            Level::High
+        } else if v <= low {
+            Level::Low
+        } else {
+            Level::Undetermined
+        }
+    };
+    let initial_state = level_of(values[0]);
+    let mut state = initial_state;
+    let mut edges: Vec<Edge> = Vec::new();
+    for k in 1..values.len() {
+        let v = values[k];
+        let (threshold, direction, next) = match state {
+            Level::Undetermined => {
+                // Defining the level is not an edge (module overview).
+                state = level_of(v);
+                continue;
+            }
+            Level::Low if v >= high => (high, Direction::Rising, Level::High),
+            Level::High if v <= low => (low, Direction::Falling, Level::Low),
+            _ => continue,
+        };
+        // The previous sample did not reach `threshold` (else the level
+        // would have changed there), so the denominator is not zero.
+        let (v0, t0, t1) = (values[k - 1], time[k - 1], time[k]);
+        let fraction = (threshold - v0) / (v - v0);
+        edges.push(Edge {
+            time: t0 + fraction * (t1 - t0),
+            direction,
+            width: None,
+        });
+        state = next;
+    }
+    for k in 1..edges.len() {
+        edges[k - 1].width = Some(edges[k].time - edges[k - 1].time);
+    }
+    Ok(Schmitt {
+        initial_state,
+        final_state: state,
+        edges,
+    })
+}
+
+/// Peak |i| and charge of a current, over the whole record and per closure
+/// (s, each `start <= end`). A closure partly outside the record is
+/// clipped to it; one wholly outside is an error.
+pub fn current(
+    signal: &str,
+    time: &[f64],
+    values: &[f64],
+    closures: &[(f64, f64)],
+) -> Result<CurrentAnalysis, AnalysisError> {
+    check_samples(signal, time, values)?;
+    let (first, last) = (time[0], time[time.len() - 1]);
+    let whole = window(time, values, first, last);
+    let mut per_closure = Vec::with_capacity(closures.len());
+    for (index, &(start, end)) in closures.iter().enumerate() {
+        if !(start.is_finite() && end.is_finite() && start <= end) {
+            return Err(AnalysisError::BadClosure {
+                signal: signal.to_owned(),
+                index,
+                start,
+                end,
+            });
+        }
+        if end < first || start > last {
+            return Err(AnalysisError::ClosureOutsideRecord {
+                signal: signal.to_owned(),
+                index,
+                start,
+                end,
+                record_start: first,
+                record_end: last,
+            });
+        }
+        let (start, end) = (start.max(first), end.min(last));
+        let w = window(time, values, start, end);
+        per_closure.push(ClosureCurrent {
+            start,
+            end,
+            peak: w.peak,
+            peak_time: w.peak_time,
+            charge: w.charge,
+        });
+    }
+    Ok(CurrentAnalysis {
+        peak: whole.peak,
+        peak_time: whole.peak_time,
+        charge: whole.charge,
+        closed_charge: per_closure.iter().map(|c| c.charge).sum(),
+        per_closure,
+    })
+}
+
+/// What the ideal contact's run says beside the bounced one (see
+/// [`Comparison`] for the signs). Both must analyse the same signal
+/// (ignoring case) with the same thresholds.
+pub fn compare(
+    bounced: &ProbeAnalysis,
+    ideal: &ProbeAnalysis,
+) -> Result<Comparison, AnalysisError> {
+    if !bounced.signal.eq_ignore_ascii_case(&ideal.signal)
+        || bounced.low != ideal.low
+        || bounced.high != ideal.high
+    {
+        return Err(AnalysisError::NotComparable {
+            bounced: bounced.signal.clone(),
+            ideal: ideal.signal.clone(),
+        });
+    }
+    let count = |n: usize| i64::try_from(n).unwrap_or(i64::MAX);
+    let settle_delay = match (bounced.last_edge, ideal.last_edge) {
+        (Some(b), Some(i)) => Some(b - i),
+        _ => None,
+    };
+    let both = |f: fn(&CurrentAnalysis) -> f64| match (&bounced.current, &ideal.current) {
+        (Some(b), Some(i)) => Some(f(b) - f(i)),
+        _ => None,
+    };
+    Ok(Comparison {
+        signal: bounced.signal.clone(),
+        extra_edges: count(bounced.edges) - count(ideal.edges),
+        extra_glitches: count(bounced.glitches) - count(ideal.glitches),
+        settle_delay,
+        same_final_state: bounced.final_state == ideal.final_state,
+        max_difference: bounced.max - ideal.max,
+        min_difference: bounced.min - ideal.min,
+        peak_difference: both(|c| c.peak),
+        charge_difference: both(|c| c.charge),
+    })
+}
+
+/// Peak |v| and ∫ v dt over a window.
+struct Window {
+    peak: f64,
+    peak_time: f64,
+    charge: f64,
+}
+
+/// The value at `t` on the straight lines between samples (the first of
+/// repeated instants; the end values outside the record).
+fn interpolate(time: &[f64], values: &[f64], t: f64) -> f64 {
+    let k = time.partition_point(|&x| x < t);
+    if k == 0 {
+        return values[0];
+    }
+    if k == time.len() {
+        return values[k - 1];
+    }
+    let (t0, t1, v0, v1) = (time[k - 1], time[k], values[k - 1], values[k]);
+    if t1 == t0 {
+        v1
+    } else {
+        v0 + (v1 - v0) * (t - t0) / (t1 - t0)
+    }
+}
+
+/// Peak |v| and trapezoid ∫ v dt over [a, b] inside the record, with the
+/// values at the ends interpolated: on straight lines the extremes are at
+/// samples or at the ends, so the peak is exact for the data.
+fn window(time: &[f64], values: &[f64], a: f64, b: f64) -> Window {
+    let inner_start = time.partition_point(|&x| x <= a);
+    let inner_end = time.partition_point(|&x| x < b).max(inner_start);
+    let ends = [(a, interpolate(time, values, a))];
+    let inner = time[inner_start..inner_end]
+        .iter()
+        .copied()
+        .zip(values[inner_start..inner_end].iter().copied());
+    let points = ends
+        .into_iter()
+        .chain(inner)
+        .chain([(b, interpolate(time, values, b))]);
+    let mut w = Window {
+        peak: f64::NEG_INFINITY,
+        peak_time: a,
+        charge: 0.0,
+    };
+    let mut previous: Option<(f64, f64)> = None;
+    for (t, v) in points {
+        if v.abs() > w.peak {
+            w.peak = v.abs();
+            w.peak_time = t;
+        }
+        if let Some((t0, v0)) = previous {
+            w.charge += 0.5 * (v + v0) * (t - t0);
+        }
+        previous = Some((t, v));
+    }
+    w
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn probe(signal: &str, low: f64, high: f64) -> Probe {
+        Probe {
+            signal: signal.to_owned(),
+            low,
+            high,
+        }
+    }
+
+    /// `n` points evenly spaced over [0, t_end].
+    fn grid(n: usize, t_end: f64) -> Vec<f64> {
+        (0..n).map(|k| t_end * k as f64 / (n - 1) as f64).collect()
+    }
+
+    /// A deterministic uniform sequence in [-1, 1) (64-bit LCG, Knuth's
+    /// constants), so the noise test needs no crate and never changes.
+    fn noise(seed: u64, n: usize) -> Vec<f64> {
+        let mut s = seed;
+        (0..n)
+            .map(|_| {
+                s = s
+                    .wrapping_mul(6_364_136_223_846_793_005)
+                    .wrapping_add(1_442_695_040_888_963_407);
+                (s >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+            })
+            .collect()
+    }
+
+    #[test]
+    fn square_wave_with_n_pulses_gives_two_n_edges() {
+        // 0 V, then N pulses of 3.3 V: samples every 1 µs, high from
+        // sample 100 + 100p to 139 + 100p. The steps fall between samples,
+        // so the interpolated crossing of 2.31 V (rising) or 0.99 V
+        // (falling) is 2.31/3.3 of the way from the sample before it.
+        const N: usize = 7;
+        let t = grid(1001, 1e-3);
+        let v: Vec<f64> = (0..t.len())
+            .map(|k| {
+                let high = (100..100 + 100 * N).contains(&k) && (k % 100) < 40;
+                if high { 3.3 } else { 0.0 }
+            })
+            .collect();
+        let a =
+            analyze_samples(&probe("v(in)", 0.99, 2.31), ProbeKind::Voltage, &t, &v, &[]).unwrap();
+        assert_eq!(a.edges, 2 * N);
+        assert_eq!(a.glitches, 2 * N - 1);
+        assert_eq!((a.initial_state, a.final_state), (Level::Low, Level::Low));
+        assert_eq!((a.min, a.max), (0.0, 3.3));
+        let fraction = 2.31 / 3.3;
+        for (k, e) in a.transitions.iter().enumerate() {
+            let (before, direction) = if k % 2 == 0 {
+                (99 + 50 * k, Direction::Rising)
+            } else {
+                (139 + 50 * (k - 1), Direction::Falling)
+            };
+            let expected = (before as f64 + fraction) * 1e-6;
+            assert_eq!(e.direction, direction, "edge {k}");
+            assert!((e.time - expected).abs() < 1e-15, "edge {k} at {}", e.time);
+        }
+        // Widths alternate 40 µs high and 60 µs low.
+        let widths: Vec<f64> = a.transitions.iter().filter_map(|e| e.width).collect();
+        assert_eq!(widths.len(), 2 * N - 1);
+        for (k, w) in widths.iter().enumerate() {
+            let expected = if k % 2 == 0 { 40e-6 } else { 60e-6 };
+            assert!((w - expected).abs() < 1e-15, "width {k}: {w}");
+        }
+        assert!((a.shortest_pulse.unwrap() - 40e-6).abs() < 1e-15);
+        assert_eq!(a.first_edge, Some(a.transitions[0].time));
+        assert_eq!(a.last_edge, Some(a.transitions[2 * N - 1].time));
+    }
+
+    #[test]
+    fn ringing_between_the_thresholds_gives_no_edge() {
+        // From 0 V to 1.65 V with a ±0.6 V decaying ring: it stays within
+        // [1.05, 2.25] V, between low = 0.99 V and high = 2.31 V.
+        let t = grid(20_001, 2e-3);
+        let v: Vec<f64> = t
+            .iter()
+            .map(|&t| {
+                if t < 1e-4 {
+                    0.0
+                } else {
+                    let s = t - 1e-4;
+                    1.65 + 0.6 * (-s / 5e-4).exp() * (2.0 * std::f64::consts::PI * 1e4 * s).sin()
+                }
+            })
+            .collect();
+        assert!(v.iter().all(|&x| x < 2.31));
+        assert!(v.iter().skip_while(|&&x| x == 0.0).all(|&x| x > 0.99));
+        let a =
+            analyze_samples(&probe("v(x)", 0.99, 2.31), ProbeKind::Voltage, &t, &v, &[]).unwrap();
+        assert_eq!((a.edges, a.glitches), (0, 0));
+        assert_eq!(
+            (a.first_edge, a.last_edge, a.shortest_pulse),
+            (None, None, None)
+        );
+        assert_eq!(a.final_state, Level::Low);
+    }
+
+    #[test]
+    fn noise_around_one_threshold_gives_one_edge() {
+        // A ramp to 2.31 V, then ±0.3 V of noise around 2.31 V for 10^4
+        // samples: it crosses `high` thousands of times but never reaches
+        // `low`, so the hysteresis keeps a single rising edge.
+        let n = 11_000;
+        let t = grid(n, 1.1e-2);
+        let jitter = noise(42, n);
+        let v: Vec<f64> = (0..n)
+            .map(|k| {
+                if k < 1000 {
+                    2.31 * k as f64 / 1000.0
+                } else {
+                    2.31 + 0.3 * jitter[k]
+                }
+            })
+            .collect();
+        let crossings = v
+            .windows(2)
+            .filter(|w| (w[0] < 2.31) != (w[1] < 2.31))
+            .count();
+        assert!(crossings > 1000, "{crossings}");
+        let s = schmitt("v(in)", &t, &v, 0.99, 2.31).unwrap();
+        assert_eq!(s.edges.len(), 1);
+        assert_eq!(s.edges[0].direction, Direction::Rising);
+        assert_eq!(s.edges[0].width, None);
+    }
+
+    #[test]
+    fn crossing_of_a_sampled_exponential_is_within_the_interpolation_error() {
+        // v = 1 − e^(−t/τ) crosses 0.5 at τ·ln 2. Linear interpolation of
+        // a concave curve crosses late, by at most Δt²·max|v''|/(8·min v')
+        // over the bracketing interval = Δt²/(8τ)·e^(Δt/τ).
+        let tau = 1e-3;
+        for dt in [1e-4, 3e-5, 1e-6] {
+            let n = (5.0 * tau / dt) as usize + 1;
+            let t: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
+            let v: Vec<f64> = t.iter().map(|&t| 1.0 - (-t / tau).exp()).collect();
+            let s = schmitt("v(out)", &t, &v, 0.2, 0.5).unwrap();
+            assert_eq!(s.edges.len(), 1);
+            let exact = tau * std::f64::consts::LN_2;
+            let bound = dt * dt / (8.0 * tau) * (dt / tau).exp();
+            let error = s.edges[0].time - exact;
+            assert!(
+                (-1e-15..=bound + 1e-15).contains(&error),
+                "Δt = {dt}: error {error:e}, bound {bound:e}"
+            );
+        }
+    }
+
+    #[test]
+    fn an_undetermined_start_becomes_a_level_without_an_edge() {
+        let t = [0.0, 1.0, 2.0, 3.0, 4.0];
+        // Starts at 1.5 V (between), reaches high: defined, not an edge;
+        // then falls through low: one falling edge at 3.5 s.
+        let v = [1.5, 2.0, 3.0, 3.0, 0.0];
+        let s = schmitt("v(a)", &t, &v, 1.0, 2.5).unwrap();
+        assert_eq!(s.initial_state, Level::Undetermined);
+        assert_eq!(s.final_state, Level::Low);
+        assert_eq!(s.edges.len(), 1);
+        assert_eq!(s.edges[0].direction, Direction::Falling);
+        assert!((s.edges[0].time - (3.0 + 2.0 / 3.0)).abs() < 1e-12);
+        // Never reaching a threshold leaves it undetermined.
+        let s = schmitt("v(a)", &t, &[1.5; 5], 1.0, 2.5).unwrap();
+        assert_eq!(s.final_state, Level::Undetermined);
+        assert!(s.edges.is_empty());
+    }
+
+    #[test]
+    fn a_start_on_a_threshold_is_that_level() {
+        let t = [0.0, 1.0, 2.0];
+        let s = schmitt("v(a)", &t, &[2.5, 1.0, 1.0], 1.0, 2.5).unwrap();
+        assert_eq!(s.initial_state, Level::High);
+        assert_eq!(s.edges.len(), 1);
+        assert_eq!(s.edges[0].time, 1.0);
+        // A step stored as two samples at one instant is an edge at it.
+        let s = schmitt(
+            "v(a)",
+            &[0.0, 1.0, 1.0, 2.0],
+            &[0.0, 0.0, 3.0, 3.0],
+            1.0,
+            2.5,
+        )
+        .unwrap();
+        assert_eq!(s.edges.len(), 1);
+        assert_eq!(s.edges[0].time, 1.0);
+    }
+
+    #[test]
+    fn charge_per_closure_of_exponential_pulses() {
+        // Two closures, each a current pulse i = I0·e^(−(t−ts)/τ) while
+        // closed and 0 when open: charge I0·τ·(1 − e^(−T/τ)) each, with T
+        // the closure's length. Sampled every 0.1 µs; the trapezoid's error
+        // is at most Δt²/12·T·max|i''| = Δt²·T·I0/(12τ²), plus the open
+        // edges, which are steps inside one sample interval (≤ I0·Δt/2).
+        let (i0, tau, dt) = (0.5, 2e-5, 1e-7);
+        let n = 5001;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
+        // On samples, so that each pulse's first value is I0 exactly.
+        let closures = [(t[1000], t[1800]), (t[3000], t[3200])];
+        let i: Vec<f64> = t
+            .iter()
+            .map(|&t| {
+                closures
+                    .iter()
+                    .find(|&&(a, b)| t >= a && t <= b)
+                    .map_or(0.0, |&(a, _)| i0 * (-(t - a) / tau).exp())
+            })
+            .collect();
+        let c = current("i(v1)", &t, &i, &closures).unwrap();
+        assert_eq!(c.per_closure.len(), 2);
+        let mut total = 0.0;
+        for (w, &(a, b)) in c.per_closure.iter().zip(&closures) {
+            let length = b - a;
+            let exact = i0 * tau * (1.0 - (-length / tau).exp());
+            let bound = dt * dt * length * i0 / (12.0 * tau * tau) + i0 * dt;
+            assert!(
+                (w.charge - exact).abs() <= bound,
+                "{} vs {exact}, bound {bound:e}",
+                w.charge
+            );
+            assert!((w.peak - i0).abs() < 1e-12, "{}", w.peak);
+            assert!((w.peak_time - a).abs() <= dt, "{}", w.peak_time);
+            assert_eq!((w.start, w.end), (a, b));
+            total += exact;
+        }
+        assert!((c.closed_charge - total).abs() < 2.0 * i0 * dt);
+        // Zero current outside the closures: the record's charge is theirs.
+        assert!((c.charge - total).abs() < 2.0 * i0 * dt);
+        assert!((c.peak - i0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn window_interpolates_its_ends() {
+        // A ramp i = t: ∫ from 0.25 to 2.5 of t dt = (2.5² − 0.25²)/2.
+        let t = [0.0, 1.0, 2.0, 3.0];
+        let c = current("i(x)", &t, &t, &[(0.25, 2.5), (1.5, 1.5), (2.5, 9.0)]).unwrap();
+        let q = c.per_closure[0];
+        assert!((q.charge - (2.5f64.powi(2) - 0.0625) / 2.0).abs() < 1e-12);
+        assert_eq!((q.peak, q.peak_time), (2.5, 2.5));
+        // A zero-length closure (rigid surface): no charge, the value then.
+        let q = c.per_closure[1];
+        assert_eq!((q.charge, q.peak), (0.0, 1.5));
+        // Clipped to the record's end.
+        let q = c.per_closure[2];
+        assert_eq!((q.start, q.end), (2.5, 3.0));
+        assert!((q.charge - (9.0 - 6.25) / 2.0).abs() < 1e-12);
+        assert_eq!(c.charge, 4.5);
+    }
+
+    #[test]
+    fn a_voltage_has_no_current_analysis_and_a_current_has_one() {
+        let t = [0.0, 1.0];
+        let p = probe("i(v1)", -1.0, 1.0);
+        let a = analyze_samples(&p, ProbeKind::Current, &t, &[0.0, -2.0], &[(0.0, 1.0)]).unwrap();
+        let c = a.current.unwrap();
+        assert_eq!((c.peak, c.peak_time, c.charge), (2.0, 1.0, -1.0));
+        let a = analyze_samples(&p, ProbeKind::Voltage, &t, &[0.0, -2.0], &[]).unwrap();
+        assert_eq!(a.current, None);
+    }
+
+    #[test]
+    fn comparison_is_bounced_minus_ideal() {
+        let t = grid(1001, 1e-3);
+        let p = probe("i(v1)", 0.1, 0.2);
+        // Ideal: one make at 100 µs to 0.3 A. Bounced: two short closures
+        // to 0.4 A first, final make at 300 µs.
+        let ideal: Vec<f64> = t
+            .iter()
+            .map(|&t| if t >= 1e-4 { 0.3 } else { 0.0 })
+            .collect();
+        let bounced: Vec<f64> = t
+            .iter()
+            .map(|&t| match t {
+                t if (1e-4..1.2e-4).contains(&t) || (2e-4..2.1e-4).contains(&t) => 0.4,
+                t if t >= 3e-4 => 0.3,
+                _ => 0.0,
+            })
+            .collect();
+        let kind = ProbeKind::Current;
+        let i = analyze_samples(&p, kind, &t, &ideal, &[(1e-4, 1e-3)]).unwrap();
+        let b = analyze_samples(&p, kind, &t, &bounced, &[(1e-4, 1e-3)]).unwrap();
+        assert_eq!((i.edges, b.edges), (1, 5));
+        let c = compare(&b, &i).unwrap();
+        assert_eq!((c.extra_edges, c.extra_glitches), (4, 4));
+        assert!(c.same_final_state);
+        let delay = c.settle_delay.unwrap();
+        assert!((delay - 2e-4).abs() < 1e-6 + 1e-12, "{delay}");
+        assert!((c.max_difference - 0.1).abs() < 1e-12);
+        assert_eq!(c.min_difference, 0.0);
+        assert!((c.peak_difference.unwrap() - 0.1).abs() < 1e-12);
+        // Less charge: 200 µs late at 0.3 A, partly made up by 30 µs at 0.4 A.
+        let expected = -2e-4 * 0.3 + 3e-5 * 0.4;
+        assert!((c.charge_difference.unwrap() - expected).abs() < 3e-6 * 0.4);
+        // And the other way round, the signs flip.
+        let r = compare(&i, &b).unwrap();
+        assert_eq!(r.extra_edges, -4);
+        let other = analyze_samples(&probe("v(x)", 0.1, 0.2), kind, &t, &ideal, &[]).unwrap();
+        assert!(matches!(
+            compare(&b, &other),
+            Err(AnalysisError::NotComparable { .. })
+        ));
+    }
+
+    #[test]
+    fn classify_by_name_then_raw_type() {
+        use ProbeKind::*;
+        assert_eq!(ProbeKind::classify("v(in)", None), Voltage);
+        assert_eq!(ProbeKind::classify("V(a,b)", Some("current")), Voltage);
+        assert_eq!(ProbeKind::classify("i(v1)", None), Current);
+        assert_eq!(ProbeKind::classify("@r1[i]", None), Current);
+        assert_eq!(ProbeKind::classify("v1#branch", Some("current")), Current);
+        assert_eq!(ProbeKind::classify("out", Some("voltage")), Voltage);
+        assert_eq!(ProbeKind::classify("@m1[gm]", Some("notype")), Other);
+        assert_eq!(ProbeKind::classify("x", None), Other);
+        assert_eq!(
+            (Voltage.unit(), Current.unit(), Other.unit()),
+            ("V", "A", "")
+        );
+    }
+
+    #[test]
+    fn bad_input_is_named() {
+        let t = [0.0, 1e-3, 2e-3];
+        let err = schmitt("v(in)", &t, &[0.0, f64::NAN, 1.0], 1.0, 2.0).unwrap_err();
+        assert!(
+            matches!(err, AnalysisError::NotFinite { index: 1, time, value, .. }
+                if time == 1e-3 && value.is_nan()),
+            "{err:?}"
+        );
+        let msg = err.to_string();
+        assert!(
+            msg.contains("v(in)") && msg.contains("NaN") && msg.contains("1e-3"),
+            "{msg}"
+        );
+        let err = schmitt("v(in)", &[0.0, f64::NAN], &[0.0, 1.0], 1.0, 2.0).unwrap_err();
+        assert!(matches!(err, AnalysisError::NotFinite { ref signal, .. } if signal == "time"));
+        for (low, high) in [
+            (2.0, 1.0),
+            (1.0, 1.0),
+            (f64::NAN, 1.0),
+            (0.0, f64::INFINITY),
+        ] {
+            let err = schmitt("v(q)", &t, &[0.0; 3], low, high).unwrap_err();
+            assert!(matches!(err, AnalysisError::Thresholds { .. }), "{err}");
+            assert!(err.to_string().contains("v(q)"), "{err}");
+        }
+        let err = schmitt("v(in)", &[], &[], 1.0, 2.0).unwrap_err();
+        assert!(matches!(err, AnalysisError::Empty { .. }), "{err}");
+        let err = schmitt("v(in)", &t, &[0.0; 2], 1.0, 2.0).unwrap_err();
+        assert!(matches!(
+            err,
+            AnalysisError::LengthMismatch {
+                time: 3,
+                values: 2,
+                ..
+            }
+        ));
+        let err = schmitt("v(in)", &[0.0, 2.0, 1.0], &[0.0; 3], 1.0, 2.0).unwrap_err();
+        assert!(
+            matches!(err, AnalysisError::TimeGoesBack { index: 2, .. }),
+            "{err}"
+        );
+        for bad in [(2e-3, 1e-3), (f64::NAN, 1e-3)] {
+            let err = current("i(v1)", &t, &[0.0; 3], &[bad]).unwrap_err();
+            assert!(
+                matches!(err, AnalysisError::BadClosure { index: 0, .. }),
+                "{err}"
+            );
+        }
+        let err = current("i(v1)", &t, &[0.0; 3], &[(0.0, 1e-3), (3e-3, 4e-3)]).unwrap_err();
+        assert!(
+            matches!(err, AnalysisError::ClosureOutsideRecord { index: 1, .. }),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn json_starts_with_the_contract_fields() {
+        let a = analyze_samples(
+            &probe("v(in)", 1.0, 2.0),
+            ProbeKind::Voltage,
+            &[0.0, 1.0, 2.0],
+            &[3.0, 0.0, 3.0],
+            &[],
+        )
+        .unwrap();
+        let json = serde_json::to_string(&a).unwrap();
+        assert!(
+            json.starts_with(r#"{"signal":"v(in)","edges":2,"glitches":1,"first_edge":"#),
+            "{json}"
+        );
+        let at = |key: &str| json.find(&format!("\"{key}\":")).unwrap();
+        let order = ["first_edge", "last_edge", "min", "max", "kind"].map(at);
+        assert!(order.windows(2).all(|w| w[0] < w[1]), "{json}");
+        assert!(json.contains(r#""current":null"#), "{json}");
+        assert!(json.contains(r#""direction":"falling""#), "{json}");
+    }
+
+    #[test]
+    fn closures_are_the_closed_intervals() {
+        let chatter = crate::report::fixtures::stuck();
+        assert_eq!(
+            closures(&chatter),
+            vec![(0.0012, 0.00121), (0.0014, 0.001405), (0.0016, 0.02)]
+        );
+    }
+}
