@@ -44,6 +44,8 @@
 //! single clean make at the first impact and reports what the bounce
 //! added. Every difference is *bounced − ideal*.
 
+use std::borrow::Cow;
+
 use serde::Serialize;
 use thiserror::Error;
 
@@ -345,26 +347,69 @@ pub fn analyze(
             });
         }
     };
-    let Some(index) = plot.index_of(&probe.signal) else {
+    let (values, raw_type) = signal_values(plot, &probe.signal)?;
+    let kind = ProbeKind::classify(&probe.signal, raw_type.as_deref());
+    analyze_samples(probe, kind, time, &values, closures)
+}
+
+/// The samples of `signal` in `plot`, and the raw file's type for it. A
+/// vector ngspice wrote is used as it is; a differential voltage
+/// `v(a,b)`, which ngspice's raw files never hold, is computed as
+/// v(a) − v(b) (node `0` being ground).
+pub fn signal_values<'p>(
+    plot: &'p Plot,
+    signal: &str,
+) -> Result<(Cow<'p, [f64]>, Option<String>), AnalysisError> {
+    let missing = || {
         let mut available: Vec<String> = plot.variables.iter().map(|v| v.name.clone()).collect();
         available.sort();
-        return Err(AnalysisError::MissingSignal {
-            signal: probe.signal.clone(),
+        AnalysisError::MissingSignal {
+            signal: signal.to_owned(),
             plot: plot.name.clone(),
             available,
-        });
-    };
-    let values = match plot.vector(index) {
-        Some(Vector::Real(v)) => v,
-        _ => {
-            return Err(AnalysisError::ComplexSignal {
-                signal: probe.signal.clone(),
-                plot: plot.name.clone(),
-            });
         }
     };
-    let kind = ProbeKind::classify(&probe.signal, Some(&plot.variables[index].kind));
-    analyze_samples(probe, kind, time, values, closures)
+    let real = |index: usize| match plot.vector(index) {
+        Some(Vector::Real(v)) => Ok(v),
+        _ => Err(AnalysisError::ComplexSignal {
+            signal: signal.to_owned(),
+            plot: plot.name.clone(),
+        }),
+    };
+    if let Some(index) = plot.index_of(signal) {
+        let kind = plot.variables[index].kind.clone();
+        return Ok((Cow::Borrowed(real(index)?), Some(kind)));
+    }
+    let Some((a, b)) = differential_nodes(signal) else {
+        return Err(missing());
+    };
+    let node = |name: &str| -> Result<Option<&'p [f64]>, AnalysisError> {
+        if name == "0" {
+            return Ok(None);
+        }
+        let index = plot.index_of(&format!("v({name})")).ok_or_else(missing)?;
+        real(index).map(Some)
+    };
+    let values = match (node(a)?, node(b)?) {
+        (Some(va), Some(vb)) => va.iter().zip(vb).map(|(x, y)| x - y).collect(),
+        (Some(va), None) => va.to_vec(),
+        (None, Some(vb)) => vb.iter().map(|y| -y).collect(),
+        (None, None) => vec![0.0; plot.points()],
+    };
+    Ok((Cow::Owned(values), Some("voltage".to_owned())))
+}
+
+/// `v(a,b)` → `("a", "b")`, spaces allowed, case kept.
+fn differential_nodes(signal: &str) -> Option<(&str, &str)> {
+    let inner = signal
+        .trim()
+        .strip_prefix(['v', 'V'])?
+        .trim_start()
+        .strip_prefix('(')?
+        .strip_suffix(')')?;
+    let (a, b) = inner.split_once(',')?;
+    let (a, b) = (a.trim(), b.trim());
+    (!a.is_empty() && !b.is_empty()).then_some((a, b))
 }
 
 /// Analyse sampled data: `time` (s, non-decreasing) and `values` of

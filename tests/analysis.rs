@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use chatterspice::analysis::{
-    AnalysisError, Direction, Level, ProbeKind, analyze, compare, schmitt,
+    AnalysisError, Direction, Level, ProbeKind, analyze, compare, schmitt, signal_values,
 };
 use chatterspice::rawfile::{Plot, RawFile};
 use chatterspice::scenario::Probe;
@@ -187,4 +187,39 @@ fn a_killed_run_analyses_what_was_written() {
     assert_eq!(a.final_value, *out.last().unwrap());
     let direct = schmitt("v(out)", time, out, 0.2, 0.8).unwrap();
     assert_eq!(direct.edges, a.transitions);
+}
+
+#[test]
+fn a_differential_voltage_is_the_difference_of_its_nodes() {
+    let raw = read("rc_tran.raw");
+    let plot = transient(&raw);
+    let v_in = plot.real("v(in)").unwrap();
+    let v_out = plot.real("v(out)").unwrap();
+    // Across the resistor: the same as the capacitor's current times R.
+    let (across, kind) = signal_values(plot, "v(in, out)").unwrap();
+    assert_eq!(kind.as_deref(), Some("voltage"));
+    assert_eq!(across.len(), v_in.len());
+    for ((d, a), b) in across.iter().zip(v_in).zip(v_out) {
+        assert_eq!(*d, a - b);
+    }
+    let (to_ground, _) = signal_values(plot, "V(out,0)").unwrap();
+    assert_eq!(&*to_ground, v_out);
+    let (reversed, _) = signal_values(plot, "v(0,out)").unwrap();
+    assert!(reversed.iter().zip(v_out).all(|(r, v)| *r == -v));
+
+    let peak = analyze(plot, &probe("v(in,out)", 0.2, 0.8), &[]).unwrap();
+    assert!(
+        (peak.max
+            - v_in
+                .iter()
+                .zip(v_out)
+                .map(|(a, b)| a - b)
+                .fold(f64::MIN, f64::max))
+        .abs()
+            < 1e-15
+    );
+    assert!(matches!(
+        signal_values(plot, "v(in,nowhere)"),
+        Err(AnalysisError::MissingSignal { .. })
+    ));
 }
