@@ -5,7 +5,8 @@
 //! - [`json`]: the contract of `interfaces.md` §3, for scripts;
 //! - [`csv`]: one row per impact, for spreadsheets and plotting;
 //! - [`table`]: a summary and an aligned impact table, for a person at a
-//!   terminal, in engineering units.
+//!   terminal, in engineering units;
+//! - [`svg`]: a plot of the contact and the probed signals over time.
 //!
 //! Output is deterministic: the same result gives byte-identical text (no
 //! timestamps, fixed field order, shortest round-trip floats).
@@ -15,6 +16,7 @@ pub mod csv;
 pub mod json;
 pub mod svg;
 pub mod table;
+mod units;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -170,8 +172,14 @@ mod tests {
         std::fs::write(out.join("plot.svg"), "mine").unwrap();
         let err = write_bundle(&out, &files, false).unwrap_err();
         assert!(err.to_string().contains("plot.svg"), "{err}");
-        assert!(!out.join("report.json").exists(), "wrote part of the bundle");
-        assert_eq!(std::fs::read_to_string(out.join("plot.svg")).unwrap(), "mine");
+        assert!(
+            !out.join("report.json").exists(),
+            "wrote part of the bundle"
+        );
+        assert_eq!(
+            std::fs::read_to_string(out.join("plot.svg")).unwrap(),
+            "mine"
+        );
 
         write_bundle(&out, &files, true).unwrap();
         assert_eq!(std::fs::read(out.join("report.json")).unwrap(), b"{}");

@@ -1,0 +1,47 @@
+//! Engineering notation shared by the reports: three significant digits
+//! and an SI prefix, so that "12.5 µs" and "3.3 V" read without exponents.
+
+/// The SI prefix of 10^exponent (a multiple of 3 within ±15).
+pub(crate) fn prefix(exponent: i32) -> &'static str {
+    match exponent {
+        -15 => "f",
+        -12 => "p",
+        -9 => "n",
+        -6 => "µ",
+        -3 => "m",
+        3 => "k",
+        6 => "M",
+        9 => "G",
+        12 => "T",
+        _ => "",
+    }
+}
+
+/// `value` with three significant digits and an SI prefix: "12.5 µs".
+pub(crate) fn engineering(value: f64, unit: &str) -> String {
+    if value == 0.0 || !value.is_finite() {
+        return format!("0 {unit}");
+    }
+    let exponent = (3.0 * (value.abs().log10() / 3.0).floor()).clamp(-15.0, 12.0) as i32;
+    significant(value, exponent, unit)
+}
+
+/// `value` in units of 10^`exponent` (an SI prefix) with three
+/// significant digits, trailing zeros dropped: "1 kΩ", not "1.00 kΩ".
+pub(crate) fn significant(value: f64, exponent: i32, unit: &str) -> String {
+    let scaled = value / 10f64.powi(exponent);
+    let magnitude = if scaled == 0.0 {
+        0
+    } else {
+        scaled.abs().log10().floor() as i32
+    };
+    let decimals = (2 - magnitude).clamp(0, 15) as usize;
+    let mut text = format!("{scaled:.decimals$}");
+    if text.contains('.') {
+        text = text.trim_end_matches('0').trim_end_matches('.').to_owned();
+    }
+    if text == "-0" {
+        text = "0".to_owned();
+    }
+    format!("{text} {}{unit}", prefix(exponent))
+}
