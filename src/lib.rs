@@ -11,6 +11,7 @@
 
 pub mod chatter;
 pub mod mechanics;
+pub mod netlist;
 pub mod rawfile;
 pub mod report;
 pub mod scenario;
