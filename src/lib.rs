@@ -12,6 +12,7 @@
 pub mod analysis;
 pub mod chatter;
 pub mod mechanics;
+pub mod netlist;
 pub mod rawfile;
 pub mod report;
 pub mod scenario;

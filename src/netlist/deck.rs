@@ -1,0 +1,940 @@
+//! The run deck: the user's netlist, read and never written, with what the
+//! run needs around it.
+//!
+//! ngspice reads a deck as *cards*: the first line is always the title
+//! (whatever it says: a `.include` there is silently lost), a line starting
+//! with `+` continues the card before it (comment and blank lines in
+//! between do not interrupt it), `*` starts a comment line, `;` and a `$`
+//! after whitespace start an inline comment, and names and keywords are
+//! case-insensitive. CRLF endings and tabs are accepted.
+//!
+//! [`prepare_deck`] copies the netlist line by line and changes only this:
+//! - `.include <contact include>` right after the title;
+//! - relative paths in `.include`/`.inc`/`.lib` become absolute, resolved
+//!   against the netlist's directory (the deck runs from a temporary work
+//!   directory); a missing file is an error naming the line;
+//! - `.control` … `.endc` blocks are left out, with a warning. In batch mode
+//!   (`ngspice -b -r out.raw`) the runner owns the analysis and the raw
+//!   file; a control block would run its own `tran` a second time, `write`
+//!   elsewhere, or `quit` before the raw file exists;
+//! - when the netlist has `.save` lines (then ngspice saves only what they
+//!   name), a `.save` for each probe's vectors;
+//! - `.end` and anything after it are dropped, and one `.end` closes the deck;
+//! - with [`DeckRequest::max_step`], a `.tran` whose TMAX is coarser gets
+//!   that TMAX (elements without breakpoints need it).
+//!
+//! It checks that some `X` card instantiates the contact subcircuit (in the
+//! netlist or, failing that, in the files it includes), that the netlist
+//! does not define a subcircuit of that name itself, and that there is one
+//! `.tran` whose stop time covers the chatter.
+
+use std::collections::HashSet;
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use super::NetlistError;
+use super::number::parse_number;
+use crate::waveform::format_time;
+
+/// How deep [`prepare_deck`] follows `.include`s looking for the contact's
+/// `X` line: enough for any real project, and a guard against cycles.
+const MAX_INCLUDE_DEPTH: usize = 8;
+
+/// What to build a run deck from.
+#[derive(Debug, Clone, Copy)]
+pub struct DeckRequest<'a> {
+    /// The netlist's text.
+    pub netlist_text: &'a str,
+    /// Where it was read from: the base of relative include paths, and the
+    /// name in messages.
+    pub netlist_path: &'a Path,
+    /// The contact include's plain file name, written next to the deck.
+    pub include_file_name: &'a str,
+    /// The contact subcircuit's name, e.g. `CONTACT`.
+    pub subckt: &'a str,
+    /// ngspice vector names to measure: `v(node)`, `v(a,b)`, `i(vsource)`.
+    pub probes: &'a [&'a str],
+    /// s, when the chatter ends: a `.tran` that stops earlier is an error.
+    pub chatter_end: f64,
+    /// s, the stop time the caller wants (chatter end plus a margin): a
+    /// `.tran` that stops earlier is a warning.
+    pub stop_at_least: f64,
+    /// s, the largest internal time step the contact element tolerates
+    /// ([`ContactInclude::max_step`](super::ContactInclude::max_step)).
+    pub max_step: Option<f64>,
+}
+
+/// The run deck and what was noticed on the way.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Deck {
+    /// Title line first, `.end` last, `\n` line endings.
+    pub text: String,
+    pub warnings: Vec<DeckWarning>,
+    /// The analysis the deck runs, as it is in the deck.
+    pub tran: Tran,
+}
+
+/// A `.tran tstep tstop [tstart [tmax]] [uic]` card. SI units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tran {
+    /// s
+    pub tstep: f64,
+    /// s
+    pub tstop: f64,
+    /// s, 0 when not given.
+    pub tstart: f64,
+    /// s, when given.
+    pub tmax: Option<f64>,
+    pub uic: bool,
+    /// 1-based line in the netlist.
+    pub line: usize,
+}
+
+impl Tran {
+    /// s, the largest step ngspice takes: TMAX, or by default
+    /// min(tstep, (tstop − tstart)/50).
+    pub fn effective_max_step(&self) -> f64 {
+        self.tmax
+            .unwrap_or_else(|| self.tstep.min((self.tstop - self.tstart) / 50.0))
+    }
+
+    fn card(&self) -> String {
+        let mut s = format!(
+            ".tran {} {} {}",
+            format_time(self.tstep),
+            format_time(self.tstop),
+            format_time(self.tstart)
+        );
+        if let Some(m) = self.tmax {
+            s.push(' ');
+            s.push_str(&format_time(m));
+        }
+        if self.uic {
+            s.push_str(" uic");
+        }
+        s
+    }
+}
+
+/// Something the deck changed or the user may want to change.
+#[derive(Debug, Clone, PartialEq)]
+pub enum DeckWarning {
+    ControlRemoved {
+        netlist: PathBuf,
+        first: usize,
+        last: usize,
+    },
+    IgnoredAfterEnd {
+        netlist: PathBuf,
+        line: usize,
+    },
+    StopShort {
+        netlist: PathBuf,
+        line: usize,
+        /// s
+        tstop: f64,
+        /// s
+        tstep: f64,
+        /// s
+        wanted: f64,
+    },
+    MaxStepSet {
+        netlist: PathBuf,
+        line: usize,
+        /// s, the step the netlist's `.tran` allowed.
+        from: f64,
+        /// s, the TMAX the deck uses.
+        to: f64,
+    },
+    TitleIsCard {
+        netlist: PathBuf,
+        text: String,
+    },
+}
+
+impl fmt::Display for DeckWarning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            DeckWarning::ControlRemoved {
+                netlist,
+                first,
+                last,
+            } => write!(
+                f,
+                "{}: lines {first}-{last}: the `.control` block is left out of the run: \
+                 chatterspice runs the netlist's dot-analyses in batch mode and writes the raw \
+                 file itself (the block's commands would run a second analysis, write elsewhere \
+                 or quit first); move what it sets into dot-cards such as `.options`",
+                netlist.display()
+            ),
+            DeckWarning::IgnoredAfterEnd { netlist, line } => write!(
+                f,
+                "{}: line {line}: text after `.end` is ignored, as ngspice does",
+                netlist.display()
+            ),
+            DeckWarning::StopShort {
+                netlist,
+                line,
+                tstop,
+                tstep,
+                wanted,
+            } => write!(
+                f,
+                "{}: line {line}: `.tran` stops at {} s, soon after the chatter: to see the \
+                 circuit settle, use `.tran {} {}`",
+                netlist.display(),
+                format_time(*tstop),
+                format_time(*tstep),
+                format_time(*wanted)
+            ),
+            DeckWarning::MaxStepSet {
+                netlist,
+                line,
+                from,
+                to,
+            } => write!(
+                f,
+                "{}: line {line}: the run uses a `.tran` TMAX of {} s instead of {} s: the \
+                 contact element sets no breakpoints and would step over short openings",
+                netlist.display(),
+                format_time(*to),
+                format_time(*from)
+            ),
+            DeckWarning::TitleIsCard { netlist, text } => write!(
+                f,
+                "{}: line 1 `{text}` is read by ngspice as the title and ignored: put a title \
+                 line first",
+                netlist.display()
+            ),
+        }
+    }
+}
+
+/// One card: its physical lines and its text with continuations joined
+/// and comments removed.
+struct Card {
+    /// 0-based index of the first physical line.
+    first: usize,
+    /// 0-based index of the last physical line.
+    last: usize,
+    text: String,
+}
+
+impl Card {
+    fn line(&self) -> usize {
+        self.first + 1
+    }
+
+    fn keyword(&self) -> String {
+        self.text
+            .split_whitespace()
+            .next()
+            .unwrap_or("")
+            .to_ascii_lowercase()
+    }
+}
+
+/// What happens to a physical line of the netlist in the deck.
+enum Fate {
+    Keep,
+    Drop,
+    Replace(String),
+}
+
+/// Build the run deck around the user's netlist (see the module overview).
+pub fn prepare_deck(req: &DeckRequest<'_>) -> Result<Deck, NetlistError> {
+    let netlist = req.netlist_path.to_path_buf();
+    let base = req
+        .netlist_path
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_default();
+    let mut save_lines: Vec<String> = Vec::new();
+    for probe in req.probes {
+        save_lines.extend(save_names(probe)?);
+    }
+
+    let lines = physical_lines(req.netlist_text);
+    if lines.iter().all(|l| l.trim().is_empty()) {
+        return Err(NetlistError::EmptyNetlist { netlist });
+    }
+    let mut warnings = Vec::new();
+    let title = lines[0];
+    let title_word = title.split_whitespace().next().unwrap_or("");
+    if title_word.starts_with('.') && !title_word.eq_ignore_ascii_case(".title") {
+        warnings.push(DeckWarning::TitleIsCard {
+            netlist: netlist.clone(),
+            text: title.trim().to_owned(),
+        });
+    }
+
+    let mut fates: Vec<Fate> = (0..lines.len()).map(|_| Fate::Keep).collect();
+    fates[0] = Fate::Keep;
+    // Control blocks and `.end` first: cards are only read outside them.
+    let mut live = vec![true; lines.len()];
+    live[0] = false;
+    let mut control_line = None;
+    let mut i = 1;
+    while i < lines.len() {
+        let word = first_word(lines[i]);
+        if word == ".control" {
+            let start = i;
+            let end = (i + 1..lines.len())
+                .find(|&j| first_word(lines[j]) == ".endc")
+                .ok_or(NetlistError::UnclosedControl {
+                    netlist: netlist.clone(),
+                    line: start + 1,
+                })?;
+            for j in start..=end {
+                live[j] = false;
+                fates[j] = Fate::Drop;
+            }
+            control_line.get_or_insert(start + 1);
+            warnings.push(DeckWarning::ControlRemoved {
+                netlist: netlist.clone(),
+                first: start + 1,
+                last: end + 1,
+            });
+            i = end + 1;
+            continue;
+        }
+        if word == ".end" {
+            for j in i..lines.len() {
+                live[j] = false;
+                fates[j] = Fate::Drop;
+            }
+            if let Some(j) = (i + 1..lines.len()).find(|&j| !is_blank_or_comment(lines[j])) {
+                warnings.push(DeckWarning::IgnoredAfterEnd {
+                    netlist: netlist.clone(),
+                    line: j + 1,
+                });
+            }
+            break;
+        }
+        i += 1;
+    }
+
+    let cards = cards(&lines, &live);
+    let mut instances = 0;
+    let mut has_save = false;
+    let mut tran: Option<(Tran, String)> = None;
+    let mut includes: Vec<(usize, PathBuf)> = Vec::new();
+    for card in &cards {
+        let keyword = card.keyword();
+        match keyword.as_str() {
+            ".include" | ".inc" | ".lib" => {
+                if let Some((rewritten, path)) = resolve_include(card, &keyword, &base, &netlist)? {
+                    replace(&mut fates, card, rewritten);
+                    includes.push((card.line(), path));
+                }
+            }
+            ".save" => has_save = true,
+            ".subckt" => {
+                let name = card.text.split_whitespace().nth(1).unwrap_or("");
+                if name.eq_ignore_ascii_case(req.subckt) {
+                    return Err(NetlistError::SubcktConflict {
+                        netlist,
+                        line: card.line(),
+                        subckt: req.subckt.to_owned(),
+                    });
+                }
+            }
+            ".tran" => {
+                if let Some((first, _)) = &tran {
+                    return Err(NetlistError::TwoTran {
+                        netlist,
+                        first: first.line,
+                        second: card.line(),
+                    });
+                }
+                tran = Some((parse_tran(card, &netlist)?, card.text.clone()));
+            }
+            _ => {
+                if instantiates(&card.text, req.subckt) {
+                    instances += 1;
+                }
+            }
+        }
+    }
+
+    if instances == 0 {
+        let mut seen = HashSet::new();
+        let found = includes.iter().try_fold(false, |found, (line, path)| {
+            if found {
+                return Ok(true);
+            }
+            include_instantiates(path, req.subckt, &netlist, *line, 1, &mut seen)
+        })?;
+        if !found {
+            return Err(NetlistError::NoContactInstance {
+                netlist,
+                subckt: req.subckt.to_owned(),
+            });
+        }
+    }
+
+    let Some((mut tran, _)) = tran else {
+        return Err(NetlistError::NoTran {
+            netlist,
+            stop: req.stop_at_least,
+            control_line,
+        });
+    };
+    if tran.tstop < req.chatter_end {
+        return Err(NetlistError::TranTooShort {
+            netlist,
+            line: tran.line,
+            tstop: tran.tstop,
+            tstep: tran.tstep,
+            chatter_end: req.chatter_end,
+            stop: req.stop_at_least.max(req.chatter_end),
+        });
+    }
+    if tran.tstop < req.stop_at_least {
+        warnings.push(DeckWarning::StopShort {
+            netlist: netlist.clone(),
+            line: tran.line,
+            tstop: tran.tstop,
+            tstep: tran.tstep,
+            wanted: req.stop_at_least,
+        });
+    }
+    if let Some(max_step) = req.max_step {
+        let from = tran.effective_max_step();
+        if from > max_step {
+            tran.tmax = Some(max_step);
+            let card = cards
+                .iter()
+                .find(|c| c.line() == tran.line)
+                .expect("the .tran card was read from the cards");
+            replace(&mut fates, card, tran.card());
+            warnings.push(DeckWarning::MaxStepSet {
+                netlist: netlist.clone(),
+                line: tran.line,
+                from,
+                to: max_step,
+            });
+        }
+    }
+
+    let mut text = String::new();
+    text.push_str(title);
+    text.push('\n');
+    text.push_str(&format!(
+        "* chatterspice run deck for {}; that file is not modified\n",
+        req.netlist_path.display()
+    ));
+    text.push_str(&format!(
+        ".include {}\n",
+        quote_if_needed(req.include_file_name)
+    ));
+    for (line, fate) in lines.iter().zip(&fates).skip(1) {
+        match fate {
+            Fate::Keep => {
+                text.push_str(line);
+                text.push('\n');
+            }
+            Fate::Drop => {}
+            Fate::Replace(new) => {
+                text.push_str(new);
+                text.push('\n');
+            }
+        }
+    }
+    if has_save && !save_lines.is_empty() {
+        text.push_str("* chatterspice: the probes\n");
+        text.push_str(&format!(".save {}\n", save_lines.join(" ")));
+    }
+    text.push_str(".end\n");
+    Ok(Deck {
+        text,
+        warnings,
+        tran,
+    })
+}
+
+/// The vectors a probe needs saved: `v(a,b)` needs both nodes (ground
+/// needs none).
+pub fn save_names(signal: &str) -> Result<Vec<String>, NetlistError> {
+    let bad = || NetlistError::BadProbe {
+        signal: signal.to_owned(),
+    };
+    let s = signal.trim();
+    let open = s.find('(').ok_or_else(bad)?;
+    let kind = s[..open].trim().to_ascii_lowercase();
+    let inner = s[open + 1..].strip_suffix(')').ok_or_else(bad)?;
+    let args: Vec<&str> = inner.split(',').map(str::trim).collect();
+    if args
+        .iter()
+        .any(|a| a.is_empty() || a.contains(|c: char| c.is_whitespace() || "()".contains(c)))
+    {
+        return Err(bad());
+    }
+    match (kind.as_str(), args.len()) {
+        ("v", 1 | 2) => Ok(args
+            .iter()
+            .filter(|a| !matches!(a.to_ascii_lowercase().as_str(), "0" | "gnd"))
+            .map(|a| format!("v({a})"))
+            .collect()),
+        ("i", 1) => Ok(vec![format!("i({})", args[0])]),
+        _ => Err(bad()),
+    }
+}
+
+/// Lines without their `\r`; a final newline does not make an extra line.
+fn physical_lines(text: &str) -> Vec<&str> {
+    let mut lines: Vec<&str> = text
+        .split('\n')
+        .map(|l| l.strip_suffix('\r').unwrap_or(l))
+        .collect();
+    if lines.len() > 1 && lines[lines.len() - 1].is_empty() {
+        lines.pop();
+    }
+    lines
+}
+
+fn first_word(line: &str) -> String {
+    strip_comment(line)
+        .split_whitespace()
+        .next()
+        .unwrap_or("")
+        .to_ascii_lowercase()
+}
+
+fn is_blank_or_comment(line: &str) -> bool {
+    let t = line.trim_start();
+    t.is_empty() || t.starts_with('*')
+}
+
+/// The line without its inline comment (`;` anywhere, `$` after
+/// whitespace), and without a whole-line `*` comment.
+fn strip_comment(line: &str) -> &str {
+    if line.trim_start().starts_with('*') {
+        return "";
+    }
+    let mut prev_space = true;
+    for (i, c) in line.char_indices() {
+        if c == ';' || (c == '$' && prev_space) {
+            return &line[..i];
+        }
+        prev_space = c.is_whitespace();
+    }
+    line
+}
+
+/// The cards among the live lines: `+` lines join the card before them,
+/// across comment and blank lines.
+fn cards(lines: &[&str], live: &[bool]) -> Vec<Card> {
+    let mut out: Vec<Card> = Vec::new();
+    for (i, line) in lines.iter().enumerate() {
+        if !live[i] || is_blank_or_comment(line) {
+            continue;
+        }
+        let text = strip_comment(line).trim();
+        if let Some(rest) = text.strip_prefix('+') {
+            if let Some(card) = out.last_mut() {
+                card.text.push(' ');
+                card.text.push_str(rest.trim());
+                card.last = i;
+                continue;
+            }
+        }
+        if !text.is_empty() {
+            out.push(Card {
+                first: i,
+                last: i,
+                text: text.to_owned(),
+            });
+        }
+    }
+    out
+}
+
+fn replace(fates: &mut [Fate], card: &Card, text: String) {
+    fates[card.first] = Fate::Replace(text);
+    for fate in &mut fates[card.first + 1..=card.last] {
+        *fate = Fate::Drop;
+    }
+}
+
+/// Whether an `X` card's subcircuit is `subckt`: the last token that is
+/// not a `name=value` parameter (nor `params:`).
+fn instantiates(card: &str, subckt: &str) -> bool {
+    let mut tokens = card.split_whitespace();
+    if !tokens
+        .next()
+        .is_some_and(|t| t.starts_with('x') || t.starts_with('X'))
+    {
+        return false;
+    }
+    // `w = 1` and `w=1` alike: glue the `=` to its neighbours first.
+    let glued = card.replace(" =", "=").replace("= ", "=");
+    let model = glued
+        .split_whitespace()
+        .skip(1)
+        .filter(|t| !t.contains('=') && !t.eq_ignore_ascii_case("params:"))
+        .last();
+    model.is_some_and(|m| m.eq_ignore_ascii_case(subckt))
+}
+
+/// The path of an include card, its rewritten card, or `None` when the
+/// card is left as it is (a `.lib` section header).
+fn resolve_include(
+    card: &Card,
+    keyword: &str,
+    base: &Path,
+    netlist: &Path,
+) -> Result<Option<(String, PathBuf)>, NetlistError> {
+    let original = card.text.split_whitespace().next().unwrap_or(keyword);
+    let rest = card.text[original.len()..].trim();
+    let (written, after) = split_path(rest);
+    if written.is_empty() {
+        return Ok(None);
+    }
+    let resolved = resolve(written, base);
+    // `.lib name` alone is a section header inside a library file; with a
+    // file behind it, PSpice-style, it includes the whole file.
+    if keyword == ".lib" && after.is_empty() && !resolved.is_file() {
+        return Ok(None);
+    }
+    if !resolved.is_file() {
+        return Err(NetlistError::MissingInclude {
+            netlist: netlist.to_path_buf(),
+            line: card.line(),
+            card: card.text.clone(),
+            resolved,
+        });
+    }
+    let mut rewritten = format!("{original} \"{}\"", resolved.display());
+    if !after.is_empty() {
+        rewritten.push(' ');
+        rewritten.push_str(after);
+    }
+    Ok(Some((rewritten, resolved)))
+}
+
+/// A possibly quoted path and the rest of the card.
+fn split_path(rest: &str) -> (&str, &str) {
+    for quote in ['"', '\''] {
+        if let Some(inner) = rest.strip_prefix(quote) {
+            if let Some(end) = inner.find(quote) {
+                return (&inner[..end], inner[end + 1..].trim());
+            }
+        }
+    }
+    match rest.find(char::is_whitespace) {
+        Some(i) => (&rest[..i], rest[i..].trim()),
+        None => (rest, ""),
+    }
+}
+
+fn resolve(written: &str, base: &Path) -> PathBuf {
+    if let Some(home_rel) = written.strip_prefix("~/") {
+        if let Some(home) = std::env::var_os("HOME") {
+            return PathBuf::from(home).join(home_rel);
+        }
+    }
+    let p = Path::new(written);
+    if p.is_absolute() {
+        p.to_path_buf()
+    } else {
+        base.join(p)
+    }
+}
+
+/// Whether an included file (or one it includes) has an `X` card for
+/// `subckt`.
+fn include_instantiates(
+    path: &Path,
+    subckt: &str,
+    netlist: &Path,
+    line: usize,
+    depth: usize,
+    seen: &mut HashSet<PathBuf>,
+) -> Result<bool, NetlistError> {
+    if depth > MAX_INCLUDE_DEPTH || !seen.insert(path.to_path_buf()) {
+        return Ok(false);
+    }
+    let bytes = std::fs::read(path).map_err(|source| NetlistError::ReadInclude {
+        netlist: netlist.to_path_buf(),
+        line,
+        included: path.to_path_buf(),
+        source,
+    })?;
+    let text = String::from_utf8_lossy(&bytes);
+    let lines = physical_lines(&text);
+    // An included file has no title line.
+    let live = vec![true; lines.len()];
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    for card in cards(&lines, &live) {
+        let keyword = card.keyword();
+        if instantiates(&card.text, subckt) {
+            return Ok(true);
+        }
+        if matches!(keyword.as_str(), ".include" | ".inc" | ".lib") {
+            let (written, _) = split_path(card.text[keyword.len()..].trim());
+            let inner = resolve(written, &base);
+            if inner.is_file()
+                && include_instantiates(&inner, subckt, netlist, line, depth + 1, seen)?
+            {
+                return Ok(true);
+            }
+        }
+    }
+    Ok(false)
+}
+
+fn parse_tran(card: &Card, netlist: &Path) -> Result<Tran, NetlistError> {
+    let bad = |problem: String| NetlistError::BadTran {
+        netlist: netlist.to_path_buf(),
+        line: card.line(),
+        card: card.text.clone(),
+        problem,
+    };
+    let mut numbers = Vec::new();
+    let mut uic = false;
+    for token in card.text.split_whitespace().skip(1) {
+        if token.eq_ignore_ascii_case("uic") {
+            uic = true;
+        } else if let Some(x) = parse_number(token) {
+            if uic || numbers.len() == 4 {
+                return Err(bad(format!(
+                    "unexpected `{token}`: the form is `.tran tstep tstop [tstart [tmax]] [uic]`"
+                )));
+            }
+            numbers.push(x);
+        } else {
+            return Err(bad(format!(
+                "`{token}` is not a number chatterspice can read (it checks the stop time \
+                 against the chatter): write plain numbers such as `1u` and `20m`"
+            )));
+        }
+    }
+    if numbers.len() < 2 {
+        return Err(bad(
+            "needs at least a step and a stop time, e.g. `.tran 1u 20m`".to_owned(),
+        ));
+    }
+    let tran = Tran {
+        tstep: numbers[0],
+        tstop: numbers[1],
+        tstart: numbers.get(2).copied().unwrap_or(0.0),
+        tmax: numbers.get(3).copied(),
+        uic,
+        line: card.line(),
+    };
+    if !(tran.tstep > 0.0 && tran.tstop > tran.tstart && tran.tstart >= 0.0) {
+        return Err(bad(
+            "needs tstep > 0 and tstop > tstart >= 0, e.g. `.tran 1u 20m`".to_owned(),
+        ));
+    }
+    if tran.tmax.is_some_and(|m| m <= 0.0) {
+        return Err(bad("TMAX must be > 0".to_owned()));
+    }
+    Ok(tran)
+}
+
+fn quote_if_needed(name: &str) -> String {
+    if name.contains(char::is_whitespace) {
+        format!("\"{name}\"")
+    } else {
+        name.to_owned()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn req<'a>(text: &'a str, probes: &'a [&'a str]) -> DeckRequest<'a> {
+        DeckRequest {
+            netlist_text: text,
+            netlist_path: Path::new("/nonexistent/dir/circuit.cir"),
+            include_file_name: "contact.inc",
+            subckt: "CONTACT",
+            probes,
+            chatter_end: 5e-3,
+            stop_at_least: 8e-3,
+            max_step: None,
+        }
+    }
+
+    const BASIC: &str = "My circuit\r\nV1 vdd 0 3.3\r\nR1 vdd in 10k\r\n\
+        x1 in\r\n+ 0 contact ; the relay\r\n.tran 1u 10m\r\n.end\r\n";
+
+    #[test]
+    fn basic_deck() {
+        let deck = prepare_deck(&req(BASIC, &["v(in)"])).unwrap();
+        assert_eq!(
+            deck.text,
+            "My circuit\n* chatterspice run deck for /nonexistent/dir/circuit.cir; that file is \
+             not modified\n.include contact.inc\nV1 vdd 0 3.3\nR1 vdd in 10k\nx1 in\n+ 0 contact \
+             ; the relay\n.tran 1u 10m\n.end\n"
+        );
+        assert!(deck.warnings.is_empty(), "{:?}", deck.warnings);
+        assert_eq!(deck.tran.tstop, 10e-3);
+        assert_eq!(deck.tran.line, 6);
+        assert_eq!(deck.tran.effective_max_step(), 1e-6);
+    }
+
+    #[test]
+    fn instance_detection() {
+        assert!(instantiates("X1 a b CONTACT", "contact"));
+        assert!(instantiates("xk1 a b Contact r = 1 w=2", "CONTACT"));
+        assert!(instantiates("X1 a b CONTACT params: r=1", "CONTACT"));
+        assert!(!instantiates("X1 a b CONTACTS", "CONTACT"));
+        assert!(!instantiates("R1 a CONTACT 1k", "CONTACT"));
+        assert!(!instantiates("X1 CONTACT b OTHER", "CONTACT"));
+    }
+
+    #[test]
+    fn comments_are_stripped() {
+        assert_eq!(strip_comment("R1 a b 1k ; note"), "R1 a b 1k ");
+        assert_eq!(strip_comment("R1 a b 1k $ note"), "R1 a b 1k ");
+        assert_eq!(strip_comment("R1 a$b c 1k"), "R1 a$b c 1k");
+        assert_eq!(strip_comment("* X1 a b CONTACT"), "");
+    }
+
+    #[test]
+    fn missing_instance_names_the_file_and_the_line_to_add() {
+        let text = "t\nR1 a 0 1k\n* X1 a 0 CONTACT\n.tran 1u 10m\n.end\n";
+        let e = prepare_deck(&req(text, &[])).unwrap_err();
+        assert!(matches!(e, NetlistError::NoContactInstance { .. }));
+        let msg = e.to_string();
+        assert!(msg.starts_with("/nonexistent/dir/circuit.cir: "), "{msg}");
+        assert!(msg.contains("`X1 a b CONTACT`"), "{msg}");
+    }
+
+    #[test]
+    fn own_subckt_of_that_name_is_an_error() {
+        let text = "t\nX1 a 0 CONTACT\n.SUBCKT contact a b\nR1 a b 1\n.ends\n.tran 1u 10m\n";
+        let e = prepare_deck(&req(text, &[])).unwrap_err();
+        assert!(
+            matches!(e, NetlistError::SubcktConflict { line: 3, .. }),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn tran_checks() {
+        let deck = |tran: &str| {
+            let text = format!("t\nX1 a 0 CONTACT\n{tran}\n.end\n");
+            prepare_deck(&req(&text, &[]))
+        };
+        let e = deck("* none").unwrap_err();
+        assert!(
+            e.to_string().contains("add a line such as `.tran 1u 8e-3`"),
+            "{e}"
+        );
+        let e = deck(".tran 1u 4m").unwrap_err();
+        let msg = e.to_string();
+        assert!(matches!(e, NetlistError::TranTooShort { line: 3, .. }));
+        assert!(
+            msg.contains("at least 8e-3 s, e.g. `.tran 1e-6 8e-3`"),
+            "{msg}"
+        );
+        let d = deck(".TRAN 1u 6ms").unwrap();
+        assert!(matches!(d.warnings[..], [DeckWarning::StopShort { .. }]));
+        let d = deck(".tran 1u\n+ 10m 0 5u UIC").unwrap();
+        assert_eq!(d.tran.tmax, Some(5e-6));
+        assert!(d.tran.uic);
+        let e = deck(".tran 1u {tstop}").unwrap_err();
+        assert!(e.to_string().contains("`{tstop}` is not a number"), "{e}");
+        let e = deck(".tran 1u 10m\n.tran 1u 20m").unwrap_err();
+        assert!(matches!(
+            e,
+            NetlistError::TwoTran {
+                first: 3,
+                second: 4,
+                ..
+            }
+        ));
+        assert!(deck(".tran 1u").is_err());
+        assert!(deck(".tran 0 10m").is_err());
+    }
+
+    #[test]
+    fn control_blocks_are_left_out() {
+        let text = "t\nX1 a 0 CONTACT\n.control\ntran 1u 10m\nrun\n.endc\n.end\n";
+        let e = prepare_deck(&req(text, &[])).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("outside the `.control` block at line 3"),
+            "{e}"
+        );
+        let text = "t\nX1 a 0 CONTACT\n.tran 1u 10m\n.control\nrun\nquit\n.endc\n";
+        let d = prepare_deck(&req(text, &[])).unwrap();
+        assert!(!d.text.contains("quit"), "{}", d.text);
+        assert!(matches!(
+            d.warnings[..],
+            [DeckWarning::ControlRemoved {
+                first: 4,
+                last: 7,
+                ..
+            }]
+        ));
+        let text = "t\nX1 a 0 CONTACT\n.tran 1u 10m\n.control\nrun\n";
+        assert!(matches!(
+            prepare_deck(&req(text, &[])),
+            Err(NetlistError::UnclosedControl { line: 4, .. })
+        ));
+    }
+
+    #[test]
+    fn end_is_last_and_saves_follow_user_saves() {
+        let text = "t\nX1 a 0 CONTACT\n.tran 1u 10m\n.save v(a)\n.END\nR9 x y 1\n";
+        let d = prepare_deck(&req(text, &["v(in)", "V(a,0)", "i(V1)"])).unwrap();
+        assert!(
+            d.text.ends_with(
+                ".save v(a)\n* chatterspice: the probes\n.save v(in) v(a) i(V1)\n.end\n"
+            ),
+            "{}",
+            d.text
+        );
+        assert!(!d.text.contains("R9"));
+        assert!(matches!(
+            d.warnings[..],
+            [DeckWarning::IgnoredAfterEnd { line: 6, .. }]
+        ));
+        // Without `.save` ngspice saves everything: nothing to add.
+        let d = prepare_deck(&req(BASIC, &["v(in)"])).unwrap();
+        assert!(!d.text.contains(".save"));
+    }
+
+    #[test]
+    fn probes_must_be_vectors() {
+        assert_eq!(save_names("v(a,b)").unwrap(), ["v(a)", "v(b)"]);
+        assert_eq!(save_names(" I(Vdd) ").unwrap(), ["i(Vdd)"]);
+        for bad in ["v(in", "in", "v()", "i(a,b)", "p(x)", "v(a b)"] {
+            let e = save_names(bad).unwrap_err();
+            assert!(e.to_string().contains("`v(node)`"), "{e}");
+        }
+    }
+
+    #[test]
+    fn max_step_rewrites_the_tran_card() {
+        let text = "t\nX1 a 0 CONTACT\n.tran 10u 10m uic ; slow\n";
+        let mut r = req(text, &[]);
+        r.max_step = Some(2e-6);
+        let d = prepare_deck(&r).unwrap();
+        assert!(
+            d.text.contains("\n.tran 1e-5 1e-2 0e0 2e-6 uic\n"),
+            "{}",
+            d.text
+        );
+        assert!(matches!(
+            d.warnings[..],
+            [DeckWarning::MaxStepSet { from, to, .. }] if from == 1e-5 && to == 2e-6
+        ));
+        r.max_step = Some(1e-3);
+        assert!(prepare_deck(&r).unwrap().warnings.is_empty());
+    }
+
+    #[test]
+    fn title_that_is_a_card_is_reported() {
+        let text = ".include x.lib\nX1 a 0 CONTACT\n.tran 1u 10m\n";
+        let d = prepare_deck(&req(text, &[])).unwrap();
+        assert!(matches!(d.warnings[..], [DeckWarning::TitleIsCard { .. }]));
+        assert!(d.warnings[0].to_string().contains("line 1"));
+    }
+}
