@@ -11,11 +11,17 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
+use std::time::Duration;
+
 use chatterspice::mechanics::Dimensionless;
+use chatterspice::netlist::{self, ContactElement};
+use chatterspice::pipeline::{self, RunOptions};
 use chatterspice::rawfile::{RawFile, export};
 use chatterspice::report::{self, Format};
 use chatterspice::scenario::Scenario;
 use chatterspice::simulate;
+use chatterspice::spice::Ngspice;
+use chatterspice::waveform::{ContactModel, Waveform};
 
 /// Relay contact bounce from physics, into circuit simulation.
 #[derive(Debug, Parser)]
@@ -27,8 +33,13 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// The main job: the relay's chatter switching your circuit in ngspice,
+    /// and what the bounce did to every probed signal.
+    Run(RunArgs),
     /// Mechanics only: the chatter sequence of one closing.
     Bounce(BounceArgs),
+    /// Print the ngspice include file with the contact subcircuit.
+    Pwl(PwlArgs),
     /// Print a SPICE raw file: one plot as CSV, or a JSON summary of every plot.
     Raw(RawArgs),
 }
@@ -36,7 +47,9 @@ pub enum Command {
 impl Command {
     pub fn run(&self) -> Result<()> {
         match self {
+            Command::Run(args) => run(args),
             Command::Bounce(args) => bounce(args),
+            Command::Pwl(args) => pwl(args),
             Command::Raw(args) => raw(args),
         }
     }
@@ -61,6 +74,99 @@ pub struct BounceArgs {
     /// Replace FILE if it already exists.
     #[arg(long, requires = "output")]
     pub force: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// Scenario file (TOML) with a [circuit] netlist and [[probe]]s; `-`
+    /// reads it from stdin. Without it, the built-in default: a small
+    /// signal relay switching an MCU input.
+    #[arg(value_name = "SCENARIO")]
+    pub scenario: Option<PathBuf>,
+
+    /// Output format of the report on standard output.
+    #[arg(long, value_enum, default_value_t = RunFormat::Table)]
+    pub format: RunFormat,
+
+    /// Also write every artefact into DIR: report.json, waveforms.csv,
+    /// netlist.cir, contact.inc, plot.svg. Existing files there are an
+    /// error unless --force.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+
+    /// Replace files that already exist in DIR.
+    #[arg(long, requires = "out")]
+    pub force: bool,
+
+    /// Wall-clock limit of each ngspice run, in seconds.
+    #[arg(long, value_name = "S", default_value_t = 60.0, value_parser = parse_timeout)]
+    pub timeout: f64,
+
+    /// How the contact is emitted: pwl (default), event-ramp, filesource
+    /// or switch. See the README's comparison.
+    #[arg(long, value_name = "ELEMENT", value_parser = parse_element)]
+    pub element: Option<ContactElement>,
+
+    /// Skip the second run with an ideal contact (no comparison).
+    #[arg(long)]
+    pub no_ideal: bool,
+
+    /// Keep ngspice's work directories and print where they are.
+    #[arg(long)]
+    pub keep_workdir: bool,
+
+    /// The ngspice program [default: $CHATTERSPICE_NGSPICE, else ngspice
+    /// on PATH].
+    #[arg(long, value_name = "PROGRAM")]
+    pub ngspice: Option<PathBuf>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RunFormat {
+    /// The run JSON of interfaces.md §3, for scripts.
+    Json,
+    /// A summary for people.
+    Table,
+}
+
+#[derive(Debug, Args)]
+pub struct PwlArgs {
+    /// Scenario file (TOML); `-` reads it from stdin. Without it, the
+    /// built-in default.
+    #[arg(value_name = "SCENARIO")]
+    pub scenario: Option<PathBuf>,
+
+    /// Write the include to FILE instead of standard output. An existing
+    /// FILE is an error unless --force.
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    pub output: Option<PathBuf>,
+
+    /// Replace FILE if it already exists.
+    #[arg(long, requires = "output")]
+    pub force: bool,
+
+    /// How the contact is emitted: pwl (default), event-ramp, filesource
+    /// or switch. Data files an element needs are written next to FILE.
+    #[arg(long, value_name = "ELEMENT", value_parser = parse_element)]
+    pub element: Option<ContactElement>,
+
+    /// Use a measured chatter sequence instead of the mechanics: a CSV
+    /// `time,state` with one row per state change (open/closed or 0/1).
+    #[arg(long, value_name = "CSV")]
+    pub measured: Option<PathBuf>,
+}
+
+fn parse_timeout(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(s) if s.is_finite() && s > 0.0 && Duration::try_from_secs_f64(s).is_ok() => Ok(s),
+        _ => Err(format!(
+            "`{text}` is not a time limit: give a number of seconds > 0, e.g. 60"
+        )),
+    }
+}
+
+fn parse_element(text: &str) -> Result<ContactElement, String> {
+    text.parse::<ContactElement>().map_err(|e| e.to_string())
 }
 
 #[derive(Debug, Args)]
@@ -117,6 +223,116 @@ fn bounce(args: &BounceArgs) -> Result<()> {
     let dimensionless = Dimensionless::of(&mechanics, &surface);
     let text = report::render(args.format.into(), &chatter, Some(&dimensionless));
     emit(&text, args.output.as_deref(), args.force)
+}
+
+fn run(args: &RunArgs) -> Result<()> {
+    if let Some(dir) = &args.out {
+        refuse_existing_bundle(dir, args.force)?;
+    }
+    let scenario = load_scenario(args.scenario.as_deref())?;
+    let ngspice = Ngspice::locate(args.ngspice.as_deref())?;
+    let options = RunOptions {
+        timeout: Duration::from_secs_f64(args.timeout),
+        keep_workdir: args.keep_workdir,
+        element: args.element.unwrap_or_default(),
+        compare_ideal: !args.no_ideal,
+    };
+    let result = pipeline::run(&scenario, &ngspice, &options)?;
+    let dimensionless = scenario
+        .mechanics()
+        .ok()
+        .map(|m| Dimensionless::of(&m, &scenario.surface()));
+    for sim in std::iter::once(&result.simulation).chain(&result.ideal) {
+        if let Some(dir) = &sim.workdir {
+            eprintln!("ngspice work directory kept: {}", dir.display());
+        }
+    }
+    let text = match args.format {
+        RunFormat::Json => report::json::render_run(&result, dimensionless.as_ref()),
+        RunFormat::Table => report::table::render_run(&result),
+    };
+    if args.format == RunFormat::Json {
+        for warning in &result.warnings {
+            eprintln!("warning: {warning}");
+        }
+    }
+    if let Some(dir) = &args.out {
+        let files = report::bundle::run_files(&result, dimensionless.as_ref())
+            .context("the run succeeded, but its files could not be made")?;
+        report::write_bundle(dir, &files, args.force)?;
+    }
+    emit(&text, None, false)
+}
+
+/// Fail before any work if `--out DIR` already holds a file the run
+/// would write.
+fn refuse_existing_bundle(dir: &Path, force: bool) -> Result<()> {
+    if force {
+        return Ok(());
+    }
+    let names = [
+        "report.json",
+        "waveforms.csv",
+        "netlist.cir",
+        pipeline::INCLUDE_FILE,
+        "plot.svg",
+    ];
+    if let Some(existing) = names.iter().map(|n| dir.join(n)).find(|p| p.exists()) {
+        bail!(
+            "{}: already exists; pass --force to overwrite the files in {}, or choose another --out",
+            existing.display(),
+            dir.display()
+        );
+    }
+    Ok(())
+}
+
+fn pwl(args: &PwlArgs) -> Result<()> {
+    refuse_existing(args.output.as_deref(), args.force)?;
+    let scenario = load_scenario(args.scenario.as_deref())?;
+    let model = ContactModel::from(&scenario.contact);
+    let waveform = match &args.measured {
+        Some(csv) => {
+            let text = std::fs::read_to_string(csv)
+                .with_context(|| format!("{}: cannot read the measured chatter", csv.display()))?;
+            Waveform::from_state_changes(&text, csv, &model)?
+        }
+        None => {
+            let chatter = simulate(
+                &scenario.mechanics()?,
+                &scenario.surface(),
+                &scenario.settings(),
+            )
+            .with_context(|| {
+                format!(
+                    "{}: the mechanics simulation failed",
+                    scenario.origin.display()
+                )
+            })?;
+            Waveform::from_chatter(&chatter, &model)?
+        }
+    };
+    let subckt = scenario
+        .circuit
+        .as_ref()
+        .map_or("CONTACT", |c| c.subckt.as_str());
+    let include = netlist::contact_include(&waveform, subckt, args.element.unwrap_or_default())?;
+    if !include.data_files.is_empty() {
+        let Some(output) = &args.output else {
+            bail!(
+                "the {} element reads data files next to the include; give -o FILE so they can be written",
+                include.element
+            );
+        };
+        let dir = output
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        for (name, contents) in &include.data_files {
+            report::write_new_file(&dir.join(name), contents.as_bytes(), args.force)?;
+        }
+    }
+    emit(&include.text, args.output.as_deref(), args.force)
 }
 
 /// The named scenario file, stdin for `-`, or the built-in default.

@@ -13,6 +13,7 @@ pub mod analysis;
 pub mod chatter;
 pub mod mechanics;
 pub mod netlist;
+pub mod pipeline;
 pub mod rawfile;
 pub mod report;
 pub mod scenario;

@@ -11,33 +11,7 @@ use std::time::{Duration, Instant};
 
 use chatterspice::spice::{Exit, Failure, Ngspice, RunRequest, Runner, SpiceError};
 
-fn ngspice() -> Option<Ngspice> {
-    match Ngspice::find() {
-        Ok(n) => Some(n),
-        Err(e) if std::env::var("REQUIRE_NGSPICE").as_deref() == Ok("1") => {
-            panic!("REQUIRE_NGSPICE=1 but ngspice is unusable: {e}")
-        }
-        Err(e) => {
-            // Written to the stderr handle, not eprintln!, which the test
-            // harness captures: the skip must be visible.
-            use std::io::Write;
-            let _ = writeln!(
-                std::io::stderr(),
-                "note: skipping a test that needs ngspice (set REQUIRE_NGSPICE=1 to fail instead): {e}"
-            );
-            None
-        }
-    }
-}
-
-macro_rules! ngspice_or_skip {
-    () => {
-        match ngspice() {
-            Some(n) => n,
-            None => return,
-        }
-    };
-}
+mod common;
 
 const RC: &str =
     "RC step\nV1 in 0 PWL(0 0 1n 1)\nR1 in out 1k\nC1 out 0 1u\n.tran 50u 5m 0 50u\n.end\n";

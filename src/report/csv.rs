@@ -7,7 +7,10 @@
 //! A result without impacts gives the header alone. Numbers are SI, in
 //! Rust's shortest round-trip form; no cell ever needs quoting.
 
+use crate::analysis::{AnalysisError, signal_values};
 use crate::chatter::{Chatter, Impact};
+use crate::rawfile::{Plot, Vector};
+use crate::waveform::Waveform;
 
 /// The column names, matching [`Impact`]'s JSON field names.
 pub const HEADER: [&str; 9] = [
@@ -49,6 +52,46 @@ pub fn render(chatter: &Chatter) -> String {
         out.push('\n');
     }
     out
+}
+
+/// A simulation's signals as CSV, one row per ngspice time point: `time`
+/// (s), then `contact_resistance` (Ω, from `contact` at that time) when
+/// given, then each of `signals` in its own unit. Names with a comma
+/// (`v(a,b)`) are quoted. Fails only when a signal is not in `plot`.
+pub fn waveforms(
+    plot: &Plot,
+    contact: Option<&Waveform>,
+    signals: &[&str],
+) -> Result<String, AnalysisError> {
+    let time: &[f64] = match plot.scale() {
+        Some(Vector::Real(t)) => t,
+        _ => &[],
+    };
+    let columns = signals
+        .iter()
+        .map(|s| signal_values(plot, s).map(|(values, _)| values))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut out = ::csv::Writer::from_writer(Vec::new());
+    let mut header = vec!["time"];
+    if contact.is_some() {
+        header.push("contact_resistance");
+    }
+    header.extend_from_slice(signals);
+    let written = out.write_record(&header).and_then(|()| {
+        for (i, &t) in time.iter().enumerate() {
+            let mut row = vec![format!("{t:?}")];
+            if let Some(w) = contact {
+                row.push(format!("{:?}", w.resistance_at(t)));
+            }
+            row.extend(columns.iter().map(|c| format!("{:?}", c[i])));
+            out.write_record(&row)?;
+        }
+        Ok(())
+    });
+    // Writing into a Vec cannot fail.
+    written.expect("CSV into memory");
+    let bytes = out.into_inner().expect("CSV into memory");
+    Ok(String::from_utf8(bytes).expect("CSV of ASCII names and numbers"))
 }
 
 #[cfg(test)]

@@ -9,8 +9,10 @@
 
 use serde::Serialize;
 
+use crate::analysis::{Comparison, ProbeAnalysis};
 use crate::chatter::Chatter;
 use crate::mechanics::Dimensionless;
+use crate::pipeline::{RunResult, Simulation};
 
 /// The bounce object, ready to serialize alone or to embed (as `bounce`)
 /// in a larger document such as `run`'s.
@@ -67,6 +69,97 @@ pub fn render(chatter: &Chatter, dimensionless: Option<&Dimensionless>) -> Strin
         // Only maps with non-string keys or a failing writer can fail, and
         // these types have neither.
         .expect("a chatter result always serializes");
+    text.push('\n');
+    text
+}
+
+/// The `run` document: the contract's `probes`, `bounce` and `ngspice`
+/// first, then the contact waveform's figures, the netlist and any
+/// warnings.
+#[derive(Debug, Serialize)]
+pub struct RunJson<'a> {
+    probes: Vec<ProbeJson<'a>>,
+    bounce: BounceJson<'a>,
+    ngspice: NgspiceJson<'a>,
+    contact: ContactJson<'a>,
+    netlist: String,
+    warnings: &'a [String],
+}
+
+/// One probe: the contract's fields (flattened from the analysis), then
+/// the ideal contact's analysis and what the bounce added to it.
+#[derive(Debug, Serialize)]
+struct ProbeJson<'a> {
+    #[serde(flatten)]
+    analysis: &'a ProbeAnalysis,
+    ideal: Option<&'a ProbeAnalysis>,
+    bounce_added: Option<&'a Comparison>,
+}
+
+#[derive(Debug, Serialize)]
+struct NgspiceJson<'a> {
+    version: Option<&'a str>,
+    /// s, wall time of the bounced run.
+    elapsed: f64,
+    /// Time points of the bounced run.
+    points: usize,
+    ideal_elapsed: Option<f64>,
+    ideal_points: Option<usize>,
+}
+
+#[derive(Debug, Serialize)]
+struct ContactJson<'a> {
+    element: &'a str,
+    subckt: &'a str,
+    points: usize,
+    pwl_sources: usize,
+    make_edges: usize,
+    break_edges: usize,
+    merged_openings: usize,
+    widened_closures: usize,
+}
+
+impl<'a> RunJson<'a> {
+    pub fn new(run: &'a RunResult, dimensionless: Option<&Dimensionless>) -> Self {
+        let sim = |s: &'a Simulation| (s.elapsed.as_secs_f64(), s.plot.points());
+        RunJson {
+            probes: run
+                .probes
+                .iter()
+                .map(|p| ProbeJson {
+                    analysis: &p.analysis,
+                    ideal: p.ideal.as_ref(),
+                    bounce_added: p.comparison.as_ref(),
+                })
+                .collect(),
+            bounce: BounceJson::new(&run.chatter, dimensionless),
+            ngspice: NgspiceJson {
+                version: run.simulation.version.as_deref(),
+                elapsed: sim(&run.simulation).0,
+                points: sim(&run.simulation).1,
+                ideal_elapsed: run.ideal.as_ref().map(|s| sim(s).0),
+                ideal_points: run.ideal.as_ref().map(|s| sim(s).1),
+            },
+            contact: ContactJson {
+                element: run.include.element.as_str(),
+                subckt: &run.include.subckt,
+                points: run.include.points,
+                pwl_sources: run.include.pwl_sources,
+                make_edges: run.waveform.make_edges(),
+                break_edges: run.waveform.break_edges(),
+                merged_openings: run.waveform.merged_openings(),
+                widened_closures: run.waveform.widened_closures(),
+            },
+            netlist: run.netlist.display().to_string(),
+            warnings: &run.warnings,
+        }
+    }
+}
+
+/// The `run` result as pretty-printed JSON with a trailing newline.
+pub fn render_run(run: &RunResult, dimensionless: Option<&Dimensionless>) -> String {
+    let mut text = serde_json::to_string_pretty(&RunJson::new(run, dimensionless))
+        .expect("a run result always serializes");
     text.push('\n');
     text
 }

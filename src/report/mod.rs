@@ -6,12 +6,14 @@
 //! - [`csv`]: one row per impact, for spreadsheets and plotting;
 //! - [`table`]: a summary and an aligned impact table, for a person at a
 //!   terminal, in engineering units;
-//! - [`svg`]: a plot of the contact and the probed signals over time.
+//! - [`svg`]: a plot of the contact and the probed signals over time;
+//! - [`bundle`]: every file of a `run --out DIR`.
 //!
 //! Output is deterministic: the same result gives byte-identical text (no
 //! timestamps, fixed field order, shortest round-trip floats).
 //! [`write_new_file`] puts a report on disk without clobbering anything.
 
+pub mod bundle;
 pub mod csv;
 pub mod json;
 pub mod svg;

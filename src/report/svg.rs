@@ -24,9 +24,9 @@ use std::fmt::Write as _;
 
 use thiserror::Error;
 
+use super::units::{engineering, prefix, significant};
 use crate::analysis::{Direction, Edge, ProbeAnalysis};
 use crate::chatter::{ContactState, Interval};
-use super::units::{engineering, prefix, significant};
 
 /// Why a plot could not be drawn.
 #[derive(Debug, Clone, PartialEq, Error)]

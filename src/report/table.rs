@@ -8,7 +8,10 @@
 
 use std::fmt::Write;
 
+use super::units::engineering;
+use crate::analysis::ProbeAnalysis;
 use crate::chatter::{Chatter, Impact, Outcome};
+use crate::pipeline::RunResult;
 
 /// Summary and impact table, `\n`-terminated.
 pub fn render(chatter: &Chatter) -> String {
@@ -63,8 +66,177 @@ pub fn render(chatter: &Chatter) -> String {
     for (n, impact) in chatter.impacts.iter().enumerate() {
         rows.push(impact_row(n + 1, impact));
     }
-    out.push_str(&align(&rows));
+    out.push_str(&align(&rows, false));
     out
+}
+
+/// The `run` result for a person: the relay in one line, the circuit run,
+/// a table of the probes (each followed by the ideal contact's row), and a
+/// sentence per probe saying what the bounce added. Current probes get a
+/// table of their closures.
+pub fn render_run(run: &RunResult) -> String {
+    let mut out = String::new();
+    let c = &run.chatter;
+    let relay = match (c.first_impact, c.settle_time) {
+        (Some(first), Some(settle)) => format!(
+            "{} bounce{}, {} ({}); first make {}, settled {} (bounce time {})",
+            c.bounce_count,
+            if c.bounce_count == 1 { "" } else { "s" },
+            c.outcome,
+            explain(c.outcome),
+            ms(Some(first)),
+            ms(Some(settle)),
+            ms(Some(settle - first)),
+        ),
+        _ => format!(
+            "{} ({}), {} bounces",
+            c.outcome,
+            explain(c.outcome),
+            c.bounce_count
+        ),
+    };
+    let sim = &run.simulation;
+    let mut circuit = format!(
+        "{}: ngspice {}, {} points in {:.3} s",
+        run.netlist.display(),
+        sim.version.as_deref().unwrap_or("(version unknown)"),
+        sim.plot.points(),
+        sim.elapsed.as_secs_f64()
+    );
+    if let Some(ideal) = &run.ideal {
+        let _ = write!(
+            circuit,
+            "; ideal contact {:.3} s",
+            ideal.elapsed.as_secs_f64()
+        );
+    }
+    let w = &run.waveform;
+    let mut contact = format!(
+        "{} element, {} points, {} makes, {} breaks",
+        run.include.element,
+        run.include.points,
+        w.make_edges(),
+        w.break_edges()
+    );
+    if w.merged_openings() > 0 {
+        let _ = write!(contact, ", {} openings merged", w.merged_openings());
+    }
+    if w.widened_closures() > 0 {
+        let _ = write!(contact, ", {} touches widened", w.widened_closures());
+    }
+    for (label, value) in [("relay", relay), ("contact", contact), ("circuit", circuit)] {
+        let _ = writeln!(out, "{label:<8} {value}");
+    }
+
+    out.push('\n');
+    let mut rows = vec![
+        [
+            "probe",
+            "edges",
+            "glitches",
+            "first edge",
+            "last edge",
+            "shortest pulse",
+            "min",
+            "max",
+        ]
+        .map(String::from),
+    ];
+    for p in &run.probes {
+        rows.push(probe_row(&p.analysis.signal, &p.analysis));
+        if let Some(ideal) = &p.ideal {
+            rows.push(probe_row("  ideal contact", ideal));
+        }
+    }
+    out.push_str(&align(&rows, true));
+
+    for p in &run.probes {
+        let a = &p.analysis;
+        let unit = a.kind.unit();
+        out.push('\n');
+        let _ = write!(out, "{}: ", a.signal);
+        match &p.comparison {
+            Some(cmp) => {
+                let added = match cmp.extra_edges {
+                    0 => "the bounce adds no edge".to_owned(),
+                    1 => "the bounce adds 1 edge".to_owned(),
+                    n if n > 0 => format!("the bounce adds {n} edges"),
+                    n => format!("the bounce removes {} edges", -n),
+                };
+                out.push_str(&added);
+                if let Some(delay) = cmp.settle_delay {
+                    if delay != 0.0 {
+                        let _ = write!(
+                            out,
+                            "; the last edge comes {} {} the ideal contact's",
+                            engineering(delay.abs(), "s"),
+                            if delay > 0.0 { "after" } else { "before" }
+                        );
+                    }
+                }
+                if !cmp.same_final_state {
+                    out.push_str("; it ends at a different level than with an ideal contact");
+                }
+                let _ = writeln!(
+                    out,
+                    "; range {} to {} (ideal: {} to {})",
+                    engineering(a.min, unit),
+                    engineering(a.max, unit),
+                    engineering(a.min - cmp.min_difference, unit),
+                    engineering(a.max - cmp.max_difference, unit),
+                );
+            }
+            None => {
+                let _ = writeln!(
+                    out,
+                    "{} edges; range {} to {}",
+                    a.edges,
+                    engineering(a.min, unit),
+                    engineering(a.max, unit)
+                );
+            }
+        }
+        if let Some(current) = &a.current {
+            let _ = writeln!(
+                out,
+                "  peak {} at {}, charge {} ({} while closed)",
+                engineering(current.peak, "A"),
+                ms(Some(current.peak_time)),
+                engineering(current.charge, "C"),
+                engineering(current.closed_charge, "C"),
+            );
+            let mut rows = vec![["closure", "from", "to", "peak", "charge"].map(String::from)];
+            for (n, k) in current.per_closure.iter().enumerate() {
+                rows.push([
+                    format!("  {}", n + 1),
+                    ms(Some(k.start)),
+                    ms(Some(k.end)),
+                    engineering(k.peak, "A"),
+                    engineering(k.charge, "C"),
+                ]);
+            }
+            out.push_str(&align(&rows, true));
+        }
+    }
+    for warning in &run.warnings {
+        let _ = writeln!(out, "warning: {warning}");
+    }
+    out
+}
+
+fn probe_row(label: &str, a: &ProbeAnalysis) -> [String; 8] {
+    let unit = a.kind.unit();
+    [
+        label.to_owned(),
+        a.edges.to_string(),
+        a.glitches.to_string(),
+        ms(a.first_edge),
+        ms(a.last_edge),
+        a.shortest_pulse
+            .map_or_else(|| ABSENT.to_owned(), |t| engineering(t, "s")),
+        engineering(a.min, unit),
+        engineering(a.max, unit),
+    ]
 }
 
 fn explain(outcome: Outcome) -> &'static str {
@@ -93,7 +265,9 @@ fn impact_row(n: usize, i: &Impact) -> [String; 10] {
 }
 
 /// Right-aligned columns two spaces apart.
-fn align<const N: usize>(rows: &[[String; N]]) -> String {
+/// Right-aligned columns, except the first when `names_first` (a column
+/// of names reads better left-aligned).
+fn align<const N: usize>(rows: &[[String; N]], names_first: bool) -> String {
     let width = |c: usize| rows.iter().map(|r| r[c].chars().count()).max().unwrap_or(0);
     let widths: Vec<usize> = (0..N).map(width).collect();
     let mut out = String::new();
@@ -101,7 +275,14 @@ fn align<const N: usize>(rows: &[[String; N]]) -> String {
         let cells: Vec<String> = row
             .iter()
             .zip(&widths)
-            .map(|(cell, &w)| format!("{cell:>w$}"))
+            .enumerate()
+            .map(|(i, (cell, &w))| {
+                if i == 0 && names_first {
+                    format!("{cell:<w$}")
+                } else {
+                    format!("{cell:>w$}")
+                }
+            })
             .collect();
         out.push_str(cells.join("  ").trim_end());
         out.push('\n');

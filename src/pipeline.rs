@@ -1,0 +1,369 @@
+//! The main job, `chatterspice run`: every stage of the pipeline in order.
+//!
+//! scenario → [`simulate`](crate::mechanics::simulate) (the chatter) →
+//! [`Waveform`] (the contact conductance) → [`netlist`](crate::netlist)
+//! (the contact include and the user's netlist with the `.include` added)
+//! → a [`Runner`] (ngspice in batch mode) → the raw file →
+//! [`analysis`](crate::analysis) of every `[[probe]]`.
+//!
+//! The same circuit is run a second time with an **ideal contact**: a
+//! single clean make at the first impact. The difference between the two
+//! runs is what the bounce added (extra edges, a later settled edge, higher
+//! peaks); it isolates the bounce from whatever the circuit does on its
+//! own, such as a filter's delay. Both runs go to the runner at once, on
+//! two threads: they are independent ngspice processes.
+//!
+//! Nothing here prints or touches the user's files: the result carries
+//! the deck and the include that were run, and the raw data, for the
+//! reports to write wherever the caller wants.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use thiserror::Error;
+
+use crate::analysis::{self, AnalysisError, Comparison, ProbeAnalysis};
+use crate::chatter::{Chatter, ContactState, Interval};
+use crate::mechanics::{MechanicsError, simulate};
+use crate::netlist::{self, ContactElement, ContactInclude, Deck, DeckRequest, NetlistError};
+use crate::rawfile::Plot;
+use crate::scenario::{Probe, Scenario, ScenarioError};
+use crate::spice::{RunRequest, Runner, SpiceError};
+use crate::waveform::{ContactModel, Waveform, WaveformError};
+
+/// The file name of the contact include in the run's work directory (and
+/// in `--out`), which the deck `.include`s.
+pub const INCLUDE_FILE: &str = "contact.inc";
+
+/// The simulation should run this many times the end of the chatter, so
+/// that the circuit's response to the last make (a filter settling, a
+/// capacitor charging) shows too; a shorter `.tran` is a warning.
+pub const STOP_MARGIN: f64 = 1.2;
+
+/// How to run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunOptions {
+    /// Wall-clock limit of each ngspice run.
+    pub timeout: Duration,
+    /// Keep ngspice's work directories (named in the result and in errors).
+    pub keep_workdir: bool,
+    /// How the contact is emitted.
+    pub element: ContactElement,
+    /// Also run the ideal contact and compare (needs a first impact).
+    pub compare_ideal: bool,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        RunOptions {
+            timeout: RunRequest::DEFAULT_TIMEOUT,
+            keep_workdir: false,
+            element: ContactElement::default(),
+            compare_ideal: true,
+        }
+    }
+}
+
+/// Why a run failed. Each variant names the file, key or run to look at.
+#[derive(Debug, Error)]
+pub enum RunError {
+    #[error(transparent)]
+    Scenario(#[from] ScenarioError),
+    #[error("{}: the mechanics simulation failed", path.display())]
+    Mechanics {
+        path: PathBuf,
+        #[source]
+        source: MechanicsError,
+    },
+    #[error("{}: cannot build the contact waveform", path.display())]
+    Waveform {
+        path: PathBuf,
+        #[source]
+        source: WaveformError,
+    },
+    #[error(
+        "{}: no [circuit] section: `run` needs the netlist the contact switches; add\n  \
+         [circuit]\n  netlist = \"my_circuit.cir\"   # instantiates the contact as X1 a b CONTACT",
+        path.display()
+    )]
+    NoCircuit { path: PathBuf },
+    #[error(
+        "{}: no [[probe]]: `run` measures the signals the probes name; add\n  \
+         [[probe]]\n  signal = \"v(in)\"\n  low = 0.99\n  high = 2.31",
+        path.display()
+    )]
+    NoProbes { path: PathBuf },
+    #[error(transparent)]
+    Netlist(#[from] NetlistError),
+    #[error("ngspice failed on the {run} run of {}", netlist.display())]
+    Spice {
+        run: &'static str,
+        netlist: PathBuf,
+        #[source]
+        source: Box<SpiceError>,
+    },
+    #[error(
+        "{}: the raw file of the {run} run has no transient plot (ngspice wrote: {plots}); \
+         the netlist's .tran analysis did not produce one",
+        netlist.display()
+    )]
+    NoTransient {
+        run: &'static str,
+        netlist: PathBuf,
+        plots: String,
+    },
+    #[error("{}: probe `{signal}` ({run} run)", origin.display())]
+    Probe {
+        origin: PathBuf,
+        signal: String,
+        run: &'static str,
+        #[source]
+        source: Box<AnalysisError>,
+    },
+}
+
+/// One ngspice run as the reports need it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Simulation {
+    /// The transient plot.
+    pub plot: Plot,
+    /// e.g. `"39"`.
+    pub version: Option<String>,
+    pub elapsed: Duration,
+    pub warnings: Vec<String>,
+    /// The kept work directory, when asked for.
+    pub workdir: Option<PathBuf>,
+}
+
+/// One probe: its analysis, and what the bounce added over the ideal run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProbeResult {
+    pub probe: Probe,
+    pub analysis: ProbeAnalysis,
+    pub ideal: Option<ProbeAnalysis>,
+    pub comparison: Option<Comparison>,
+}
+
+/// Everything `run` produced.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunResult {
+    /// The user's netlist (as named by the scenario).
+    pub netlist: PathBuf,
+    pub chatter: Chatter,
+    pub waveform: Waveform,
+    /// The contact include that was run (written as [`INCLUDE_FILE`]).
+    pub include: ContactInclude,
+    /// The deck that was run: the user's netlist plus the `.include`.
+    pub deck: Deck,
+    pub simulation: Simulation,
+    /// The ideal-contact run, when there was one.
+    pub ideal: Option<Simulation>,
+    pub probes: Vec<ProbeResult>,
+    /// Things worth a look that did not stop the run, in order.
+    pub warnings: Vec<String>,
+}
+
+/// Run the whole pipeline on `scenario` with `runner`.
+pub fn run(
+    scenario: &Scenario,
+    runner: &dyn Runner,
+    options: &RunOptions,
+) -> Result<RunResult, RunError> {
+    let origin = &scenario.origin;
+    let (netlist_path, netlist_text) =
+        scenario.netlist().ok_or_else(|| RunError::NoCircuit {
+            path: origin.clone(),
+        })??;
+    if scenario.probes.is_empty() {
+        return Err(RunError::NoProbes {
+            path: origin.clone(),
+        });
+    }
+    let circuit = scenario
+        .circuit
+        .as_ref()
+        .expect("netlist() returned Some, so there is a [circuit]");
+
+    let mechanics = scenario.mechanics()?;
+    let chatter =
+        simulate(&mechanics, &scenario.surface(), &scenario.settings()).map_err(|source| {
+            RunError::Mechanics {
+                path: origin.clone(),
+                source,
+            }
+        })?;
+    let model = ContactModel::from(&scenario.contact);
+    let waveform_error = |source| RunError::Waveform {
+        path: origin.clone(),
+        source,
+    };
+    let waveform = Waveform::from_chatter(&chatter, &model).map_err(waveform_error)?;
+    let include = netlist::contact_include(&waveform, &circuit.subckt, options.element)?;
+
+    let signals: Vec<&str> = scenario.probes.iter().map(|p| p.signal.as_str()).collect();
+    let end = chatter_end(&chatter) + model.edge_time;
+    let deck = netlist::prepare_deck(&DeckRequest {
+        netlist_text: &netlist_text,
+        netlist_path: &netlist_path,
+        include_file_name: INCLUDE_FILE,
+        subckt: &circuit.subckt,
+        probes: &signals,
+        chatter_end: end,
+        stop_at_least: end * STOP_MARGIN,
+        max_step: include.max_step,
+    })?;
+
+    let ideal_include = match (options.compare_ideal, chatter.first_impact) {
+        (true, Some(first_impact)) => {
+            let ideal =
+                ideal_waveform(first_impact, chatter.t_end, &model).map_err(waveform_error)?;
+            Some(netlist::contact_include(
+                &ideal,
+                &circuit.subckt,
+                options.element,
+            )?)
+        }
+        _ => None,
+    };
+
+    let request = |include: &ContactInclude| {
+        let mut includes = vec![(INCLUDE_FILE.to_owned(), include.text.clone())];
+        includes.extend(include.data_files.iter().cloned());
+        RunRequest {
+            deck: deck.text.clone(),
+            includes,
+            timeout: options.timeout,
+            keep_workdir: options.keep_workdir,
+        }
+    };
+    let bounced_request = request(&include);
+    let ideal_request = ideal_include.as_ref().map(request);
+    let (bounced, ideal) = std::thread::scope(|scope| {
+        let ideal = ideal_request
+            .as_ref()
+            .map(|req| scope.spawn(move || runner.run(req)));
+        let bounced = runner.run(&bounced_request);
+        let ideal = ideal.map(|handle| handle.join().expect("the ideal run does not panic"));
+        (bounced, ideal)
+    });
+    let simulation = simulation_of("bounced", bounced, &netlist_path)?;
+    let ideal = ideal
+        .map(|result| simulation_of("ideal", result, &netlist_path))
+        .transpose()?;
+
+    let closures = analysis::closures(&chatter);
+    let mut probes = Vec::with_capacity(scenario.probes.len());
+    for probe in &scenario.probes {
+        let probe_error = |run, source| RunError::Probe {
+            origin: origin.clone(),
+            signal: probe.signal.clone(),
+            run,
+            source: Box::new(source),
+        };
+        let analysis = analysis::analyze(&simulation.plot, probe, &closures)
+            .map_err(|e| probe_error("bounced", e))?;
+        let ideal_analysis = ideal
+            .as_ref()
+            .map(|sim| analysis::analyze(&sim.plot, probe, &closures))
+            .transpose()
+            .map_err(|e| probe_error("ideal", e))?;
+        let comparison = ideal_analysis
+            .as_ref()
+            .map(|ideal| analysis::compare(&analysis, ideal))
+            .transpose()
+            .map_err(|e| probe_error("ideal", e))?;
+        probes.push(ProbeResult {
+            probe: probe.clone(),
+            analysis,
+            ideal: ideal_analysis,
+            comparison,
+        });
+    }
+
+    let mut warnings: Vec<String> = deck.warnings.iter().map(ToString::to_string).collect();
+    warnings.extend(simulation.warnings.iter().cloned());
+    Ok(RunResult {
+        netlist: netlist_path,
+        chatter,
+        waveform,
+        include,
+        deck,
+        simulation,
+        ideal,
+        probes,
+        warnings,
+    })
+}
+
+/// s, the last change of contact state: the circuit must be simulated at
+/// least this far for the run to show the whole chatter.
+pub fn chatter_end(chatter: &Chatter) -> f64 {
+    chatter.intervals.last().map_or(0.0, |iv| iv.start)
+}
+
+/// A contact that closes cleanly at `first_impact` and stays closed to
+/// `t_end`: what the circuit would see without bounce.
+pub fn ideal_waveform(
+    first_impact: f64,
+    t_end: f64,
+    model: &ContactModel,
+) -> Result<Waveform, WaveformError> {
+    let intervals = [
+        Interval {
+            state: ContactState::Open,
+            start: 0.0,
+            end: first_impact,
+        },
+        Interval {
+            state: ContactState::Closed,
+            start: first_impact,
+            end: t_end.max(first_impact),
+        },
+    ];
+    Waveform::from_intervals(&intervals, model)
+}
+
+fn simulation_of(
+    run: &'static str,
+    result: Result<crate::spice::RunOutput, SpiceError>,
+    netlist: &std::path::Path,
+) -> Result<Simulation, RunError> {
+    let output = result.map_err(|source| RunError::Spice {
+        run,
+        netlist: netlist.to_owned(),
+        source: Box::new(source),
+    })?;
+    let crate::spice::RunOutput {
+        raw,
+        version,
+        elapsed,
+        workdir,
+        warnings,
+        ..
+    } = output;
+    let plot_names = || {
+        raw.plots
+            .iter()
+            .map(|p| format!("`{}`", p.name))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let plot = raw
+        .plots
+        .iter()
+        .rev()
+        .find(|p| p.name.to_ascii_lowercase().starts_with("transient"))
+        .cloned()
+        .ok_or_else(|| RunError::NoTransient {
+            run,
+            netlist: netlist.to_owned(),
+            plots: plot_names(),
+        })?;
+    Ok(Simulation {
+        plot,
+        version,
+        elapsed,
+        warnings,
+        workdir,
+    })
+}

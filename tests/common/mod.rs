@@ -1,0 +1,37 @@
+//! Helpers shared by the integration tests that need ngspice.
+#![allow(dead_code)] // each test crate uses its own subset
+
+use chatterspice::spice::Ngspice;
+
+/// ngspice, or `None` with a visible note when it is missing; a panic
+/// instead when `REQUIRE_NGSPICE=1` (CI sets it), so that no test that
+/// needs ngspice can pass by skipping.
+pub fn ngspice() -> Option<Ngspice> {
+    match Ngspice::find() {
+        Ok(n) => Some(n),
+        Err(e) if std::env::var("REQUIRE_NGSPICE").as_deref() == Ok("1") => {
+            panic!("REQUIRE_NGSPICE=1 but ngspice is unusable: {e}")
+        }
+        Err(e) => {
+            // Written to the stderr handle, not eprintln!, which the test
+            // harness captures: the skip must be visible.
+            use std::io::Write;
+            let _ = writeln!(
+                std::io::stderr(),
+                "note: skipping a test that needs ngspice (set REQUIRE_NGSPICE=1 to fail instead): {e}"
+            );
+            None
+        }
+    }
+}
+
+/// `let ng = ngspice_or_skip!();` at the top of a test.
+#[macro_export]
+macro_rules! ngspice_or_skip {
+    () => {
+        match common::ngspice() {
+            Some(n) => n,
+            None => return,
+        }
+    };
+}
