@@ -1,0 +1,321 @@
+//! `chatterspice run` and `chatterspice pwl` end to end, on real ngspice:
+//! the built-in default in both formats, `--out` and its refusal to
+//! overwrite, and bad input of every kind giving exit code 2 with a
+//! message that says what to fix.
+//!
+//! Tests that need ngspice skip with a note when it is missing, and fail
+//! when `REQUIRE_NGSPICE=1` (CI sets it).
+
+mod common;
+
+use std::path::Path;
+
+use assert_cmd::Command;
+use predicates::prelude::*;
+use serde_json::Value;
+
+fn chatterspice() -> Command {
+    Command::cargo_bin("chatterspice").unwrap()
+}
+
+fn stdout_of(args: &[&str]) -> String {
+    let out = chatterspice().args(args).assert().success();
+    String::from_utf8(out.get_output().stdout.clone()).unwrap()
+}
+
+/// A scenario in `dir` using the default relay, with `circuit` as its
+/// `[circuit]` netlist text (written to `circuit.cir`) and one probe.
+fn scenario_with_netlist(dir: &Path, netlist: &str) -> std::path::PathBuf {
+    std::fs::write(dir.join("circuit.cir"), netlist).unwrap();
+    let relay = chatterspice::scenario::DEFAULT_SCENARIO_TOML;
+    let cut = relay.find("[circuit]").unwrap();
+    let text = format!(
+        "{}[circuit]\nnetlist = \"circuit.cir\"\n\n[[probe]]\nsignal = \"v(sw)\"\nlow = 0.99\nhigh = 2.31\n",
+        &relay[..cut]
+    );
+    let path = dir.join("relay.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+const PULLUP: &str =
+    "pull-up\nVDD vdd 0 DC 3.3\nR1 vdd sw 10k\nX1 sw 0 CONTACT\n.tran 100n 5m\n.end\n";
+
+#[test]
+fn run_with_no_scenario_reports_the_default_relay_on_the_mcu_input() {
+    let _ng = ngspice_or_skip!();
+    let text = stdout_of(&["run"]);
+    for expected in [
+        "5 bounces",
+        "mcu_input.cir",
+        "ngspice",
+        "v(in)",
+        "ideal contact",
+        "the bounce adds",
+    ] {
+        assert!(
+            text.contains(expected),
+            "`{expected}` missing from:\n{text}"
+        );
+    }
+}
+
+#[test]
+fn run_json_keeps_the_contract() {
+    let _ng = ngspice_or_skip!();
+    let text = stdout_of(&["run", "--format", "json"]);
+    let top: Vec<&str> = text
+        .lines()
+        .filter(|l| l.starts_with("  \"") && !l.starts_with("   "))
+        .map(|l| l.trim().split('"').nth(1).unwrap())
+        .collect();
+    assert_eq!(&top[..3], ["probes", "bounce", "ngspice"]);
+    let v: Value = serde_json::from_str(&text).unwrap();
+    let probe = &v["probes"][0];
+    for key in [
+        "signal",
+        "edges",
+        "glitches",
+        "first_edge",
+        "last_edge",
+        "min",
+        "max",
+    ] {
+        assert!(probe.get(key).is_some(), "probe lacks {key}");
+    }
+    let edges = probe["edges"].as_u64().unwrap();
+    assert!(edges >= 1);
+    assert_eq!(probe["glitches"].as_u64().unwrap(), edges - 1);
+    assert_eq!(v["bounce"]["bounce_count"], 5);
+    assert_eq!(v["bounce"]["outcome"], "stuck");
+    assert!(v["ngspice"]["version"].is_string());
+    assert!(v["ngspice"]["elapsed"].as_f64().unwrap() > 0.0);
+    assert!(v["ngspice"]["points"].as_u64().unwrap() > 100);
+    assert_eq!(probe["ideal"]["edges"], 1);
+    assert_eq!(
+        probe["bounce_added"]["extra_edges"].as_i64().unwrap(),
+        edges as i64 - 1
+    );
+}
+
+#[test]
+fn out_writes_every_artefact_and_never_overwrites_without_force() {
+    let _ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run1");
+    let out_arg = out.to_str().unwrap();
+    chatterspice()
+        .args(["run", "--out", out_arg])
+        .assert()
+        .success();
+    for file in [
+        "report.json",
+        "waveforms.csv",
+        "waveforms_ideal.csv",
+        "netlist.cir",
+        "contact.inc",
+        "plot.svg",
+    ] {
+        assert!(out.join(file).is_file(), "{file} not written");
+    }
+    let deck = std::fs::read_to_string(out.join("netlist.cir")).unwrap();
+    assert!(deck.contains(".include contact.inc"), "{deck}");
+    let csv = std::fs::read_to_string(out.join("waveforms.csv")).unwrap();
+    assert!(
+        csv.starts_with("time,contact_resistance,v(in)\n"),
+        "{}",
+        &csv[..80]
+    );
+    let svg = std::fs::read_to_string(out.join("plot.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+
+    // The netlist written is runnable by hand, as the bundle says.
+    let ng = common::ngspice().unwrap();
+    let rerun = std::process::Command::new(ng.program())
+        .current_dir(&out)
+        .args(["-b", "-r", "again.raw", "netlist.cir"])
+        .output()
+        .unwrap();
+    assert!(rerun.status.success(), "{rerun:?}");
+    assert!(out.join("again.raw").is_file());
+
+    // A second run refuses, names the file, and leaves everything as it was.
+    std::fs::write(out.join("plot.svg"), "my edits").unwrap();
+    let before = std::fs::read(out.join("report.json")).unwrap();
+    chatterspice()
+        .args(["run", "--out", out_arg])
+        .assert()
+        .code(2)
+        .stderr(
+            predicate::str::contains("already exists").and(predicate::str::contains("--force")),
+        );
+    assert_eq!(
+        std::fs::read_to_string(out.join("plot.svg")).unwrap(),
+        "my edits"
+    );
+    assert_eq!(std::fs::read(out.join("report.json")).unwrap(), before);
+    chatterspice()
+        .args(["run", "--out", out_arg, "--force"])
+        .assert()
+        .success();
+    assert_ne!(
+        std::fs::read_to_string(out.join("plot.svg")).unwrap(),
+        "my edits"
+    );
+}
+
+#[test]
+fn a_scenario_without_a_circuit_says_what_to_add() {
+    let dir = tempfile::tempdir().unwrap();
+    let relay = chatterspice::scenario::DEFAULT_SCENARIO_TOML;
+    let path = dir.path().join("no_circuit.toml");
+    std::fs::write(&path, &relay[..relay.find("[circuit]").unwrap()]).unwrap();
+    chatterspice()
+        .args(["run", path.to_str().unwrap()])
+        .assert()
+        .code(2)
+        .stderr(
+            predicate::str::contains("no [circuit]").and(predicate::str::contains("netlist =")),
+        );
+}
+
+#[test]
+fn a_netlist_without_the_contact_names_the_file_and_the_line_to_add() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = scenario_with_netlist(
+        dir.path(),
+        "no contact\nVDD vdd 0 DC 3.3\nR1 vdd sw 10k\n.tran 100n 5m\n.end\n",
+    );
+    let original = std::fs::read(dir.path().join("circuit.cir")).unwrap();
+    chatterspice()
+        .args(["run", scenario.to_str().unwrap()])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("circuit.cir").and(predicate::str::contains("CONTACT")));
+    assert_eq!(
+        std::fs::read(dir.path().join("circuit.cir")).unwrap(),
+        original
+    );
+}
+
+#[test]
+fn a_netlist_ngspice_rejects_gives_ngspice_s_own_words() {
+    let _ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = scenario_with_netlist(
+        dir.path(),
+        "broken\nVDD vdd 0 DC 3.3\nR1 vdd sw 10kk!\nX1 sw 0 CONTACT\nQ1 a b c NOMODEL\n.tran 100n 5m\n.end\n",
+    );
+    chatterspice()
+        .args(["run", scenario.to_str().unwrap()])
+        .assert()
+        .code(2)
+        .stderr(
+            predicate::str::contains("ngspice failed").and(predicate::str::contains("circuit.cir")),
+        );
+}
+
+#[test]
+fn a_hanging_ngspice_is_killed_at_the_timeout() {
+    let _ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    // A 1 fs maximum step over 5 ms: billions of steps.
+    let scenario = scenario_with_netlist(
+        dir.path(),
+        "slow\nVDD vdd 0 DC 3.3\nR1 vdd sw 10k\nC1 sw 0 1n\nX1 sw 0 CONTACT\n.tran 1f 5m 0 1f\n.end\n",
+    );
+    let started = std::time::Instant::now();
+    chatterspice()
+        .args(["run", scenario.to_str().unwrap(), "--timeout", "1"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("timeout"));
+    assert!(started.elapsed().as_secs() < 30, "{:?}", started.elapsed());
+}
+
+#[test]
+fn a_missing_ngspice_says_how_to_install_it() {
+    chatterspice()
+        .args(["run", "--ngspice", "/nonexistent/ngspice"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("apt-get install"));
+}
+
+#[test]
+fn a_bad_timeout_or_element_is_refused() {
+    for bad in [
+        ["--timeout", "0"],
+        ["--timeout", "soon"],
+        ["--element", "relay"],
+    ] {
+        chatterspice()
+            .arg("run")
+            .args(bad)
+            .assert()
+            .code(2)
+            .stderr(predicate::str::contains(bad[1]));
+    }
+}
+
+#[test]
+fn pwl_prints_the_contact_include_the_same_every_time() {
+    let text = stdout_of(&["pwl"]);
+    assert!(text.contains(".subckt CONTACT a b"), "{text}");
+    assert!(text.contains(".ends"), "{text}");
+    assert_eq!(text, stdout_of(&["pwl"]));
+
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("contact.inc");
+    let file_arg = file.to_str().unwrap();
+    chatterspice()
+        .args(["pwl", "-o", file_arg])
+        .assert()
+        .success();
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), text);
+    chatterspice()
+        .args(["pwl", "-o", file_arg])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("already exists"));
+}
+
+#[test]
+fn pwl_takes_a_measured_chatter_sequence() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("scope.csv");
+    std::fs::write(
+        &csv,
+        "time,state\n0,open\n1e-3,closed\n1.1e-3,open\n1.2e-3,closed\n5e-3,closed\n",
+    )
+    .unwrap();
+    let text = stdout_of(&["pwl", "--measured", csv.to_str().unwrap()]);
+    assert!(text.contains(".subckt CONTACT a b"), "{text}");
+    assert!(
+        text.contains("1.1e-3"),
+        "the measured break is in the PWL:\n{text}"
+    );
+
+    std::fs::write(&csv, "time,state\n0,open\n1e-3,shut\n").unwrap();
+    chatterspice()
+        .args(["pwl", "--measured", csv.to_str().unwrap()])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("scope.csv").and(predicate::str::contains("shut")));
+}
+
+#[test]
+fn a_pullup_run_from_a_file_counts_every_bounce() {
+    let _ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = scenario_with_netlist(dir.path(), PULLUP);
+    let v: Value = serde_json::from_str(&stdout_of(&[
+        "run",
+        scenario.to_str().unwrap(),
+        "--format",
+        "json",
+    ]))
+    .unwrap();
+    let bounces = v["bounce"]["bounce_count"].as_u64().unwrap();
+    assert_eq!(v["probes"][0]["edges"].as_u64().unwrap(), 1 + 2 * bounces);
+}
