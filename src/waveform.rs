@@ -39,8 +39,17 @@
 //!
 //! Leading and trailing intervals are kept whatever their length.
 //!
-//! Not implemented yet: the force-dependent (Holm) closed resistance of
-//! model.md §5; the closed conductance is the constant 1/r_closed.
+//! # Force-dependent closed resistance (Holm)
+//! By default a closed contact has the constant resistance `r_closed`.
+//! With a [`Holm`] law (model.md §5) it follows the contact force F: the
+//! constriction resistance of the contact spots falls as the force presses
+//! them wider, R = R_film + R_ref·(F_ref/F)^m, with m = 1/2 for plastic and
+//! 1/3 for elastic spots (Holm, *Electric Contacts*), clamped to `r_open`
+//! as F → 0. Each closed plateau is then sampled at [`Holm`]'s step and the
+//! PWL follows 1/R(F(t)) through it; the make edge ramps from G_open to the
+//! first sample and the break edge from the last. A contact force that
+//! drops to zero or below (Kelvin–Voigt pulls just before release) gives
+//! R_open at that sample: the spot is gone before the contacts part.
 
 use std::path::{Path, PathBuf};
 
@@ -188,6 +197,87 @@ impl ContactModel {
     }
 }
 
+/// The force-dependent closed resistance R(F) = r_film + r_ref·(f_ref/F)^m
+/// (`[contact.holm]` of the scenario). SI units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Holm {
+    /// Ω, ≥ 0: the film (and bulk) resistance that no force removes.
+    pub r_film: f64,
+    /// Ω, > 0: the constriction resistance at `f_ref`.
+    pub r_ref: f64,
+    /// N, > 0.
+    pub f_ref: f64,
+    /// m, in (0, 1]: 1/2 for plastic contact spots, 1/3 for elastic.
+    pub exponent: f64,
+}
+
+impl Holm {
+    /// Check every parameter; the error names its scenario key.
+    pub fn validate(&self) -> Result<(), WaveformError> {
+        let check = |key: &'static str, value: f64, ok: bool, requirement: &str| {
+            if value.is_finite() && ok {
+                Ok(())
+            } else {
+                Err(WaveformError::InvalidContact {
+                    key,
+                    value,
+                    requirement: requirement.to_owned(),
+                })
+            }
+        };
+        check(
+            "contact.holm.r_film",
+            self.r_film,
+            self.r_film >= 0.0,
+            "must be a finite value >= 0: the film resistance, in Ω",
+        )?;
+        check(
+            "contact.holm.r_ref",
+            self.r_ref,
+            self.r_ref > 0.0,
+            "must be a finite value > 0: the constriction resistance at `f_ref`, in Ω",
+        )?;
+        check(
+            "contact.holm.f_ref",
+            self.f_ref,
+            self.f_ref > 0.0,
+            "must be a finite value > 0: the force at which the constriction is `r_ref`, in N",
+        )?;
+        check(
+            "contact.holm.exponent",
+            self.exponent,
+            self.exponent > 0.0 && self.exponent <= 1.0,
+            "must be in (0, 1]: 0.5 for plastic contact spots, 1/3 for elastic",
+        )
+    }
+
+    /// Ω at contact force `force` (N), at most `r_open`; `r_open` when the
+    /// force is zero or pulls.
+    pub fn resistance(&self, force: f64, r_open: f64) -> f64 {
+        if force > 0.0 {
+            (self.r_film + self.r_ref * (self.f_ref / force).powf(self.exponent)).min(r_open)
+        } else {
+            r_open
+        }
+    }
+}
+
+/// Plateau samples a Holm waveform takes per closure at most; a longer
+/// closure (the final one, usually) is sampled over its start, where the
+/// force still rings, and interpolated to its end, where it has settled.
+pub const HOLM_MAX_SAMPLES: usize = 256;
+
+/// Plateau samples per bounce closure: enough to follow a contact force
+/// that rises and falls once per closure.
+pub const HOLM_SAMPLES_PER_CLOSURE: usize = 16;
+
+/// The closed conductance as the Holm law gives it from the force.
+struct ForceLaw<'a> {
+    holm: &'a Holm,
+    /// N at each of the given times (s, increasing).
+    forces: &'a mut dyn FnMut(&[f64]) -> Vec<f64>,
+}
+
 /// One corner of the piecewise-linear conductance.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Point {
@@ -240,6 +330,24 @@ impl Waveform {
         Waveform::from_intervals(&chatter.intervals, model)
     }
 
+    /// The conductance of an engine result with the force-dependent
+    /// closed resistance of `holm`. `forces` gives the contact force (N)
+    /// at increasing times (s) within the closures, e.g.
+    /// [`mechanics::contact_forces`](crate::mechanics::contact_forces).
+    pub fn from_chatter_holm(
+        chatter: &Chatter,
+        model: &ContactModel,
+        holm: &Holm,
+        mut forces: impl FnMut(&[f64]) -> Vec<f64>,
+    ) -> Result<Waveform, WaveformError> {
+        holm.validate()?;
+        let mut law = ForceLaw {
+            holm,
+            forces: &mut forces,
+        };
+        Waveform::build(&chatter.intervals, model, Some(&mut law))
+    }
+
     /// The conductance of a measured state-change CSV (see
     /// [`read_state_csv`]); `origin` names the file in errors.
     pub fn from_state_changes(
@@ -255,6 +363,14 @@ impl Waveform {
     pub fn from_intervals(
         intervals: &[Interval],
         model: &ContactModel,
+    ) -> Result<Waveform, WaveformError> {
+        Waveform::build(intervals, model, None)
+    }
+
+    fn build(
+        intervals: &[Interval],
+        model: &ContactModel,
+        law: Option<&mut ForceLaw>,
     ) -> Result<Waveform, WaveformError> {
         model.validate()?;
         check_tiling(intervals)?;
@@ -305,38 +421,74 @@ impl Waveform {
         let ends_closed = last.state == ContactState::Closed;
 
         let (g_open, g_closed) = (model.g_open(), model.g_closed());
+        let n = spans.len();
+        // Each span's closed plateau, (start, end): after the make edge (or
+        // from the start of the record) to the start of the break edge (or
+        // the end of the record). A widened touch has start == end.
+        let plateaus: Vec<(f64, f64)> = spans
+            .iter()
+            .enumerate()
+            .map(|(i, span)| {
+                let start = if span.from_start {
+                    t0
+                } else {
+                    span.make + edge
+                };
+                let end = if i + 1 == n && ends_closed {
+                    t_end.max(start)
+                } else {
+                    span.break_start(edge)
+                };
+                (start, end)
+            })
+            .collect();
+        // The closed conductance at each plateau's corners: constant, or
+        // sampled from the force.
+        let samples: Vec<Vec<(f64, f64)>> = match law {
+            None => plateaus
+                .iter()
+                .map(|&(a, b)| {
+                    if b > a {
+                        vec![(a, g_closed), (b, g_closed)]
+                    } else {
+                        vec![(a, g_closed)]
+                    }
+                })
+                .collect(),
+            Some(law) => holm_samples(&plateaus, n > 0 && ends_closed, law, model.r_open),
+        };
+
         let mut w = Waveform {
-            points: Vec::with_capacity(4 * spans.len() + 2),
+            points: Vec::with_capacity(samples.iter().map(Vec::len).sum::<usize>() + 2 * n + 2),
             make_edges: 0,
             break_edges: 0,
             merged_openings,
             widened_closures: 0,
         };
         let starts_closed = spans.first().is_some_and(|s| s.from_start);
-        w.push(t0, if starts_closed { g_closed } else { g_open });
-        let n = spans.len();
-        for (i, span) in spans.iter().enumerate() {
+        if !starts_closed {
+            w.push(t0, g_open);
+        }
+        let mut g_end = g_open;
+        for (i, (span, corners)) in spans.iter().zip(&samples).enumerate() {
             if !span.from_start {
                 w.push(span.make, g_open);
-                w.push(span.make + edge, g_closed);
                 w.make_edges += 1;
             }
+            for &(t, g) in corners {
+                w.push(t, g);
+            }
             if i + 1 == n && ends_closed {
+                g_end = corners.last().map_or(g_closed, |&(_, g)| g);
                 break;
             }
             let b = span.break_start(edge);
             if b > span.release {
                 w.widened_closures += 1;
             }
-            w.push(b, g_closed);
             w.push(b + edge, g_open);
             w.break_edges += 1;
         }
-        let g_end = if ends_closed && n > 0 {
-            g_closed
-        } else {
-            g_open
-        };
         if t_end > w.points[w.points.len() - 1].time {
             w.push(t_end, g_end);
         }
@@ -424,6 +576,63 @@ impl Waveform {
         }
         out
     }
+}
+
+/// The Holm conductance at sample times across each plateau. The step is
+/// a [`HOLM_SAMPLES_PER_CLOSURE`]th of the shortest bounce closure (or a
+/// [`HOLM_MAX_SAMPLES`]th of the only closure), and no plateau takes more
+/// than [`HOLM_MAX_SAMPLES`] samples: past them the last sample is the
+/// plateau's end. `final_closed`: the last plateau runs to the end of the
+/// record rather than to a break.
+fn holm_samples(
+    plateaus: &[(f64, f64)],
+    final_closed: bool,
+    law: &mut ForceLaw,
+    r_open: f64,
+) -> Vec<Vec<(f64, f64)>> {
+    let bounces = if final_closed {
+        &plateaus[..plateaus.len().saturating_sub(1)]
+    } else {
+        plateaus
+    };
+    let shortest = bounces
+        .iter()
+        .map(|(a, b)| b - a)
+        .filter(|&d| d > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    let step = if shortest.is_finite() {
+        shortest / HOLM_SAMPLES_PER_CLOSURE as f64
+    } else {
+        plateaus
+            .last()
+            .map_or(0.0, |(a, b)| (b - a) / HOLM_MAX_SAMPLES as f64)
+    };
+    let times: Vec<Vec<f64>> = plateaus
+        .iter()
+        .map(|&(a, b)| {
+            let mut ts = vec![a];
+            if b > a && step > 0.0 {
+                let k = (((b - a) / step).ceil() as usize).clamp(1, HOLM_MAX_SAMPLES - 1);
+                ts.extend((1..k).map(|j| a + j as f64 * step).filter(|&t| t < b));
+                ts.push(b);
+            }
+            ts
+        })
+        .collect();
+    let all: Vec<f64> = times.iter().flatten().copied().collect();
+    let forces = (law.forces)(&all);
+    let mut forces = forces.into_iter();
+    times
+        .into_iter()
+        .map(|ts| {
+            ts.into_iter()
+                .map(|t| {
+                    let f = forces.next().unwrap_or(0.0);
+                    (t, 1.0 / law.holm.resistance(f, r_open))
+                })
+                .collect()
+        })
+        .collect()
 }
 
 /// A number in the shortest form that reads back to the same f64
@@ -870,5 +1079,134 @@ mod tests {
         );
         let msg = csv("time,state\n0,open\nx,open\n").unwrap_err().to_string();
         assert!(msg.starts_with("scope.csv: line 3: time `x`"), "{msg}");
+    }
+
+    const HOLM: Holm = Holm {
+        r_film: 0.01,
+        r_ref: 0.04,
+        f_ref: 1.0,
+        exponent: 0.5,
+    };
+
+    #[test]
+    fn holm_resistance_follows_the_force_and_is_clamped_to_open() {
+        let r = |f| HOLM.resistance(f, MODEL.r_open);
+        assert_eq!(r(1.0), 0.05);
+        assert_eq!(r(4.0), 0.01 + 0.04 / 2.0);
+        assert_eq!(r(0.0), MODEL.r_open);
+        assert_eq!(r(-0.3), MODEL.r_open);
+        assert_eq!(r(1e-40), MODEL.r_open);
+        assert!(r(0.25) > r(1.0) && r(1.0) > r(100.0));
+    }
+
+    #[test]
+    fn holm_parameters_are_checked_by_key() {
+        for (bad, key) in [
+            (
+                Holm {
+                    r_film: -1.0,
+                    ..HOLM
+                },
+                "contact.holm.r_film",
+            ),
+            (Holm { r_ref: 0.0, ..HOLM }, "contact.holm.r_ref"),
+            (
+                Holm {
+                    f_ref: f64::NAN,
+                    ..HOLM
+                },
+                "contact.holm.f_ref",
+            ),
+            (
+                Holm {
+                    exponent: 1.5,
+                    ..HOLM
+                },
+                "contact.holm.exponent",
+            ),
+        ] {
+            let err = bad.validate().unwrap_err();
+            assert!(err.to_string().contains(key), "{err}");
+        }
+    }
+
+    /// A sequence with 3 bounce closures of different lengths, then closed.
+    fn bouncing() -> Chatter {
+        let mut c = crate::report::fixtures::stuck();
+        c.intervals = tiling(
+            ContactState::Open,
+            &[
+                0.0, 1.0e-3, 1.05e-3, 1.3e-3, 1.33e-3, 1.5e-3, 1.52e-3, 1.6e-3, 5e-3,
+            ],
+        );
+        c
+    }
+
+    /// A force that rises and falls within each closure, and settles.
+    fn ringing_force(t: f64) -> f64 {
+        0.5 + 0.4 * (2e4 * t).sin()
+    }
+
+    #[test]
+    fn a_holm_contact_follows_the_force_at_every_sample() {
+        let c = bouncing();
+        let mut asked = Vec::new();
+        let w = Waveform::from_chatter_holm(&c, &MODEL, &HOLM, |ts| {
+            asked.extend_from_slice(ts);
+            ts.iter().map(|&t| ringing_force(t)).collect()
+        })
+        .unwrap();
+        assert_increasing(&w);
+        let plain = Waveform::from_chatter(&c, &MODEL).unwrap();
+        assert_eq!(w.make_edges(), plain.make_edges());
+        assert_eq!(w.break_edges(), plain.break_edges());
+        assert!(
+            asked.windows(2).all(|p| p[1] > p[0]),
+            "times asked in order"
+        );
+        // Every time asked for is a corner with the Holm conductance.
+        for t in &asked {
+            let expected = 1.0 / HOLM.resistance(ringing_force(*t), MODEL.r_open);
+            assert_eq!(w.conductance_at(*t), expected, "at {t}");
+        }
+        // The shortest closure (20 µs) gets its 16 samples and more: its
+        // plateau has at least 16 corners.
+        let in_shortest = asked.iter().filter(|&&t| t > 1.5e-3 && t < 1.52e-3).count();
+        assert!(in_shortest >= HOLM_SAMPLES_PER_CLOSURE, "{in_shortest}");
+        // The final closure is capped, and ends at the end of the record.
+        let in_final = asked.iter().filter(|&&t| t > 1.6e-3).count();
+        assert!(in_final <= HOLM_MAX_SAMPLES, "{in_final}");
+        assert_eq!(*asked.last().unwrap(), 5e-3);
+        // Open stays open.
+        assert_eq!(w.conductance_at(1.2e-3), MODEL.g_open());
+    }
+
+    #[test]
+    fn a_constant_force_gives_the_constant_contact_of_its_resistance() {
+        let c = bouncing();
+        let w = Waveform::from_chatter_holm(&c, &MODEL, &HOLM, |ts| vec![4.0; ts.len()]).unwrap();
+        let equivalent = ContactModel {
+            r_closed: HOLM.resistance(4.0, MODEL.r_open),
+            ..MODEL
+        };
+        let plain = Waveform::from_chatter(&c, &equivalent).unwrap();
+        for k in 0..5000 {
+            let t = k as f64 * 1e-6;
+            let (a, b) = (w.conductance_at(t), plain.conductance_at(t));
+            assert!((a - b).abs() <= 1e-12 * b.abs(), "at {t}: {a} vs {b}");
+        }
+    }
+
+    #[test]
+    fn a_pulling_force_opens_the_contact_electrically() {
+        let c = bouncing();
+        let w = Waveform::from_chatter_holm(&c, &MODEL, &HOLM, |ts| {
+            ts.iter()
+                .map(|&t| if t < 1.02e-3 { 1.0 } else { -0.1 })
+                .collect()
+        })
+        .unwrap();
+        assert_eq!(w.conductance_at(1.01e-3), 1.0 / 0.05);
+        assert_eq!(w.conductance_at(1.04e-3), MODEL.g_open());
     }
 }
