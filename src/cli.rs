@@ -309,7 +309,7 @@ fn pwl(args: &PwlArgs) -> Result<()> {
                     scenario.origin.display()
                 )
             })?;
-            Waveform::from_chatter(&chatter, &model)?
+            pipeline::contact_waveform(&scenario, &chatter)?.0
         }
     };
     let subckt = scenario

@@ -24,12 +24,12 @@ use thiserror::Error;
 
 use crate::analysis::{self, AnalysisError, Comparison, ProbeAnalysis};
 use crate::chatter::{Chatter, ContactState, Interval};
-use crate::mechanics::{MechanicsError, simulate};
+use crate::mechanics::{MechanicsError, contact_forces, simulate};
 use crate::netlist::{self, ContactElement, ContactInclude, Deck, DeckRequest, NetlistError};
 use crate::rawfile::Plot;
 use crate::scenario::{Probe, Scenario, ScenarioError};
 use crate::spice::{RunRequest, Runner, SpiceError};
-use crate::waveform::{ContactModel, Waveform, WaveformError};
+use crate::waveform::{ContactModel, Holm, Waveform, WaveformError};
 
 /// The file name of the contact include in the run's work directory (and
 /// in `--out`), which the deck `.include`s.
@@ -192,12 +192,11 @@ pub fn run(
                 source,
             }
         })?;
-    let model = ContactModel::from(&scenario.contact);
+    let (waveform, model) = contact_waveform(scenario, &chatter)?;
     let waveform_error = |source| RunError::Waveform {
         path: origin.clone(),
         source,
     };
-    let waveform = Waveform::from_chatter(&chatter, &model).map_err(waveform_error)?;
     let include = netlist::contact_include(&waveform, &circuit.subckt, options.element)?;
 
     let signals: Vec<&str> = scenario.probes.iter().map(|p| p.signal.as_str()).collect();
@@ -293,6 +292,52 @@ pub fn run(
         probes,
         warnings,
     })
+}
+
+/// The contact waveform of `chatter` as `scenario`'s `[contact]` section
+/// describes it: constant `r_closed`, or the Holm law on the contact
+/// force. Also returns the model of the ideal contact to compare with,
+/// whose closed resistance is the settled one (for Holm: at the final
+/// contact force).
+pub fn contact_waveform(
+    scenario: &Scenario,
+    chatter: &Chatter,
+) -> Result<(Waveform, ContactModel), RunError> {
+    let origin = &scenario.origin;
+    let mut model = ContactModel::from(&scenario.contact);
+    let waveform_error = |source| RunError::Waveform {
+        path: origin.clone(),
+        source,
+    };
+    let mechanics_error = |source| RunError::Mechanics {
+        path: origin.clone(),
+        source,
+    };
+    let Some(holm) = scenario.contact.holm.as_ref().map(Holm::from) else {
+        let waveform = Waveform::from_chatter(chatter, &model).map_err(waveform_error)?;
+        return Ok((waveform, model));
+    };
+    let mechanics = scenario.mechanics()?;
+    let surface = scenario.surface();
+    let mut failure = None;
+    let waveform = Waveform::from_chatter_holm(chatter, &model, &holm, |times| {
+        contact_forces(&mechanics, &surface, chatter, times).unwrap_or_else(|e| {
+            failure = Some(e);
+            vec![0.0; times.len()]
+        })
+    })
+    .map_err(waveform_error)?;
+    if let Some(e) = failure {
+        return Err(mechanics_error(e));
+    }
+    if chatter.settle_time.is_some() {
+        let settled = contact_forces(&mechanics, &surface, chatter, &[chatter.t_end])
+            .map_err(mechanics_error)?;
+        if settled[0] > 0.0 {
+            model.r_closed = holm.resistance(settled[0], model.r_open);
+        }
+    }
+    Ok((waveform, model))
 }
 
 /// s, the last change of contact state: the circuit must be simulated at

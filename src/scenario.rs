@@ -23,6 +23,7 @@ use toml::de::{DeTable, DeValue};
 
 use crate::mechanics::surface::hunt_crossley_chi;
 use crate::mechanics::{Mechanics, Settings, Surface};
+use crate::waveform::Holm;
 
 /// The text of the built-in scenario: a small signal relay switching an
 /// MCU input. Exposed so that a command can write it out for the user to
@@ -162,6 +163,40 @@ pub struct ContactSection {
     pub r_open: f64,
     /// s, duration of each make or break edge.
     pub edge_time: f64,
+    /// `[contact.holm]`: the closed resistance follows the contact force
+    /// instead of being `r_closed`.
+    pub holm: Option<HolmSection>,
+}
+
+/// `[contact.holm]`: R = r_film + r_ref·(f_ref/F)^exponent (model.md §5).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HolmSection {
+    /// Ω, the film resistance no force removes (default 0).
+    #[serde(default)]
+    pub r_film: f64,
+    /// Ω, the constriction resistance at `f_ref`.
+    pub r_ref: f64,
+    /// N
+    pub f_ref: f64,
+    /// 1/2 for plastic contact spots (default), 1/3 for elastic.
+    #[serde(default = "default_holm_exponent")]
+    pub exponent: f64,
+}
+
+fn default_holm_exponent() -> f64 {
+    0.5
+}
+
+impl From<&HolmSection> for Holm {
+    fn from(h: &HolmSection) -> Holm {
+        Holm {
+            r_film: h.r_film,
+            r_ref: h.r_ref,
+            f_ref: h.f_ref,
+            exponent: h.exponent,
+        }
+    }
 }
 
 impl Default for ContactSection {
@@ -173,6 +208,7 @@ impl Default for ContactSection {
             r_closed: 0.05,
             r_open: 1.0e9,
             edge_time: 1.0e-8,
+            holm: None,
         }
     }
 }
@@ -1097,6 +1133,33 @@ impl Check<'_> {
             c.edge_time,
             c.edge_time > 0.0,
             "must be > 0: the duration of each make or break edge, in s",
+        )?;
+        let Some(h) = &c.holm else {
+            return Ok(());
+        };
+        self.number(
+            "contact.holm.r_film",
+            h.r_film,
+            h.r_film >= 0.0,
+            "must be >= 0: the film resistance that no force removes, in Ω",
+        )?;
+        self.number(
+            "contact.holm.r_ref",
+            h.r_ref,
+            h.r_ref > 0.0,
+            "must be > 0: the constriction resistance at `f_ref`, in Ω",
+        )?;
+        self.number(
+            "contact.holm.f_ref",
+            h.f_ref,
+            h.f_ref > 0.0,
+            "must be > 0: the contact force at which the constriction is `r_ref`, in N",
+        )?;
+        self.number(
+            "contact.holm.exponent",
+            h.exponent,
+            h.exponent > 0.0 && h.exponent <= 1.0,
+            "must be in (0, 1]: 0.5 for plastic contact spots, 1/3 (0.3333) for elastic",
         )
     }
 
@@ -1692,6 +1755,32 @@ high = 2.31
         fails_on(&with("r_closed = 10.0\nr_open = 10.0"), "contact.r_open");
         fails_on(&with("r_open = inf"), "contact.r_open");
         fails_on(&with("edge_time = 0.0"), "contact.edge_time");
+
+        let holm = |body: &str| format!("{VALID}\n[contact.holm]\n{body}\n");
+        let s = parse(&holm("r_ref = 0.04\nf_ref = 1.0")).unwrap();
+        assert_eq!(
+            s.contact.holm,
+            Some(HolmSection {
+                r_film: 0.0,
+                r_ref: 0.04,
+                f_ref: 1.0,
+                exponent: 0.5
+            })
+        );
+        fails_on(&holm("r_ref = 0.0\nf_ref = 1.0"), "contact.holm.r_ref");
+        fails_on(&holm("r_ref = 0.04\nf_ref = -1.0"), "contact.holm.f_ref");
+        fails_on(
+            &holm("r_ref = 0.04\nf_ref = 1.0\nr_film = -0.01"),
+            "contact.holm.r_film",
+        );
+        fails_on(
+            &holm("r_ref = 0.04\nf_ref = 1.0\nexponent = 2.0"),
+            "contact.holm.exponent",
+        );
+        fails_on(
+            &holm("r_ref = 0.04\nf_ref = 1.0\nfilm = 0.01"),
+            "contact.holm.film",
+        );
     }
 
     #[test]

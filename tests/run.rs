@@ -225,3 +225,42 @@ fn the_capacitive_load_takes_its_charge_in_several_bites() {
     assert_eq!(v.analysis.edges, 1);
     assert_eq!(v.comparison.as_ref().unwrap().extra_edges, 0);
 }
+
+#[test]
+fn a_holm_contact_settles_at_the_resistance_of_its_static_force() {
+    let ng = ngspice_or_skip!();
+    let base = default_relay_on(
+        &data("tests/data/run/pullup.cir"),
+        "[[probe]]\nsignal = \"v(sw)\"\nlow = 0.99\nhigh = 2.31\n",
+    );
+    // A poor contact, so that the force-dependent resistance shows
+    // against the 10 kΩ pull-up: 100 Ω at 0.1 N, plastic spots.
+    let mut scenario = base;
+    scenario.contact.holm = Some(chatterspice::scenario::HolmSection {
+        r_film: 1.0,
+        r_ref: 100.0,
+        f_ref: 0.1,
+        exponent: 0.5,
+    });
+    let result = run(&ng, &scenario);
+    let probe = &result.probes[0].analysis;
+    assert_eq!(probe.edges, 1 + 2 * result.chatter.bounce_count);
+
+    // Settled: spring and surface share the overtravel (default relay:
+    // s = 5000 N/m, f = 1 N, g = 0.14 mm, s0 = 5e5 N/m), and the divider
+    // with the pull-up gives the node voltage.
+    let force: f64 = 5e5 * (1.0 - 5000.0 * 1.4e-4) / (5000.0 + 5e5);
+    let r = 1.0 + 100.0 * (0.1 / force).sqrt();
+    let expected = 3.3 * r / (r + 10e3);
+    assert!(
+        (probe.final_value / expected - 1.0).abs() < 1e-3,
+        "{} V vs {expected} V",
+        probe.final_value
+    );
+    // The ideal contact closes at that same settled resistance.
+    let ideal = result.probes[0].ideal.as_ref().unwrap();
+    assert!((ideal.final_value / expected - 1.0).abs() < 1e-3);
+    // While bouncing, the force rises above its settled value, so the
+    // node dips below its settled voltage.
+    assert!(probe.min < 0.9 * expected, "{} vs {expected}", probe.min);
+}

@@ -21,6 +21,7 @@
 //! force the fixed contact puts on the moving one, positive pushing back.
 
 pub mod engine;
+pub mod force;
 pub mod hunt_crossley;
 pub mod integrate;
 pub mod linear;
@@ -30,6 +31,7 @@ pub mod surface;
 pub use engine::{
     ImpactResponse, ResponseEnd, critical_impact_speed, impact_response, simulate, validate,
 };
+pub use force::contact_forces;
 pub use surface::Surface;
 
 use thiserror::Error;
