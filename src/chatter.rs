@@ -133,3 +133,100 @@ pub struct Chatter {
     /// s, the simulated horizon.
     pub t_end: f64,
 }
+
+impl Chatter {
+    /// The summary of a recorded sequence of states (e.g. a scope capture)
+    /// that tiles its record in order: `first_impact` is the first closed
+    /// interval, `settle_time` the start of a final closed one, and a
+    /// bounce every opening after the first impact. The outcome is `stuck`
+    /// when the record ends closed (closed to the end of what was seen),
+    /// `ends_open` when it ends open after closing, `never_closes` when it
+    /// never closes. There are no impacts: a record of states has no
+    /// velocities or forces.
+    pub fn from_intervals(intervals: Vec<Interval>) -> Chatter {
+        let first_impact = intervals
+            .iter()
+            .find(|i| i.state == ContactState::Closed)
+            .map(|i| i.start);
+        let last = intervals.last().copied();
+        let ends_closed = last.is_some_and(|i| i.state == ContactState::Closed);
+        let bounce_count = match first_impact {
+            Some(first) => intervals
+                .iter()
+                .filter(|i| i.state == ContactState::Open && i.start >= first)
+                .count(),
+            None => 0,
+        };
+        Chatter {
+            outcome: match (first_impact, ends_closed) {
+                (None, _) => Outcome::NeverCloses,
+                (Some(_), true) => Outcome::Stuck,
+                (Some(_), false) => Outcome::EndsOpen,
+            },
+            first_impact,
+            settle_time: if ends_closed {
+                last.map(|i| i.start)
+            } else {
+                None
+            },
+            bounce_count,
+            impacts: Vec::new(),
+            shortfall: None,
+            accumulation_time: None,
+            t_end: last.map_or(0.0, |i| i.end),
+            intervals,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tiling(first: ContactState, bounds: &[f64]) -> Vec<Interval> {
+        let mut state = first;
+        bounds
+            .windows(2)
+            .map(|w| {
+                let iv = Interval {
+                    state,
+                    start: w[0],
+                    end: w[1],
+                };
+                state = match state {
+                    ContactState::Open => ContactState::Closed,
+                    ContactState::Closed => ContactState::Open,
+                };
+                iv
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_recorded_sequence_is_summarised_like_the_engine_s() {
+        let c = Chatter::from_intervals(tiling(
+            ContactState::Open,
+            &[0.0, 1.0, 1.1, 1.5, 1.6, 1.8, 5.0],
+        ));
+        assert_eq!(c.outcome, Outcome::Stuck);
+        assert_eq!(c.first_impact, Some(1.0));
+        assert_eq!(c.settle_time, Some(1.8));
+        assert_eq!(c.bounce_count, 2);
+        assert_eq!(c.t_end, 5.0);
+        assert!(c.impacts.is_empty());
+
+        let open = Chatter::from_intervals(tiling(ContactState::Open, &[0.0, 1.0, 1.1, 2.0]));
+        assert_eq!(open.outcome, Outcome::EndsOpen);
+        assert_eq!(open.settle_time, None);
+        assert_eq!(open.bounce_count, 1);
+
+        let never = Chatter::from_intervals(tiling(ContactState::Open, &[0.0, 2.0]));
+        assert_eq!(never.outcome, Outcome::NeverCloses);
+        assert_eq!((never.first_impact, never.bounce_count), (None, 0));
+
+        // Closed from the start of the record: no bounce before it opens.
+        let closed = Chatter::from_intervals(tiling(ContactState::Closed, &[0.0, 1.0, 1.2, 3.0]));
+        assert_eq!(closed.first_impact, Some(0.0));
+        assert_eq!(closed.bounce_count, 1);
+    }
+}

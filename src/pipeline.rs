@@ -93,6 +93,12 @@ pub enum RunError {
         path.display()
     )]
     NoProbes { path: PathBuf },
+    #[error(
+        "{}: [contact.holm] needs the contact force, which a measured chatter sequence \
+         does not have: remove [contact.holm] (r_closed is used) or simulate the relay",
+        path.display()
+    )]
+    HolmNeedsForce { path: PathBuf },
     #[error(transparent)]
     Netlist(#[from] NetlistError),
     #[error("ngspice failed on the {run} run of {}", netlist.display())]
@@ -169,30 +175,82 @@ pub fn run(
     runner: &dyn Runner,
     options: &RunOptions,
 ) -> Result<RunResult, RunError> {
+    check_circuit(scenario)?;
+    let mechanics = scenario.mechanics()?;
+    let chatter =
+        simulate(&mechanics, &scenario.surface(), &scenario.settings()).map_err(|source| {
+            RunError::Mechanics {
+                path: scenario.origin.clone(),
+                source,
+            }
+        })?;
+    let (waveform, model) = contact_waveform(scenario, &chatter)?;
+    run_chatter(scenario, chatter, waveform, &model, runner, options)
+}
+
+/// [`run`] with a measured chatter sequence (e.g. from
+/// [`read_state_csv`](crate::waveform::read_state_csv)) instead of the
+/// mechanics: `scenario` supplies the contact, the circuit and the probes.
+/// The result's chatter has the intervals and the summary but no impacts
+/// (a record of states has no velocities or forces), so a `[contact.holm]`
+/// law, which needs the force, is refused.
+pub fn run_measured(
+    scenario: &Scenario,
+    intervals: Vec<Interval>,
+    runner: &dyn Runner,
+    options: &RunOptions,
+) -> Result<RunResult, RunError> {
+    check_circuit(scenario)?;
+    if scenario.contact.holm.is_some() {
+        return Err(RunError::HolmNeedsForce {
+            path: scenario.origin.clone(),
+        });
+    }
+    let chatter = Chatter::from_intervals(intervals);
+    let model = ContactModel::from(&scenario.contact);
+    let waveform = Waveform::from_intervals(&chatter.intervals, &model).map_err(|source| {
+        RunError::Waveform {
+            path: scenario.origin.clone(),
+            source,
+        }
+    })?;
+    run_chatter(scenario, chatter, waveform, &model, runner, options)
+}
+
+/// The scenario has what `run` needs besides the relay.
+fn check_circuit(scenario: &Scenario) -> Result<(), RunError> {
+    if scenario.circuit.is_none() {
+        return Err(RunError::NoCircuit {
+            path: scenario.origin.clone(),
+        });
+    }
+    if scenario.probes.is_empty() {
+        return Err(RunError::NoProbes {
+            path: scenario.origin.clone(),
+        });
+    }
+    Ok(())
+}
+
+/// From the contact waveform on: include, deck, both ngspice runs, probes.
+/// `model` is the ideal contact's.
+fn run_chatter(
+    scenario: &Scenario,
+    chatter: Chatter,
+    waveform: Waveform,
+    model: &ContactModel,
+    runner: &dyn Runner,
+    options: &RunOptions,
+) -> Result<RunResult, RunError> {
     let origin = &scenario.origin;
     let (netlist_path, netlist_text) =
         scenario.netlist().ok_or_else(|| RunError::NoCircuit {
             path: origin.clone(),
         })??;
-    if scenario.probes.is_empty() {
-        return Err(RunError::NoProbes {
-            path: origin.clone(),
-        });
-    }
     let circuit = scenario
         .circuit
         .as_ref()
         .expect("netlist() returned Some, so there is a [circuit]");
-
-    let mechanics = scenario.mechanics()?;
-    let chatter =
-        simulate(&mechanics, &scenario.surface(), &scenario.settings()).map_err(|source| {
-            RunError::Mechanics {
-                path: origin.clone(),
-                source,
-            }
-        })?;
-    let (waveform, model) = contact_waveform(scenario, &chatter)?;
     let waveform_error = |source| RunError::Waveform {
         path: origin.clone(),
         source,
@@ -215,7 +273,7 @@ pub fn run(
     let ideal_include = match (options.compare_ideal, chatter.first_impact) {
         (true, Some(first_impact)) => {
             let ideal =
-                ideal_waveform(first_impact, chatter.t_end, &model).map_err(waveform_error)?;
+                ideal_waveform(first_impact, chatter.t_end, model).map_err(waveform_error)?;
             Some(netlist::contact_include(
                 &ideal,
                 &circuit.subckt,
