@@ -1,8 +1,10 @@
 //! The contact include: an ngspice file that defines `.subckt <NAME> a b`,
 //! a two-terminal element whose conductance follows a [`Waveform`].
 //!
-//! Four elements are available ([`ContactElement`]); the comparison that
-//! chose the default is in `notes/contact-elements.md`:
+//! Three elements are available ([`ContactElement`]); the comparison that
+//! chose the default is in `notes/contact-elements.md` (which also
+//! measured an XSPICE `filesource`: without breakpoints, G jumps within a
+//! time step and the integrator rings, so it is not offered):
 //!
 //! - [`ContactElement::Pwl`] (default): PWL voltage sources set a control
 //!   node to G(t) in siemens and `B1 a b I = V(a,b) * V(g)` draws the
@@ -15,9 +17,6 @@
 //!   levels. `dac_bridge` posts a breakpoint at each edge start and end,
 //!   so edges are as exact as with PWL, and the cost per time step does
 //!   not grow with the number of bounces. Two-level waveforms only.
-//! - [`ContactElement::FileSource`]: an XSPICE `filesource` reads `t G`
-//!   lines from a data file and drives the same B-source. It sets no
-//!   breakpoints, so it needs a small TMAX ([`ContactInclude::max_step`]).
 //! - [`ContactElement::Switch`]: a PWL control voltage (0 open, 1 closed)
 //!   drives an `sw` switch between r_closed and r_open. Two states only:
 //!   no finite edges, no graded resistance; it flips 60 % into an edge.
@@ -66,9 +65,6 @@ const LINE_WIDTH: usize = 80;
 /// would run out of order.
 const EVENT_MIN_SPACING: f64 = 1e-9;
 
-/// s, the time of the row that ends a filesource data file.
-const FILE_END: f64 = 1e9;
-
 /// How the include models the contact; see the module overview.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum ContactElement {
@@ -77,35 +73,30 @@ pub enum ContactElement {
     Pwl,
     /// XSPICE `d_source` + `dac_bridge` ramps; two-level waveforms only.
     EventRamp,
-    /// XSPICE `filesource` control voltage; needs a small TMAX.
-    FileSource,
     /// `sw` switch on a PWL control voltage; two states, no edges.
     Switch,
 }
 
 impl ContactElement {
-    pub const ALL: [ContactElement; 4] = [
+    pub const ALL: [ContactElement; 3] = [
         ContactElement::Pwl,
         ContactElement::EventRamp,
-        ContactElement::FileSource,
         ContactElement::Switch,
     ];
 
-    /// The name used in options and files: `pwl`, `event-ramp`,
-    /// `filesource`, `switch`.
+    /// The name used in options and files: `pwl`, `event-ramp`, `switch`.
     pub fn as_str(self) -> &'static str {
         match self {
             ContactElement::Pwl => "pwl",
             ContactElement::EventRamp => "event-ramp",
-            ContactElement::FileSource => "filesource",
             ContactElement::Switch => "switch",
         }
     }
 
-    /// Needs ngspice built with XSPICE code models; these set ngspice's
+    /// Needs ngspice built with XSPICE code models, which set ngspice's
     /// TRTOL to 1 for the whole circuit (more, smaller time steps).
     pub fn uses_xspice(self) -> bool {
-        matches!(self, ContactElement::EventRamp | ContactElement::FileSource)
+        self == ContactElement::EventRamp
     }
 }
 
@@ -134,18 +125,13 @@ pub struct ContactInclude {
     /// The include file's text.
     pub text: String,
     /// Data files the include reads, by plain file name relative to the
-    /// directory ngspice runs in: (file name, contents). Empty for
-    /// [`ContactElement::Pwl`] and [`ContactElement::Switch`].
+    /// directory ngspice runs in: (file name, contents). Only
+    /// [`ContactElement::EventRamp`] has one.
     pub data_files: Vec<(String, String)>,
     /// Corners of the waveform.
     pub points: usize,
     /// PWL sources the points were split into (0 when none is used).
     pub pwl_sources: usize,
-    /// s, the largest time step the element tolerates, for elements that
-    /// set no breakpoints ([`ContactElement::FileSource`]): half the
-    /// shortest span of two consecutive segments, so every plateau and
-    /// every opening gets at least one time point.
-    pub max_step: Option<f64>,
 }
 
 /// The include for `waveform` as subcircuit `subckt`, with the default
@@ -183,7 +169,6 @@ pub fn contact_include_split(
     let mut body = String::new();
     let mut data_files = Vec::new();
     let mut pwl_sources = 0;
-    let mut max_step = None;
     let element_line = match element {
         ContactElement::Pwl => {
             let values: Vec<f64> = points.iter().map(|p| p.conductance).collect();
@@ -216,50 +201,6 @@ pub fn contact_include_split(
             }
             "switch: a PWL control V(c) (0 open, 1 closed) drives sw switch S1 \
              (ron = 1/G_max, roff = 1/G_min, flips at 0.6 / 0.4)"
-        }
-        ContactElement::FileSource => {
-            let file = format!("{}_g.txt", subckt.to_ascii_lowercase());
-            let mut data = format!(
-                "# chatterspice: conductance of contact subcircuit {subckt}: t (s), G (S)\n"
-            );
-            if t_first > 0.0 {
-                // filesource starts reading at t = 0.
-                data.push_str(&format!("0e0 {}\n", format_time(points[0].conductance)));
-            }
-            for p in points {
-                data.push_str(&format!(
-                    "{} {}\n",
-                    format_time(p.time),
-                    format_time(p.conductance)
-                ));
-            }
-            // At the end of its file filesource drops its output to 0 V
-            // (measured, ngspice 39): G would fall to zero. A last row far
-            // beyond any stop time holds the final value instead.
-            data.push_str(&format!(
-                "{} {}\n",
-                format_time(FILE_END),
-                format_time(points[points.len() - 1].conductance)
-            ));
-            line(&mut body, "A1 %v([g]) contact_g");
-            line(
-                &mut body,
-                &format!(
-                    ".model contact_g filesource (file=\"{file}\" amploffset=[0] amplscale=[1]"
-                ),
-            );
-            line(
-                &mut body,
-                "+ timeoffset=0 timescale=1 timerelative=false amplstep=false)",
-            );
-            line(&mut body, "B1 a b I = V(a,b) * V(g)");
-            data_files.push((file, data));
-            max_step = points
-                .windows(3)
-                .map(|w| (w[2].time - w[0].time) / 2.0)
-                .reduce(f64::min);
-            "filesource: XSPICE filesource A1 reads V(g) = G (S) from the data file; \
-             B1 draws I = V(a,b) * V(g)"
         }
         ContactElement::EventRamp => {
             let ramps = two_level_ramps(points, g_min, g_max)?;
@@ -321,7 +262,7 @@ pub fn contact_include_split(
              The data file is opened from the directory ngspice runs in.",
         );
     }
-    let mut counts = format!(
+    let counts = format!(
         "{} points, {} PWL source{}, t = {} s to {} s, G = {} S to {} S.",
         points.len(),
         pwl_sources,
@@ -331,12 +272,6 @@ pub fn contact_include_split(
         format_time(g_min),
         format_time(g_max)
     );
-    if let Some(step) = max_step {
-        counts.push_str(&format!(
-            " Sets no breakpoints: use a .tran TMAX of at most {} s.",
-            format_time(step)
-        ));
-    }
     comment(&mut head, &counts);
 
     let mut text = head;
@@ -350,7 +285,6 @@ pub fn contact_include_split(
         data_files,
         points: points.len(),
         pwl_sources,
-        max_step,
     })
 }
 
@@ -736,18 +670,6 @@ mod tests {
         let at_zero = Waveform::from_intervals(&ivs, &MODEL).unwrap();
         let e = contact_include(&at_zero, "C", ContactElement::EventRamp).unwrap_err();
         assert!(e.to_string().contains("use element `pwl`"), "{e}");
-    }
-
-    #[test]
-    fn filesource_needs_a_max_step() {
-        let w = chatter(3);
-        let inc = contact_include(&w, "CONTACT", ContactElement::FileSource).unwrap();
-        // The shortest two-segment span: a break edge and the opening
-        // after it, from the break to the next impact.
-        let step = inc.max_step.unwrap();
-        assert!((step / 5e-6 - 1.0).abs() < 1e-9, "{step:e}");
-        assert_eq!(inc.data_files[0].0, "contact_g.txt");
-        assert!(inc.text.contains("TMAX of at most"));
     }
 
     #[test]

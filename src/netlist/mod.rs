@@ -41,9 +41,7 @@ pub enum NetlistError {
          then letters, digits or `_`) such as CONTACT, instantiated as `X1 a b CONTACT`"
     )]
     BadSubcktName { name: String, problem: &'static str },
-    #[error(
-        "unknown contact element {name:?}: use one of `pwl`, `event-ramp`, `filesource`, `switch`"
-    )]
+    #[error("unknown contact element {name:?}: use one of `pwl`, `event-ramp`, `switch`")]
     UnknownElement { name: String },
     #[error(
         "contact element `{element}` cannot represent this waveform: {reason}; use element `pwl`"
