@@ -479,3 +479,30 @@ fn instance_in_an_included_file_counts() {
         dir.path().join("board.inc").display()
     )));
 }
+
+/// A netlist named by a relative path still gets absolute include paths.
+#[test]
+fn relative_netlist_path_gives_absolute_includes() {
+    let rel = Path::new("tests/data/netlists/kicad.cir");
+    let text = std::fs::read_to_string(rel).unwrap();
+    let deck = prepare_deck(&DeckRequest {
+        netlist_text: &text,
+        netlist_path: rel,
+        include_file_name: "contact.inc",
+        subckt: "CONTACT",
+        probes: &[],
+        chatter_end: 4e-4,
+        stop_at_least: 6e-4,
+    })
+    .unwrap();
+    let lib = std::env::current_dir()
+        .unwrap()
+        .join("tests/data/netlists/models/input_stage.lib");
+    assert!(lib.is_absolute());
+    assert!(
+        deck.text
+            .contains(&format!(".include \"{}\"\n", lib.display())),
+        "{}",
+        deck.text
+    );
+}

@@ -35,11 +35,13 @@
 //! waveform, every corner is still a breakpoint of one source, and as
 //! every term is ≥ 0, G ≥ G_min > 0.
 //!
-//! Measured in ngspice 39, the split removes the deck-reading cost but
-//! not the run cost: a source whose window is over is still scanned to its
-//! end at every step, so the sum of all windows' scans equals the scan of
-//! one long PWL. For thousands of bounces use
-//! [`ContactElement::EventRamp`], whose cost is linear.
+//! Measured in ngspice 39, the split removes the deck-reading cost (40 000
+//! points: 4.2 s to 0.1 s) but not the run cost: a source whose window is
+//! over is still scanned to its end at every step (`VSRCload` only skips
+//! the scan *before* the first point), so the windows together scan as
+//! much as one long PWL. 10 000 bounces take ~77× the time of 1000. For
+//! long sequences [`ContactElement::for_waveform`] picks
+//! [`ContactElement::EventRamp`], whose cost is linear (~6×).
 //!
 //! # Output
 //! The text is deterministic: the same waveform, name and element give the
@@ -52,10 +54,16 @@ use super::NetlistError;
 use crate::waveform::{Point, Waveform, format_time};
 
 /// Points per PWL source before the waveform is split into windows.
-/// 256 points keep each card to ~70 continuation lines (cheap for
-/// ngspice's reader) while a realistic closing (tens of bounces, four
-/// points each) stays one source.
+/// 256 points keep each card to ~70 continuation lines (ngspice joins
+/// them one at a time, quadratically) while a realistic closing (tens of
+/// bounces, four points each) stays one source.
 pub const DEFAULT_POINTS_PER_SOURCE: usize = 256;
+
+/// Above this many points [`ContactElement::for_waveform`] picks
+/// event-ramp. Measured (notes/contact-elements.md): 100 bounces (404
+/// points) run in 0.07 s as PWL and 0.13 s as event-ramp, 1000 bounces
+/// (4004 points) in 2.5 s and 1.1 s; the crossover lies near 500 bounces.
+pub const EVENT_RAMP_ABOVE_POINTS: usize = 2000;
 
 /// Emitted lines stay below this many characters.
 const LINE_WIDTH: usize = 80;
@@ -90,6 +98,22 @@ impl ContactElement {
             ContactElement::Pwl => "pwl",
             ContactElement::EventRamp => "event-ramp",
             ContactElement::Switch => "switch",
+        }
+    }
+
+    /// The element for `waveform`: [`ContactElement::EventRamp`] above
+    /// [`EVENT_RAMP_ABOVE_POINTS`] when it can represent the waveform (the
+    /// PWL's run time grows with points × steps, event-ramp's does not),
+    /// else the default [`ContactElement::Pwl`].
+    pub fn for_waveform(waveform: &Waveform) -> ContactElement {
+        let points = waveform.points();
+        if points.len() <= EVENT_RAMP_ABOVE_POINTS {
+            return ContactElement::Pwl;
+        }
+        let (g_min, g_max) = levels(points);
+        match two_level_ramps(points, g_min, g_max) {
+            Ok(_) => ContactElement::EventRamp,
+            Err(_) => ContactElement::Pwl,
         }
     }
 
@@ -155,14 +179,7 @@ pub fn contact_include_split(
 ) -> Result<ContactInclude, NetlistError> {
     check_subckt_name(subckt)?;
     let points = waveform.points();
-    let g_min = points
-        .iter()
-        .map(|p| p.conductance)
-        .fold(f64::INFINITY, f64::min);
-    let g_max = points
-        .iter()
-        .map(|p| p.conductance)
-        .fold(f64::NEG_INFINITY, f64::max);
+    let (g_min, g_max) = levels(points);
     let (t_first, t_last) = (points[0].time, points[points.len() - 1].time);
 
     let mut head = String::new();
@@ -286,6 +303,15 @@ pub fn contact_include_split(
         points: points.len(),
         pwl_sources,
     })
+}
+
+/// S, the lowest and highest conductance.
+fn levels(points: &[Point]) -> (f64, f64) {
+    points
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p.conductance), hi.max(p.conductance))
+        })
 }
 
 /// A SPICE identifier that is also safe in a file name: a letter or `_`,
@@ -670,6 +696,18 @@ mod tests {
         let at_zero = Waveform::from_intervals(&ivs, &MODEL).unwrap();
         let e = contact_include(&at_zero, "C", ContactElement::EventRamp).unwrap_err();
         assert!(e.to_string().contains("use element `pwl`"), "{e}");
+    }
+
+    #[test]
+    fn long_two_level_waveforms_get_event_ramps() {
+        assert_eq!(
+            ContactElement::for_waveform(&chatter(100)),
+            ContactElement::Pwl
+        );
+        assert_eq!(
+            ContactElement::for_waveform(&chatter(1000)),
+            ContactElement::EventRamp
+        );
     }
 
     #[test]

@@ -573,12 +573,10 @@ fn resolve(written: &str, base: &Path) -> PathBuf {
             return PathBuf::from(home).join(home_rel);
         }
     }
-    let p = Path::new(written);
-    if p.is_absolute() {
-        p.to_path_buf()
-    } else {
-        base.join(p)
-    }
+    let p = base.join(written);
+    // A netlist given by a relative path has a relative directory; the
+    // deck runs elsewhere, so the current directory is joined here.
+    std::path::absolute(&p).unwrap_or(p)
 }
 
 /// Whether an included file (or one it includes) has an `X` card for
