@@ -7,7 +7,7 @@
 //! minutes, far beyond criterion's sampling.
 //!
 //! ```text
-//! cargo bench --bench contact_elements                 # everything (~15 min)
+//! cargo bench --bench contact_elements                 # everything (~8 min)
 //! cargo bench --bench contact_elements -- --quick      # 10 and 100 bounces
 //! cargo bench --bench contact_elements -- --bounces 1000,10000 --elements event-ramp
 //! cargo bench --bench contact_elements -- --only scaling|robustness|reading

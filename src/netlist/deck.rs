@@ -226,7 +226,6 @@ pub fn prepare_deck(req: &DeckRequest<'_>) -> Result<Deck, NetlistError> {
     }
 
     let mut fates: Vec<Fate> = (0..lines.len()).map(|_| Fate::Keep).collect();
-    fates[0] = Fate::Keep;
     // Control blocks and `.end` first: cards are only read outside them.
     let mut live = vec![true; lines.len()];
     live[0] = false;
