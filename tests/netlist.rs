@@ -133,7 +133,6 @@ fn run_pullup(
         probes: &["v(in)"],
         chatter_end: stop,
         stop_at_least: stop,
-        max_step: inc.max_step,
     })
     .unwrap();
     let mut req = RunRequest::new(deck.text.clone());
@@ -268,14 +267,7 @@ fn every_element_shows_exactly_the_waveforms_edges() {
         );
         // Open at the start, closed at the end.
         assert!(v[0] > 3.2 && v[v.len() - 1] < 0.01, "{element}");
-        if element == ContactElement::FileSource {
-            assert!(matches!(
-                deck.warnings[..],
-                [DeckWarning::MaxStepSet { .. }]
-            ));
-        } else {
-            assert!(deck.warnings.is_empty(), "{element}: {:?}", deck.warnings);
-        }
+        assert!(deck.warnings.is_empty(), "{element}: {:?}", deck.warnings);
     }
 }
 
@@ -406,7 +398,6 @@ fn deck_error(file: &str) -> NetlistError {
         probes: &["v(in)"],
         chatter_end: 4e-4,
         stop_at_least: 6e-4,
-        max_step: None,
     })
     .unwrap_err()
 }
@@ -481,11 +472,37 @@ fn instance_in_an_included_file_counts() {
         probes: &[],
         chatter_end: 4e-4,
         stop_at_least: 6e-4,
-        max_step: None,
     })
     .unwrap();
     assert!(deck.text.contains(&format!(
         ".inc \"{}\"",
         dir.path().join("board.inc").display()
     )));
+}
+
+/// A netlist named by a relative path still gets absolute include paths.
+#[test]
+fn relative_netlist_path_gives_absolute_includes() {
+    let rel = Path::new("tests/data/netlists/kicad.cir");
+    let text = std::fs::read_to_string(rel).unwrap();
+    let deck = prepare_deck(&DeckRequest {
+        netlist_text: &text,
+        netlist_path: rel,
+        include_file_name: "contact.inc",
+        subckt: "CONTACT",
+        probes: &[],
+        chatter_end: 4e-4,
+        stop_at_least: 6e-4,
+    })
+    .unwrap();
+    let lib = std::env::current_dir()
+        .unwrap()
+        .join("tests/data/netlists/models/input_stage.lib");
+    assert!(lib.is_absolute());
+    assert!(
+        deck.text
+            .contains(&format!(".include \"{}\"\n", lib.display())),
+        "{}",
+        deck.text
+    );
 }

@@ -1,8 +1,10 @@
 //! The contact include: an ngspice file that defines `.subckt <NAME> a b`,
 //! a two-terminal element whose conductance follows a [`Waveform`].
 //!
-//! Four elements are available ([`ContactElement`]); the comparison that
-//! chose the default is in `notes/contact-elements.md`:
+//! Three elements are available ([`ContactElement`]); the comparison that
+//! chose the default is in `notes/contact-elements.md` (which also
+//! measured an XSPICE `filesource`: without breakpoints, G jumps within a
+//! time step and the integrator rings, so it is not offered):
 //!
 //! - [`ContactElement::Pwl`] (default): PWL voltage sources set a control
 //!   node to G(t) in siemens and `B1 a b I = V(a,b) * V(g)` draws the
@@ -15,9 +17,6 @@
 //!   levels. `dac_bridge` posts a breakpoint at each edge start and end,
 //!   so edges are as exact as with PWL, and the cost per time step does
 //!   not grow with the number of bounces. Two-level waveforms only.
-//! - [`ContactElement::FileSource`]: an XSPICE `filesource` reads `t G`
-//!   lines from a data file and drives the same B-source. It sets no
-//!   breakpoints, so it needs a small TMAX ([`ContactInclude::max_step`]).
 //! - [`ContactElement::Switch`]: a PWL control voltage (0 open, 1 closed)
 //!   drives an `sw` switch between r_closed and r_open. Two states only:
 //!   no finite edges, no graded resistance; it flips 60 % into an edge.
@@ -36,11 +35,13 @@
 //! waveform, every corner is still a breakpoint of one source, and as
 //! every term is ≥ 0, G ≥ G_min > 0.
 //!
-//! Measured in ngspice 39, the split removes the deck-reading cost but
-//! not the run cost: a source whose window is over is still scanned to its
-//! end at every step, so the sum of all windows' scans equals the scan of
-//! one long PWL. For thousands of bounces use
-//! [`ContactElement::EventRamp`], whose cost is linear.
+//! Measured in ngspice 39, the split removes the deck-reading cost (40 000
+//! points: 4.2 s to 0.1 s) but not the run cost: a source whose window is
+//! over is still scanned to its end at every step (`VSRCload` only skips
+//! the scan *before* the first point), so the windows together scan as
+//! much as one long PWL. 10 000 bounces take ~77× the time of 1000. For
+//! long sequences [`ContactElement::for_waveform`] picks
+//! [`ContactElement::EventRamp`], whose cost is linear (~6×).
 //!
 //! # Output
 //! The text is deterministic: the same waveform, name and element give the
@@ -53,10 +54,16 @@ use super::NetlistError;
 use crate::waveform::{Point, Waveform, format_time};
 
 /// Points per PWL source before the waveform is split into windows.
-/// 256 points keep each card to ~70 continuation lines (cheap for
-/// ngspice's reader) while a realistic closing (tens of bounces, four
-/// points each) stays one source.
+/// 256 points keep each card to ~70 continuation lines (ngspice joins
+/// them one at a time, quadratically) while a realistic closing (tens of
+/// bounces, four points each) stays one source.
 pub const DEFAULT_POINTS_PER_SOURCE: usize = 256;
+
+/// Above this many points [`ContactElement::for_waveform`] picks
+/// event-ramp. Measured (notes/contact-elements.md): 100 bounces (404
+/// points) run in 0.07 s as PWL and 0.13 s as event-ramp, 1000 bounces
+/// (4004 points) in 2.5 s and 1.1 s; the crossover lies near 500 bounces.
+pub const EVENT_RAMP_ABOVE_POINTS: usize = 2000;
 
 /// Emitted lines stay below this many characters.
 const LINE_WIDTH: usize = 80;
@@ -66,9 +73,6 @@ const LINE_WIDTH: usize = 80;
 /// would run out of order.
 const EVENT_MIN_SPACING: f64 = 1e-9;
 
-/// s, the time of the row that ends a filesource data file.
-const FILE_END: f64 = 1e9;
-
 /// How the include models the contact; see the module overview.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum ContactElement {
@@ -77,35 +81,46 @@ pub enum ContactElement {
     Pwl,
     /// XSPICE `d_source` + `dac_bridge` ramps; two-level waveforms only.
     EventRamp,
-    /// XSPICE `filesource` control voltage; needs a small TMAX.
-    FileSource,
     /// `sw` switch on a PWL control voltage; two states, no edges.
     Switch,
 }
 
 impl ContactElement {
-    pub const ALL: [ContactElement; 4] = [
+    pub const ALL: [ContactElement; 3] = [
         ContactElement::Pwl,
         ContactElement::EventRamp,
-        ContactElement::FileSource,
         ContactElement::Switch,
     ];
 
-    /// The name used in options and files: `pwl`, `event-ramp`,
-    /// `filesource`, `switch`.
+    /// The name used in options and files: `pwl`, `event-ramp`, `switch`.
     pub fn as_str(self) -> &'static str {
         match self {
             ContactElement::Pwl => "pwl",
             ContactElement::EventRamp => "event-ramp",
-            ContactElement::FileSource => "filesource",
             ContactElement::Switch => "switch",
         }
     }
 
-    /// Needs ngspice built with XSPICE code models; these set ngspice's
+    /// The element for `waveform`: [`ContactElement::EventRamp`] above
+    /// [`EVENT_RAMP_ABOVE_POINTS`] when it can represent the waveform (the
+    /// PWL's run time grows with points × steps, event-ramp's does not),
+    /// else the default [`ContactElement::Pwl`].
+    pub fn for_waveform(waveform: &Waveform) -> ContactElement {
+        let points = waveform.points();
+        if points.len() <= EVENT_RAMP_ABOVE_POINTS {
+            return ContactElement::Pwl;
+        }
+        let (g_min, g_max) = levels(points);
+        match two_level_ramps(points, g_min, g_max) {
+            Ok(_) => ContactElement::EventRamp,
+            Err(_) => ContactElement::Pwl,
+        }
+    }
+
+    /// Needs ngspice built with XSPICE code models, which set ngspice's
     /// TRTOL to 1 for the whole circuit (more, smaller time steps).
     pub fn uses_xspice(self) -> bool {
-        matches!(self, ContactElement::EventRamp | ContactElement::FileSource)
+        self == ContactElement::EventRamp
     }
 }
 
@@ -134,18 +149,13 @@ pub struct ContactInclude {
     /// The include file's text.
     pub text: String,
     /// Data files the include reads, by plain file name relative to the
-    /// directory ngspice runs in: (file name, contents). Empty for
-    /// [`ContactElement::Pwl`] and [`ContactElement::Switch`].
+    /// directory ngspice runs in: (file name, contents). Only
+    /// [`ContactElement::EventRamp`] has one.
     pub data_files: Vec<(String, String)>,
     /// Corners of the waveform.
     pub points: usize,
     /// PWL sources the points were split into (0 when none is used).
     pub pwl_sources: usize,
-    /// s, the largest time step the element tolerates, for elements that
-    /// set no breakpoints ([`ContactElement::FileSource`]): half the
-    /// shortest span of two consecutive segments, so every plateau and
-    /// every opening gets at least one time point.
-    pub max_step: Option<f64>,
 }
 
 /// The include for `waveform` as subcircuit `subckt`, with the default
@@ -169,21 +179,13 @@ pub fn contact_include_split(
 ) -> Result<ContactInclude, NetlistError> {
     check_subckt_name(subckt)?;
     let points = waveform.points();
-    let g_min = points
-        .iter()
-        .map(|p| p.conductance)
-        .fold(f64::INFINITY, f64::min);
-    let g_max = points
-        .iter()
-        .map(|p| p.conductance)
-        .fold(f64::NEG_INFINITY, f64::max);
+    let (g_min, g_max) = levels(points);
     let (t_first, t_last) = (points[0].time, points[points.len() - 1].time);
 
     let mut head = String::new();
     let mut body = String::new();
     let mut data_files = Vec::new();
     let mut pwl_sources = 0;
-    let mut max_step = None;
     let element_line = match element {
         ContactElement::Pwl => {
             let values: Vec<f64> = points.iter().map(|p| p.conductance).collect();
@@ -216,50 +218,6 @@ pub fn contact_include_split(
             }
             "switch: a PWL control V(c) (0 open, 1 closed) drives sw switch S1 \
              (ron = 1/G_max, roff = 1/G_min, flips at 0.6 / 0.4)"
-        }
-        ContactElement::FileSource => {
-            let file = format!("{}_g.txt", subckt.to_ascii_lowercase());
-            let mut data = format!(
-                "# chatterspice: conductance of contact subcircuit {subckt}: t (s), G (S)\n"
-            );
-            if t_first > 0.0 {
-                // filesource starts reading at t = 0.
-                data.push_str(&format!("0e0 {}\n", format_time(points[0].conductance)));
-            }
-            for p in points {
-                data.push_str(&format!(
-                    "{} {}\n",
-                    format_time(p.time),
-                    format_time(p.conductance)
-                ));
-            }
-            // At the end of its file filesource drops its output to 0 V
-            // (measured, ngspice 39): G would fall to zero. A last row far
-            // beyond any stop time holds the final value instead.
-            data.push_str(&format!(
-                "{} {}\n",
-                format_time(FILE_END),
-                format_time(points[points.len() - 1].conductance)
-            ));
-            line(&mut body, "A1 %v([g]) contact_g");
-            line(
-                &mut body,
-                &format!(
-                    ".model contact_g filesource (file=\"{file}\" amploffset=[0] amplscale=[1]"
-                ),
-            );
-            line(
-                &mut body,
-                "+ timeoffset=0 timescale=1 timerelative=false amplstep=false)",
-            );
-            line(&mut body, "B1 a b I = V(a,b) * V(g)");
-            data_files.push((file, data));
-            max_step = points
-                .windows(3)
-                .map(|w| (w[2].time - w[0].time) / 2.0)
-                .reduce(f64::min);
-            "filesource: XSPICE filesource A1 reads V(g) = G (S) from the data file; \
-             B1 draws I = V(a,b) * V(g)"
         }
         ContactElement::EventRamp => {
             let ramps = two_level_ramps(points, g_min, g_max)?;
@@ -321,7 +279,7 @@ pub fn contact_include_split(
              The data file is opened from the directory ngspice runs in.",
         );
     }
-    let mut counts = format!(
+    let counts = format!(
         "{} points, {} PWL source{}, t = {} s to {} s, G = {} S to {} S.",
         points.len(),
         pwl_sources,
@@ -331,12 +289,6 @@ pub fn contact_include_split(
         format_time(g_min),
         format_time(g_max)
     );
-    if let Some(step) = max_step {
-        counts.push_str(&format!(
-            " Sets no breakpoints: use a .tran TMAX of at most {} s.",
-            format_time(step)
-        ));
-    }
     comment(&mut head, &counts);
 
     let mut text = head;
@@ -350,8 +302,16 @@ pub fn contact_include_split(
         data_files,
         points: points.len(),
         pwl_sources,
-        max_step,
     })
+}
+
+/// S, the lowest and highest conductance.
+fn levels(points: &[Point]) -> (f64, f64) {
+    points
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p.conductance), hi.max(p.conductance))
+        })
 }
 
 /// A SPICE identifier that is also safe in a file name: a letter or `_`,
@@ -739,15 +699,15 @@ mod tests {
     }
 
     #[test]
-    fn filesource_needs_a_max_step() {
-        let w = chatter(3);
-        let inc = contact_include(&w, "CONTACT", ContactElement::FileSource).unwrap();
-        // The shortest two-segment span: a break edge and the opening
-        // after it, from the break to the next impact.
-        let step = inc.max_step.unwrap();
-        assert!((step / 5e-6 - 1.0).abs() < 1e-9, "{step:e}");
-        assert_eq!(inc.data_files[0].0, "contact_g.txt");
-        assert!(inc.text.contains("TMAX of at most"));
+    fn long_two_level_waveforms_get_event_ramps() {
+        assert_eq!(
+            ContactElement::for_waveform(&chatter(100)),
+            ContactElement::Pwl
+        );
+        assert_eq!(
+            ContactElement::for_waveform(&chatter(1000)),
+            ContactElement::EventRamp
+        );
     }
 
     #[test]

@@ -19,9 +19,7 @@
 //!   elsewhere, or `quit` before the raw file exists;
 //! - when the netlist has `.save` lines (then ngspice saves only what they
 //!   name), a `.save` for each probe's vectors;
-//! - `.end` and anything after it are dropped, and one `.end` closes the deck;
-//! - with [`DeckRequest::max_step`], a `.tran` whose TMAX is coarser gets
-//!   that TMAX (elements without breakpoints need it).
+//! - `.end` and anything after it are dropped, and one `.end` closes the deck.
 //!
 //! It checks that some `X` card instantiates the contact subcircuit (in the
 //! netlist or, failing that, in the files it includes), that the netlist
@@ -59,9 +57,6 @@ pub struct DeckRequest<'a> {
     /// s, the stop time the caller wants (chatter end plus a margin): a
     /// `.tran` that stops earlier is a warning.
     pub stop_at_least: f64,
-    /// s, the largest internal time step the contact element tolerates
-    /// ([`ContactInclude::max_step`](super::ContactInclude::max_step)).
-    pub max_step: Option<f64>,
 }
 
 /// The run deck and what was noticed on the way.
@@ -97,23 +92,6 @@ impl Tran {
         self.tmax
             .unwrap_or_else(|| self.tstep.min((self.tstop - self.tstart) / 50.0))
     }
-
-    fn card(&self) -> String {
-        let mut s = format!(
-            ".tran {} {} {}",
-            format_time(self.tstep),
-            format_time(self.tstop),
-            format_time(self.tstart)
-        );
-        if let Some(m) = self.tmax {
-            s.push(' ');
-            s.push_str(&format_time(m));
-        }
-        if self.uic {
-            s.push_str(" uic");
-        }
-        s
-    }
 }
 
 /// Something the deck changed or the user may want to change.
@@ -137,14 +115,6 @@ pub enum DeckWarning {
         tstep: f64,
         /// s
         wanted: f64,
-    },
-    MaxStepSet {
-        netlist: PathBuf,
-        line: usize,
-        /// s, the step the netlist's `.tran` allowed.
-        from: f64,
-        /// s, the TMAX the deck uses.
-        to: f64,
     },
     TitleIsCard {
         netlist: PathBuf,
@@ -186,19 +156,6 @@ impl fmt::Display for DeckWarning {
                 format_time(*tstop),
                 format_time(*tstep),
                 format_time(*wanted)
-            ),
-            DeckWarning::MaxStepSet {
-                netlist,
-                line,
-                from,
-                to,
-            } => write!(
-                f,
-                "{}: line {line}: the run uses a `.tran` TMAX of {} s instead of {} s: the \
-                 contact element sets no breakpoints and would step over short openings",
-                netlist.display(),
-                format_time(*to),
-                format_time(*from)
             ),
             DeckWarning::TitleIsCard { netlist, text } => write!(
                 f,
@@ -269,7 +226,6 @@ pub fn prepare_deck(req: &DeckRequest<'_>) -> Result<Deck, NetlistError> {
     }
 
     let mut fates: Vec<Fate> = (0..lines.len()).map(|_| Fate::Keep).collect();
-    fates[0] = Fate::Keep;
     // Control blocks and `.end` first: cards are only read outside them.
     let mut live = vec![true; lines.len()];
     live[0] = false;
@@ -317,7 +273,7 @@ pub fn prepare_deck(req: &DeckRequest<'_>) -> Result<Deck, NetlistError> {
     let cards = cards(&lines, &live);
     let mut instances = 0;
     let mut has_save = false;
-    let mut tran: Option<(Tran, String)> = None;
+    let mut tran: Option<Tran> = None;
     let mut includes: Vec<(usize, PathBuf)> = Vec::new();
     for card in &cards {
         let keyword = card.keyword();
@@ -340,14 +296,14 @@ pub fn prepare_deck(req: &DeckRequest<'_>) -> Result<Deck, NetlistError> {
                 }
             }
             ".tran" => {
-                if let Some((first, _)) = &tran {
+                if let Some(first) = &tran {
                     return Err(NetlistError::TwoTran {
                         netlist,
                         first: first.line,
                         second: card.line(),
                     });
                 }
-                tran = Some((parse_tran(card, &netlist)?, card.text.clone()));
+                tran = Some(parse_tran(card, &netlist)?);
             }
             _ => {
                 if instantiates(&card.text, req.subckt) {
@@ -373,7 +329,7 @@ pub fn prepare_deck(req: &DeckRequest<'_>) -> Result<Deck, NetlistError> {
         }
     }
 
-    let Some((mut tran, _)) = tran else {
+    let Some(tran) = tran else {
         return Err(NetlistError::NoTran {
             netlist,
             stop: req.stop_at_least,
@@ -399,24 +355,6 @@ pub fn prepare_deck(req: &DeckRequest<'_>) -> Result<Deck, NetlistError> {
             wanted: req.stop_at_least,
         });
     }
-    if let Some(max_step) = req.max_step {
-        let from = tran.effective_max_step();
-        if from > max_step {
-            tran.tmax = Some(max_step);
-            let card = cards
-                .iter()
-                .find(|c| c.line() == tran.line)
-                .expect("the .tran card was read from the cards");
-            replace(&mut fates, card, tran.card());
-            warnings.push(DeckWarning::MaxStepSet {
-                netlist: netlist.clone(),
-                line: tran.line,
-                from,
-                to: max_step,
-            });
-        }
-    }
-
     let mut text = String::new();
     text.push_str(title);
     text.push('\n');
@@ -634,12 +572,10 @@ fn resolve(written: &str, base: &Path) -> PathBuf {
             return PathBuf::from(home).join(home_rel);
         }
     }
-    let p = Path::new(written);
-    if p.is_absolute() {
-        p.to_path_buf()
-    } else {
-        base.join(p)
-    }
+    let p = base.join(written);
+    // A netlist given by a relative path has a relative directory; the
+    // deck runs elsewhere, so the current directory is joined here.
+    std::path::absolute(&p).unwrap_or(p)
 }
 
 /// Whether an included file (or one it includes) has an `X` card for
@@ -755,7 +691,6 @@ mod tests {
             probes,
             chatter_end: 5e-3,
             stop_at_least: 8e-3,
-            max_step: None,
         }
     }
 
@@ -909,25 +844,6 @@ mod tests {
             let e = save_names(bad).unwrap_err();
             assert!(e.to_string().contains("`v(node)`"), "{e}");
         }
-    }
-
-    #[test]
-    fn max_step_rewrites_the_tran_card() {
-        let text = "t\nX1 a 0 CONTACT\n.tran 10u 10m uic ; slow\n";
-        let mut r = req(text, &[]);
-        r.max_step = Some(2e-6);
-        let d = prepare_deck(&r).unwrap();
-        assert!(
-            d.text.contains("\n.tran 1e-5 1e-2 0e0 2e-6 uic\n"),
-            "{}",
-            d.text
-        );
-        assert!(matches!(
-            d.warnings[..],
-            [DeckWarning::MaxStepSet { from, to, .. }] if from == 1e-5 && to == 2e-6
-        ));
-        r.max_step = Some(1e-3);
-        assert!(prepare_deck(&r).unwrap().warnings.is_empty());
     }
 
     #[test]

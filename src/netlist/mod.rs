@@ -26,8 +26,8 @@ use thiserror::Error;
 use crate::waveform::format_time;
 
 pub use contact::{
-    ContactElement, ContactInclude, DEFAULT_POINTS_PER_SOURCE, check_subckt_name, contact_include,
-    contact_include_split,
+    ContactElement, ContactInclude, DEFAULT_POINTS_PER_SOURCE, EVENT_RAMP_ABOVE_POINTS,
+    check_subckt_name, contact_include, contact_include_split,
 };
 pub use deck::{Deck, DeckRequest, DeckWarning, Tran, prepare_deck, save_names};
 pub use number::parse_number;
@@ -41,9 +41,7 @@ pub enum NetlistError {
          then letters, digits or `_`) such as CONTACT, instantiated as `X1 a b CONTACT`"
     )]
     BadSubcktName { name: String, problem: &'static str },
-    #[error(
-        "unknown contact element {name:?}: use one of `pwl`, `event-ramp`, `filesource`, `switch`"
-    )]
+    #[error("unknown contact element {name:?}: use one of `pwl`, `event-ramp`, `switch`")]
     UnknownElement { name: String },
     #[error(
         "contact element `{element}` cannot represent this waveform: {reason}; use element `pwl`"
