@@ -21,7 +21,7 @@ use chatterspice::report::{self, Format};
 use chatterspice::scenario::Scenario;
 use chatterspice::simulate;
 use chatterspice::spice::Ngspice;
-use chatterspice::waveform::{ContactModel, Waveform};
+use chatterspice::waveform::{ContactModel, Waveform, read_state_csv};
 
 /// Relay contact bounce from physics, into circuit simulation.
 #[derive(Debug, Parser)]
@@ -102,14 +102,20 @@ pub struct RunArgs {
     #[arg(long, value_name = "S", default_value_t = 60.0, value_parser = parse_timeout)]
     pub timeout: f64,
 
-    /// How the contact is emitted: pwl (default), event-ramp, filesource
-    /// or switch. See the README's comparison.
+    /// How the contact is emitted: pwl, event-ramp or switch [default:
+    /// pwl, or event-ramp for sequences of more than 2000 points]. See the
+    /// README's comparison.
     #[arg(long, value_name = "ELEMENT", value_parser = parse_element)]
     pub element: Option<ContactElement>,
 
     /// Skip the second run with an ideal contact (no comparison).
     #[arg(long)]
     pub no_ideal: bool,
+
+    /// Use a measured chatter sequence instead of the mechanics: a CSV
+    /// `time,state` with one row per state change (open/closed or 0/1).
+    #[arg(long, value_name = "CSV")]
+    pub measured: Option<PathBuf>,
 
     /// Keep ngspice's work directories and print where they are.
     #[arg(long)]
@@ -145,8 +151,9 @@ pub struct PwlArgs {
     #[arg(long, requires = "output")]
     pub force: bool,
 
-    /// How the contact is emitted: pwl (default), event-ramp, filesource
-    /// or switch. Data files an element needs are written next to FILE.
+    /// How the contact is emitted: pwl, event-ramp or switch [default:
+    /// pwl, or event-ramp for sequences of more than 2000 points]. Data
+    /// files an element needs are written next to FILE.
     #[arg(long, value_name = "ELEMENT", value_parser = parse_element)]
     pub element: Option<ContactElement>,
 
@@ -234,10 +241,18 @@ fn run(args: &RunArgs) -> Result<()> {
     let options = RunOptions {
         timeout: Duration::from_secs_f64(args.timeout),
         keep_workdir: args.keep_workdir,
-        element: args.element.unwrap_or_default(),
+        element: args.element,
         compare_ideal: !args.no_ideal,
     };
-    let result = pipeline::run(&scenario, &ngspice, &options)?;
+    let result = match &args.measured {
+        Some(csv) => {
+            let text = std::fs::read_to_string(csv)
+                .with_context(|| format!("{}: cannot read the measured chatter", csv.display()))?;
+            let intervals = read_state_csv(&text, csv)?;
+            pipeline::run_measured(&scenario, intervals, &ngspice, &options)?
+        }
+        None => pipeline::run(&scenario, &ngspice, &options)?,
+    };
     let dimensionless = scenario
         .mechanics()
         .ok()
@@ -316,7 +331,10 @@ fn pwl(args: &PwlArgs) -> Result<()> {
         .circuit
         .as_ref()
         .map_or("CONTACT", |c| c.subckt.as_str());
-    let include = netlist::contact_include(&waveform, subckt, args.element.unwrap_or_default())?;
+    let element = args
+        .element
+        .unwrap_or_else(|| ContactElement::for_waveform(&waveform));
+    let include = netlist::contact_include(&waveform, subckt, element)?;
     if !include.data_files.is_empty() {
         let Some(output) = &args.output else {
             bail!(

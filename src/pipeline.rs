@@ -47,8 +47,10 @@ pub struct RunOptions {
     pub timeout: Duration,
     /// Keep ngspice's work directories (named in the result and in errors).
     pub keep_workdir: bool,
-    /// How the contact is emitted.
-    pub element: ContactElement,
+    /// How the contact is emitted; `None` lets
+    /// [`ContactElement::for_waveform`] choose (PWL, or the event-driven
+    /// ramp for long two-level sequences, where a PWL gets slow).
+    pub element: Option<ContactElement>,
     /// Also run the ideal contact and compare (needs a first impact).
     pub compare_ideal: bool,
 }
@@ -58,7 +60,7 @@ impl Default for RunOptions {
         RunOptions {
             timeout: RunRequest::DEFAULT_TIMEOUT,
             keep_workdir: false,
-            element: ContactElement::default(),
+            element: None,
             compare_ideal: true,
         }
     }
@@ -255,7 +257,10 @@ fn run_chatter(
         path: origin.clone(),
         source,
     };
-    let include = netlist::contact_include(&waveform, &circuit.subckt, options.element)?;
+    let element = options
+        .element
+        .unwrap_or_else(|| ContactElement::for_waveform(&waveform));
+    let include = netlist::contact_include(&waveform, &circuit.subckt, element)?;
 
     let signals: Vec<&str> = scenario.probes.iter().map(|p| p.signal.as_str()).collect();
     let end = chatter_end(&chatter) + model.edge_time;
@@ -267,18 +272,13 @@ fn run_chatter(
         probes: &signals,
         chatter_end: end,
         stop_at_least: end * STOP_MARGIN,
-        max_step: include.max_step,
     })?;
 
     let ideal_include = match (options.compare_ideal, chatter.first_impact) {
         (true, Some(first_impact)) => {
             let ideal =
                 ideal_waveform(first_impact, chatter.t_end, model).map_err(waveform_error)?;
-            Some(netlist::contact_include(
-                &ideal,
-                &circuit.subckt,
-                options.element,
-            )?)
+            Some(netlist::contact_include(&ideal, &circuit.subckt, element)?)
         }
         _ => None,
     };

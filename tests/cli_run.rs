@@ -319,3 +319,33 @@ fn a_pullup_run_from_a_file_counts_every_bounce() {
     let bounces = v["bounce"]["bounce_count"].as_u64().unwrap();
     assert_eq!(v["probes"][0]["edges"].as_u64().unwrap(), 1 + 2 * bounces);
 }
+
+#[test]
+fn run_takes_a_measured_chatter_sequence() {
+    let _ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = scenario_with_netlist(dir.path(), PULLUP);
+    let csv = dir.path().join("scope.csv");
+    // Two bounces of 50 µs, then closed to the end of the record.
+    std::fs::write(
+        &csv,
+        "time,state\n0,open\n1e-3,closed\n1.1e-3,open\n1.15e-3,closed\n1.3e-3,open\n\
+         1.35e-3,closed\n4e-3,closed\n",
+    )
+    .unwrap();
+    let v: Value = serde_json::from_str(&stdout_of(&[
+        "run",
+        scenario.to_str().unwrap(),
+        "--measured",
+        csv.to_str().unwrap(),
+        "--format",
+        "json",
+    ]))
+    .unwrap();
+    assert_eq!(v["bounce"]["bounce_count"], 2);
+    assert_eq!(v["bounce"]["first_impact"], 1e-3);
+    assert_eq!(v["bounce"]["settle_time"], 1.35e-3);
+    assert_eq!(v["probes"][0]["edges"], 5);
+    let first = v["probes"][0]["first_edge"].as_f64().unwrap();
+    assert!((1e-3..1e-3 + 2e-8).contains(&first), "{first}");
+}
