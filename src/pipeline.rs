@@ -28,7 +28,7 @@ use crate::mechanics::{MechanicsError, contact_forces, simulate};
 use crate::netlist::{self, ContactElement, ContactInclude, Deck, DeckRequest, NetlistError};
 use crate::rawfile::Plot;
 use crate::scenario::{Probe, Scenario, ScenarioError};
-use crate::spice::{RunRequest, Runner, SpiceError};
+use crate::spice::{Failure, RunRequest, Runner, SpiceError};
 use crate::waveform::{ContactModel, Holm, Waveform, WaveformError};
 
 /// The file name of the contact include in the run's work directory (and
@@ -103,10 +103,20 @@ pub enum RunError {
     HolmNeedsForce { path: PathBuf },
     #[error(transparent)]
     Netlist(#[from] NetlistError),
-    #[error("ngspice failed on the {run} run of {}", netlist.display())]
+    #[error(
+        "ngspice failed on the {run} run of {}{}",
+        netlist.display(),
+        line.map_or_else(String::new, |l| format!(
+            ": the error is on line {l} of that file (ngspice counts the lines of the \
+             deck it ran, which has the `.include` added)"
+        ))
+    )]
     Spice {
         run: &'static str,
         netlist: PathBuf,
+        /// The netlist's own line, when ngspice named a deck line that
+        /// came from it.
+        line: Option<usize>,
         #[source]
         source: Box<SpiceError>,
     },
@@ -303,9 +313,9 @@ fn run_chatter(
         let ideal = ideal.map(|handle| handle.join().expect("the ideal run does not panic"));
         (bounced, ideal)
     });
-    let simulation = simulation_of("bounced", bounced, &netlist_path)?;
+    let simulation = simulation_of("bounced", bounced, &netlist_path, &deck)?;
     let ideal = ideal
-        .map(|result| simulation_of("ideal", result, &netlist_path))
+        .map(|result| simulation_of("ideal", result, &netlist_path, &deck))
         .transpose()?;
 
     let closures = analysis::closures(&chatter);
@@ -430,11 +440,30 @@ fn simulation_of(
     run: &'static str,
     result: Result<crate::spice::RunOutput, SpiceError>,
     netlist: &std::path::Path,
+    deck: &Deck,
 ) -> Result<Simulation, RunError> {
-    let output = result.map_err(|source| RunError::Spice {
-        run,
-        netlist: netlist.to_owned(),
-        source: Box::new(source),
+    let output = result.map_err(|source| {
+        let line = match source.failure() {
+            Some(Failure::Netlist {
+                line: Some(l),
+                text,
+                ..
+            }) => deck
+                .source_line(*l)
+                // Only when the deck line is the one ngspice echoed.
+                .filter(|_| {
+                    let deck_line = deck.text.lines().nth(l - 1).unwrap_or_default();
+                    text.as_ref()
+                        .is_none_or(|t| deck_line.trim().eq_ignore_ascii_case(t.trim()))
+                }),
+            _ => None,
+        };
+        RunError::Spice {
+            run,
+            netlist: netlist.to_owned(),
+            line,
+            source: Box::new(source),
+        }
     })?;
     let crate::spice::RunOutput {
         raw,

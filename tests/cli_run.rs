@@ -211,7 +211,9 @@ fn a_netlist_ngspice_rejects_gives_ngspice_s_own_words() {
         .assert()
         .code(2)
         .stderr(
-            predicate::str::contains("ngspice failed").and(predicate::str::contains("circuit.cir")),
+            predicate::str::contains("ngspice failed")
+                .and(predicate::str::contains("circuit.cir"))
+                .and(predicate::str::contains("line 5 of that file")),
         );
 }
 

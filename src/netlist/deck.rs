@@ -64,9 +64,22 @@ pub struct DeckRequest<'a> {
 pub struct Deck {
     /// Title line first, `.end` last, `\n` line endings.
     pub text: String,
+    /// For each line of `text`, the 1-based line of the user's netlist it
+    /// came from; `None` for a line chatterspice added.
+    pub source_lines: Vec<Option<usize>>,
     pub warnings: Vec<DeckWarning>,
     /// The analysis the deck runs, as it is in the deck.
     pub tran: Tran,
+}
+
+impl Deck {
+    /// The user's netlist line behind line `deck_line` (1-based, the title
+    /// being line 1, as ngspice counts) of the deck, when it has one.
+    pub fn source_line(&self, deck_line: usize) -> Option<usize> {
+        deck_line
+            .checked_sub(1)
+            .and_then(|i| self.source_lines.get(i).copied().flatten())
+    }
 }
 
 /// A `.tran tstep tstop [tstart [tmax]] [uic]` card. SI units.
@@ -343,7 +356,7 @@ pub fn prepare_deck(req: &DeckRequest<'_>) -> Result<Deck, NetlistError> {
             tstop: tran.tstop,
             tstep: tran.tstep,
             chatter_end: req.chatter_end,
-            stop: req.stop_at_least.max(req.chatter_end),
+            stop: round_up_2(req.stop_at_least.max(req.chatter_end)),
         });
     }
     if tran.tstop < req.stop_at_least {
@@ -352,43 +365,59 @@ pub fn prepare_deck(req: &DeckRequest<'_>) -> Result<Deck, NetlistError> {
             line: tran.line,
             tstop: tran.tstop,
             tstep: tran.tstep,
-            wanted: req.stop_at_least,
+            wanted: round_up_2(req.stop_at_least),
         });
     }
     let mut text = String::new();
-    text.push_str(title);
-    text.push('\n');
-    text.push_str(&format!(
-        "* chatterspice run deck for {}; that file is not modified\n",
-        req.netlist_path.display()
-    ));
-    text.push_str(&format!(
-        ".include {}\n",
-        quote_if_needed(req.include_file_name)
-    ));
-    for (line, fate) in lines.iter().zip(&fates).skip(1) {
+    let mut source_lines = Vec::new();
+    let mut emit = |line: &str, source: Option<usize>| {
+        text.push_str(line);
+        text.push('\n');
+        source_lines.push(source);
+    };
+    emit(title, Some(1));
+    emit(
+        &format!(
+            "* chatterspice run deck for {}; that file is not modified",
+            req.netlist_path.display()
+        ),
+        None,
+    );
+    emit(
+        &format!(".include {}", quote_if_needed(req.include_file_name)),
+        None,
+    );
+    for (index, (line, fate)) in lines.iter().zip(&fates).enumerate().skip(1) {
         match fate {
-            Fate::Keep => {
-                text.push_str(line);
-                text.push('\n');
-            }
+            Fate::Keep => emit(line, Some(index + 1)),
             Fate::Drop => {}
-            Fate::Replace(new) => {
-                text.push_str(new);
-                text.push('\n');
-            }
+            Fate::Replace(new) => emit(new, Some(index + 1)),
         }
     }
     if has_save && !save_lines.is_empty() {
-        text.push_str("* chatterspice: the probes\n");
-        text.push_str(&format!(".save {}\n", save_lines.join(" ")));
+        emit("* chatterspice: the probes", None);
+        emit(&format!(".save {}", save_lines.join(" ")), None);
     }
-    text.push_str(".end\n");
+    emit(".end", None);
     Ok(Deck {
         text,
+        source_lines,
         warnings,
         tran,
     })
+}
+
+/// `t` rounded up to two significant digits (1.4779e-3 → 1.5e-3): a stop
+/// time to suggest, which a person can type.
+fn round_up_2(t: f64) -> f64 {
+    if !(t.is_finite() && t > 0.0) {
+        return t;
+    }
+    let scale = 10f64.powi(t.log10().floor() as i32 - 1);
+    let rounded = (t / scale).ceil() * scale;
+    // Back to the shortest decimal form: 1.5e-3, not 1.5000000000000002e-3.
+    let text = format!("{rounded:.1e}");
+    text.parse::<f64>().map_or(rounded, |r| r.max(t))
 }
 
 /// The vectors a probe needs saved: `v(a,b)` needs both nodes (ground
@@ -680,6 +709,17 @@ fn quote_if_needed(name: &str) -> String {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn suggested_stop_times_are_rounded_up_to_two_digits() {
+        assert_eq!(super::round_up_2(1.4779929920509072e-3), 1.5e-3);
+        assert_eq!(super::round_up_2(1.5e-3), 1.5e-3);
+        assert_eq!(super::round_up_2(9.91e-3), 1e-2);
+        assert_eq!(super::round_up_2(0.02), 0.02);
+        for t in [1.234e-9, 7.77e-4, 3.0000001e-2] {
+            assert!(super::round_up_2(t) >= t);
+        }
+    }
+
     use super::*;
 
     fn req<'a>(text: &'a str, probes: &'a [&'a str]) -> DeckRequest<'a> {
