@@ -244,7 +244,7 @@ fn run(args: &RunArgs) -> Result<()> {
         element: args.element,
         compare_ideal: !args.no_ideal,
     };
-    let result = match &args.measured {
+    let mut result = match &args.measured {
         Some(csv) => {
             let text = std::fs::read_to_string(csv)
                 .with_context(|| format!("{}: cannot read the measured chatter", csv.display()))?;
@@ -253,6 +253,13 @@ fn run(args: &RunArgs) -> Result<()> {
         }
         None => pipeline::run(&scenario, &ngspice, &options)?,
     };
+    // Shown relative to where the user is, when it is below it.
+    if let Some(relative) = std::env::current_dir()
+        .ok()
+        .and_then(|cwd| result.netlist.strip_prefix(cwd).ok().map(Path::to_path_buf))
+    {
+        result.netlist = relative;
+    }
     let dimensionless = scenario
         .mechanics()
         .ok()
