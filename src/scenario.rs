@@ -13,6 +13,7 @@
 //! A validated [`Scenario`] converts into the library's inputs:
 //! [`Scenario::mechanics`], [`Scenario::surface`], [`Scenario::settings`].
 
+use std::collections::BTreeMap;
 use std::fmt;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -288,6 +289,7 @@ struct Document {
     circuit: Option<CircuitSection>,
     #[serde(default)]
     probe: Vec<Probe>,
+    sweep: Option<SweepSection>,
 }
 
 /// A loaded and validated scenario file.
@@ -303,6 +305,8 @@ pub struct Scenario {
     pub circuit: Option<CircuitSection>,
     /// The `[[probe]]` tables, in file order.
     pub probes: Vec<Probe>,
+    /// `[sweep]`, for `chatterspice sweep`.
+    pub sweep: Option<SweepSection>,
     /// Computed once during validation: converting a Hunt–Crossley
     /// restitution into χ is a root solve that can fail.
     resolved_surface: Surface,
@@ -405,6 +409,22 @@ pub enum ScenarioError {
         path.display()
     )]
     CoilDriveUnsupported { path: PathBuf },
+    #[error("{at}: `{key}` is not a number of the scenario{within}; use one of: {known}")]
+    UnknownNumber {
+        at: Location,
+        key: String,
+        /// Where the key was named, e.g. " (in [sweep.vary])"; empty for a
+        /// library call.
+        within: &'static str,
+        /// The keys that are numbers, comma-separated.
+        known: String,
+    },
+    #[error("{at}: `{key}`: {problem}")]
+    Sweep {
+        at: Location,
+        key: String,
+        problem: String,
+    },
     #[error(
         "{}: cannot read the netlist named by `circuit.netlist` in {} \
          (relative paths are relative to the scenario file)",
@@ -429,7 +449,9 @@ impl ScenarioError {
             | ScenarioError::Invalid { key, .. }
             | ScenarioError::Empty { key, .. }
             | ScenarioError::Conflict { key, .. }
-            | ScenarioError::NotForLaw { key, .. } => Some(key),
+            | ScenarioError::NotForLaw { key, .. }
+            | ScenarioError::UnknownNumber { key, .. }
+            | ScenarioError::Sweep { key, .. } => Some(key),
             ScenarioError::Read { .. }
             | ScenarioError::Syntax { .. }
             | ScenarioError::CoilDriveUnsupported { .. } => None,
@@ -479,7 +501,7 @@ impl Scenario {
             netlist: lexically_normal(&base.join(&c.netlist)),
             ..c
         });
-        Ok(Scenario {
+        Scenario {
             origin: origin.to_owned(),
             mechanics: document.mechanics,
             coil: document.coil,
@@ -488,9 +510,11 @@ impl Scenario {
             simulation: document.simulation,
             circuit,
             probes: document.probe,
+            sweep: document.sweep,
             resolved_surface,
             embedded_netlist: None,
-        })
+        }
+        .with_checked_sweep(&check)
     }
 
     /// The built-in scenario (`scenarios/default.toml`, compiled in): a
@@ -1222,6 +1246,547 @@ impl Check<'_> {
     }
 }
 
+// ---------------------------------------------------------------------------
+// `[sweep]` and setting single numbers: what `chatterspice sweep` varies.
+// ---------------------------------------------------------------------------
+
+/// `[sweep]`: a Monte Carlo or grid sweep over the scenario's numbers, for
+/// `chatterspice sweep` (the sampling itself is [`crate::sweep`]).
+///
+/// ```toml
+/// [sweep]
+/// samples = 1000
+/// seed = 7
+/// [sweep.vary]
+/// "mechanics.mass" = 0.1                # ±10 %, uniform
+/// "surface.damping" = { normal = 0.05 } # σ = 5 %, normal
+/// ```
+/// or, instead of `vary`, a grid of one or two keys:
+/// ```toml
+/// [sweep.grid]
+/// "mechanics.force" = { from = 0.5, to = 2.0, steps = 16 }
+/// ```
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepSection {
+    /// Random samples to draw; `None` leaves it to the command line or
+    /// the sweep's default. Not with `grid`, which runs all its points.
+    pub samples: Option<u64>,
+    /// Seed of the random draws; `None` leaves it to the command line or 0.
+    pub seed: Option<u64>,
+    /// Dotted number key (see [`NUMBER_KEYS`]) → its tolerance, sorted by key.
+    #[serde(default)]
+    pub vary: BTreeMap<String, Tolerance>,
+    /// One or two dotted number keys → the values they step through; the
+    /// first key (in sorted order) is the outer loop.
+    #[serde(default)]
+    pub grid: BTreeMap<String, GridAxis>,
+}
+
+/// How far one number varies around its value in the scenario (the
+/// nominal), relative to it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Tolerance {
+    /// `0.1` or `{ uniform = 0.1 }`: uniform within nominal·(1 ± 0.1).
+    /// Must lie in (0, 1), so that the value keeps its sign.
+    Uniform(f64),
+    /// `{ normal = 0.05 }`: normal with mean nominal and σ = 5 % of it,
+    /// truncated at ±4σ. σ must lie in (0, 0.25), so that the value keeps
+    /// its sign.
+    Normal(f64),
+}
+
+impl<'de> Deserialize<'de> for Tolerance {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        use serde::de::{self, MapAccess, Visitor};
+        struct ToleranceVisitor;
+        impl<'de> Visitor<'de> for ToleranceVisitor {
+            type Value = Tolerance;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str(
+                    "a relative tolerance: a number (± uniform, 0.1 = ±10 %), \
+                     { uniform = 0.1 } or { normal = 0.05 } (σ)",
+                )
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<Tolerance, E> {
+                Ok(Tolerance::Uniform(v))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<Tolerance, E> {
+                Ok(Tolerance::Uniform(v as f64))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<Tolerance, E> {
+                Ok(Tolerance::Uniform(v as f64))
+            }
+            fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Tolerance, A::Error> {
+                let mut found = None;
+                while let Some(name) = map.next_key::<String>()? {
+                    let value: f64 = map.next_value()?;
+                    let tolerance = match name.as_str() {
+                        "uniform" => Tolerance::Uniform(value),
+                        "normal" => Tolerance::Normal(value),
+                        // A custom message: serde's unknown-field error would be
+                        // reported at the table, as if its key were the typo.
+                        other => {
+                            return Err(de::Error::custom(format!(
+                                "`{other}` is not a distribution: give {{ uniform = r }} \
+                                 or {{ normal = σ }}"
+                            )));
+                        }
+                    };
+                    if found.replace(tolerance).is_some() {
+                        return Err(de::Error::custom(
+                            "give one distribution: { uniform = r } or { normal = σ }, not both",
+                        ));
+                    }
+                }
+                found.ok_or_else(|| {
+                    de::Error::custom("an empty table: give { uniform = r } or { normal = σ }")
+                })
+            }
+        }
+        deserializer.deserialize_any(ToleranceVisitor)
+    }
+}
+
+/// One axis of `[sweep.grid]`: `steps` values from `from` to `to`, both
+/// included, evenly spaced (geometrically with `log = true`).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GridAxis {
+    pub from: f64,
+    pub to: f64,
+    pub steps: u32,
+    /// Space the values geometrically (e.g. a stiffness over decades).
+    #[serde(default)]
+    pub log: bool,
+}
+
+impl GridAxis {
+    /// The `j`-th value, `0 <= j < steps`; the ends are exact.
+    pub fn value(&self, j: u32) -> f64 {
+        if self.steps <= 1 || j == 0 {
+            return self.from;
+        }
+        if j + 1 >= self.steps {
+            return self.to;
+        }
+        let u = f64::from(j) / f64::from(self.steps - 1);
+        if self.log {
+            self.from * (self.to / self.from).powf(u)
+        } else {
+            self.from + (self.to - self.from) * u
+        }
+    }
+}
+
+/// The number keys that [`Scenario::set_number`] sets and `[sweep]`
+/// varies, besides `probe[N].low` and `probe[N].high`. (`coil.turns` is an
+/// integer and is left out.)
+pub const NUMBER_KEYS: &[&str] = &[
+    "mechanics.mass",
+    "mechanics.stiffness",
+    "mechanics.damping",
+    "mechanics.force",
+    "mechanics.gap",
+    "mechanics.initial_position",
+    "mechanics.initial_velocity",
+    "mechanics.preload",
+    "coil.resistance",
+    "coil.pole_area",
+    "coil.air_gap",
+    "coil.iron_gap",
+    "surface.stiffness",
+    "surface.damping",
+    "surface.restitution",
+    "surface.exponent",
+    "surface.chi",
+    "surface.reference_velocity",
+    "contact.r_closed",
+    "contact.r_open",
+    "contact.edge_time",
+    "contact.holm.r_film",
+    "contact.holm.r_ref",
+    "contact.holm.f_ref",
+    "contact.holm.exponent",
+    "simulation.t_end",
+    "simulation.min_open_time",
+    "simulation.min_gap",
+];
+
+/// Every number key, for messages.
+fn number_keys_described() -> String {
+    let mut known = NUMBER_KEYS.join(", ");
+    known.push_str(", probe[N].low, probe[N].high");
+    known
+}
+
+/// Where a number key lives.
+enum Field<P, O> {
+    /// A number that always has a value.
+    Plain(P),
+    /// A number that may be absent (`mechanics.force`, the surface keys).
+    Optional(O),
+    /// A known key whose section the scenario does not have.
+    NoSection(&'static str),
+    Unknown,
+}
+
+/// The field of `key` in scenario `$s`, borrowed with `$($r)*` (`&` or
+/// `&mut`), so that the getter and the setter share one table.
+macro_rules! number_field {
+    ($s:expr, $key:expr, $($r:tt)*) => {{
+        let s = $s;
+        match $key {
+            "mechanics.mass" => Field::Plain($($r)* s.mechanics.mass),
+            "mechanics.stiffness" => Field::Plain($($r)* s.mechanics.stiffness),
+            "mechanics.damping" => Field::Plain($($r)* s.mechanics.damping),
+            "mechanics.force" => Field::Optional($($r)* s.mechanics.force),
+            "mechanics.gap" => Field::Plain($($r)* s.mechanics.gap),
+            "mechanics.initial_position" => Field::Plain($($r)* s.mechanics.initial_position),
+            "mechanics.initial_velocity" => Field::Plain($($r)* s.mechanics.initial_velocity),
+            "mechanics.preload" => Field::Plain($($r)* s.mechanics.preload),
+            "coil.resistance" | "coil.pole_area" | "coil.air_gap" | "coil.iron_gap" => {
+                match $($r)* s.coil {
+                    Some(c) => Field::Plain(match $key {
+                        "coil.resistance" => $($r)* c.resistance,
+                        "coil.pole_area" => $($r)* c.pole_area,
+                        "coil.air_gap" => $($r)* c.air_gap,
+                        _ => $($r)* c.iron_gap,
+                    }),
+                    None => Field::NoSection("[coil]"),
+                }
+            }
+            "surface.stiffness" => Field::Optional($($r)* s.surface.stiffness),
+            "surface.damping" => Field::Optional($($r)* s.surface.damping),
+            "surface.restitution" => Field::Optional($($r)* s.surface.restitution),
+            "surface.exponent" => Field::Optional($($r)* s.surface.exponent),
+            "surface.chi" => Field::Optional($($r)* s.surface.chi),
+            "surface.reference_velocity" => Field::Optional($($r)* s.surface.reference_velocity),
+            "contact.r_closed" => Field::Plain($($r)* s.contact.r_closed),
+            "contact.r_open" => Field::Plain($($r)* s.contact.r_open),
+            "contact.edge_time" => Field::Plain($($r)* s.contact.edge_time),
+            "contact.holm.r_film" | "contact.holm.r_ref" | "contact.holm.f_ref"
+            | "contact.holm.exponent" => match $($r)* s.contact.holm {
+                Some(h) => Field::Plain(match $key {
+                    "contact.holm.r_film" => $($r)* h.r_film,
+                    "contact.holm.r_ref" => $($r)* h.r_ref,
+                    "contact.holm.f_ref" => $($r)* h.f_ref,
+                    _ => $($r)* h.exponent,
+                }),
+                None => Field::NoSection("[contact.holm]"),
+            },
+            "simulation.t_end" => Field::Plain($($r)* s.simulation.t_end),
+            "simulation.min_open_time" => Field::Plain($($r)* s.simulation.min_open_time),
+            "simulation.min_gap" => Field::Plain($($r)* s.simulation.min_gap),
+            other => match probe_key(other) {
+                Some((i, _)) if i >= s.probes.len() => Field::NoSection("[[probe]] of that number"),
+                Some((i, true)) => Field::Plain($($r)* s.probes[i].low),
+                Some((i, false)) => Field::Plain($($r)* s.probes[i].high),
+                None => Field::Unknown,
+            },
+        }
+    }};
+}
+
+/// `probe[N].low` → (N, true), `probe[N].high` → (N, false).
+fn probe_key(key: &str) -> Option<(usize, bool)> {
+    let rest = key.strip_prefix("probe[")?;
+    let (index, name) = rest.split_once("].")?;
+    let index = index.parse().ok()?;
+    match name {
+        "low" => Some((index, true)),
+        "high" => Some((index, false)),
+        _ => None,
+    }
+}
+
+impl Scenario {
+    /// The value of number `key` (one of [`NUMBER_KEYS`], or
+    /// `probe[N].low`/`.high`); `None` for an optional key the file does
+    /// not give (e.g. `surface.restitution` of a Kelvin–Voigt surface).
+    pub fn number(&self, key: &str) -> Result<Option<f64>, ScenarioError> {
+        match number_field!(self, key, &) {
+            Field::Plain(v) => Ok(Some(*v)),
+            Field::Optional(v) => Ok(*v),
+            Field::NoSection(section) => Err(self.no_section(key, section)),
+            Field::Unknown => Err(self.unknown_number(key, "")),
+        }
+    }
+
+    /// Set number `key` (see [`Scenario::number`]) and validate the
+    /// scenario again by the loader's rules, so that it stays one the file
+    /// could have given (a Hunt–Crossley restitution is converted to χ
+    /// again). On error the scenario is unchanged.
+    pub fn set_number(&mut self, key: &str, value: f64) -> Result<(), ScenarioError> {
+        self.set_numbers(&[(key, value)])
+    }
+
+    /// [`Scenario::set_number`] for several keys at once, validated once
+    /// at the end: a change that is only valid together with another
+    /// (`contact.r_closed` past the old `contact.r_open`) is accepted. On
+    /// error the scenario is unchanged.
+    pub fn set_numbers(&mut self, values: &[(&str, f64)]) -> Result<(), ScenarioError> {
+        let mut old: Vec<(&str, Option<f64>)> = Vec::with_capacity(values.len());
+        let mut failure = None;
+        for &(key, value) in values {
+            match number_field!(&mut *self, key, &mut) {
+                Field::Plain(v) => old.push((key, Some(std::mem::replace(v, value)))),
+                Field::Optional(v) => old.push((key, v.replace(value))),
+                Field::NoSection(section) => {
+                    failure = Some(self.no_section(key, section));
+                    break;
+                }
+                Field::Unknown => {
+                    failure = Some(self.unknown_number(key, ""));
+                    break;
+                }
+            }
+        }
+        let probes = values.iter().any(|(key, _)| key.starts_with("probe["));
+        let result = match failure {
+            Some(e) => Err(e),
+            None => self.revalidate(probes),
+        };
+        match result {
+            Ok(surface) => {
+                self.resolved_surface = surface;
+                Ok(())
+            }
+            Err(e) => {
+                for &(key, value) in old.iter().rev() {
+                    match number_field!(&mut *self, key, &mut) {
+                        Field::Plain(v) => *v = value.expect("a plain number had a value"),
+                        Field::Optional(v) => *v = value,
+                        Field::NoSection(_) | Field::Unknown => {
+                            unreachable!("`{key}` was set above")
+                        }
+                    }
+                }
+                Err(e)
+            }
+        }
+    }
+
+    /// The loader's physics rules on the scenario as it now is; the
+    /// probes only when asked (their keys are formatted, which allocates).
+    fn revalidate(&self, probes: bool) -> Result<Surface, ScenarioError> {
+        let index = KeyIndex {
+            text: "",
+            document_span: 0..0,
+            entries: Vec::new(),
+        };
+        let check = Check {
+            origin: &self.origin,
+            index: &index,
+        };
+        check.mechanics(&self.mechanics)?;
+        check.drive(&self.mechanics, self.coil.as_ref())?;
+        let surface = check.surface(&self.surface)?;
+        check.contact(&self.contact)?;
+        check.simulation(&self.simulation)?;
+        if probes {
+            for (i, probe) in self.probes.iter().enumerate() {
+                check.probe(i, probe)?;
+            }
+        }
+        Ok(surface)
+    }
+
+    fn unknown_number(&self, key: &str, within: &'static str) -> ScenarioError {
+        ScenarioError::UnknownNumber {
+            at: Location {
+                path: self.origin.clone(),
+                line: None,
+            },
+            key: key.to_owned(),
+            within,
+            known: number_keys_described(),
+        }
+    }
+
+    fn no_section(&self, key: &str, section: &'static str) -> ScenarioError {
+        ScenarioError::Sweep {
+            at: Location {
+                path: self.origin.clone(),
+                line: None,
+            },
+            key: key.to_owned(),
+            problem: format!("the scenario has no {section} section: add it to set this key"),
+        }
+    }
+
+    /// The `[sweep]` rules, which need the rest of the scenario (the
+    /// nominal values the tolerances are relative to).
+    fn with_checked_sweep(self, check: &Check) -> Result<Scenario, ScenarioError> {
+        if let Some(sweep) = &self.sweep {
+            check.sweep(sweep, &self)?;
+        }
+        Ok(self)
+    }
+}
+
+impl Check<'_> {
+    fn sweep_error(&self, key: &str, line_key: &str, problem: String) -> ScenarioError {
+        ScenarioError::Sweep {
+            at: self.at(line_key),
+            key: key.to_owned(),
+            problem,
+        }
+    }
+
+    fn sweep(&self, sweep: &SweepSection, scenario: &Scenario) -> Result<(), ScenarioError> {
+        if sweep.samples == Some(0) {
+            return Err(self.invalid(
+                "sweep.samples",
+                0.0,
+                "must be at least 1: the number of random samples",
+            ));
+        }
+        if !sweep.grid.is_empty() {
+            if !sweep.vary.is_empty() {
+                return Err(ScenarioError::Conflict {
+                    at: self.at("sweep.grid"),
+                    key: "sweep.grid".to_owned(),
+                    other: "sweep.vary".to_owned(),
+                    advice: "a grid steps its keys instead of drawing random samples; \
+                             keep [sweep.grid] or [sweep.vary], and sweep the other in a second run",
+                });
+            }
+            if sweep.samples.is_some() {
+                return Err(ScenarioError::Conflict {
+                    at: self.at("sweep.samples"),
+                    key: "sweep.samples".to_owned(),
+                    other: "sweep.grid".to_owned(),
+                    advice: "a grid runs each of its points once; remove `samples` \
+                             (the number of points is the product of the `steps`)",
+                });
+            }
+            if sweep.grid.len() > 2 {
+                return Err(self.sweep_error(
+                    "sweep.grid",
+                    "sweep.grid",
+                    format!(
+                        "has {} keys; a grid steps one or two (for a plot against them): \
+                         remove the others, or vary them with [sweep.vary] in another run",
+                        sweep.grid.len()
+                    ),
+                ));
+            }
+        }
+        for (key, tolerance) in &sweep.vary {
+            let line_key = format!("sweep.vary.{key}");
+            let nominal = self.sweep_nominal(key, &line_key, "[sweep.vary]", scenario)?;
+            let shown = format!("sweep.vary.\"{key}\"");
+            if nominal == 0.0 {
+                return Err(self.sweep_error(
+                    &shown,
+                    &line_key,
+                    format!(
+                        "`{key}` is 0 in the scenario, and a tolerance relative to 0 \
+                         varies nothing: step it with [sweep.grid] instead"
+                    ),
+                ));
+            }
+            let (value, ok, requirement) = match *tolerance {
+                Tolerance::Uniform(r) => (
+                    r,
+                    r > 0.0 && r < 1.0,
+                    "must lie in (0, 1): the relative half-width, 0.1 for ±10 %",
+                ),
+                Tolerance::Normal(sigma) => (
+                    sigma,
+                    sigma > 0.0 && sigma < 0.25,
+                    "must lie in (0, 0.25): σ relative to the nominal value, 0.05 for 5 % \
+                     (draws are kept within ±4σ, which must not reach 0)",
+                ),
+            };
+            if !(value.is_finite() && ok) {
+                return Err(ScenarioError::Invalid {
+                    at: self.at(&line_key),
+                    key: shown,
+                    value,
+                    requirement: requirement.to_owned(),
+                });
+            }
+        }
+        for (key, axis) in &sweep.grid {
+            let line_key = format!("sweep.grid.{key}");
+            self.sweep_nominal(key, &line_key, "[sweep.grid]", scenario)?;
+            let shown = |field: &str| format!("sweep.grid.\"{key}\".{field}");
+            if axis.steps == 0 {
+                return Err(ScenarioError::Invalid {
+                    at: self.at(&format!("{line_key}.steps")),
+                    key: shown("steps"),
+                    value: 0.0,
+                    requirement: "must be at least 1: the number of values from `from` to `to`"
+                        .to_owned(),
+                });
+            }
+            for (field, value) in [("from", axis.from), ("to", axis.to)] {
+                let field_line = format!("{line_key}.{field}");
+                let log_ok = !axis.log || value > 0.0;
+                if !(value.is_finite() && log_ok) {
+                    return Err(ScenarioError::Invalid {
+                        at: self.at(&field_line),
+                        key: shown(field),
+                        value,
+                        requirement: if axis.log {
+                            "must be a finite number > 0 on a `log = true` grid".to_owned()
+                        } else {
+                            "must be a finite number".to_owned()
+                        },
+                    });
+                }
+                // Each end on its own, the other keys nominal: a grid that
+                // leaves the valid range fails here, not after hours.
+                let mut probe = scenario.clone();
+                if let Err(e) = probe.set_number(key, value) {
+                    return Err(self.sweep_error(
+                        &shown(field),
+                        &field_line,
+                        format!("{value:?} is not a valid `{key}`: {e}"),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The scenario's value of a key named in `[sweep.*]`, which must be
+    /// a number it has.
+    fn sweep_nominal(
+        &self,
+        key: &str,
+        line_key: &str,
+        within: &'static str,
+        scenario: &Scenario,
+    ) -> Result<f64, ScenarioError> {
+        let shown = format!("{}.\"{key}\"", &within[1..within.len() - 1]);
+        match scenario.number(key) {
+            Ok(Some(value)) => Ok(value),
+            Ok(None) => Err(self.sweep_error(
+                &shown,
+                line_key,
+                format!(
+                    "the scenario gives no `{key}` to vary around (it is optional and not \
+                     set, or not a key of this surface law): set it, or sweep another key"
+                ),
+            )),
+            Err(ScenarioError::UnknownNumber { known, .. }) => Err(ScenarioError::UnknownNumber {
+                at: self.at(line_key),
+                key: key.to_owned(),
+                within: if within == "[sweep.vary]" {
+                    " (named in [sweep.vary])"
+                } else {
+                    " (named in [sweep.grid])"
+                },
+                known,
+            }),
+            Err(e) => Err(self.sweep_error(&shown, line_key, e.to_string())),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1290,7 +1855,9 @@ high = 2.31
             | ScenarioError::Invalid { at, .. }
             | ScenarioError::Empty { at, .. }
             | ScenarioError::Conflict { at, .. }
-            | ScenarioError::NotForLaw { at, .. } => at.line,
+            | ScenarioError::NotForLaw { at, .. }
+            | ScenarioError::UnknownNumber { at, .. }
+            | ScenarioError::Sweep { at, .. } => at.line,
             ScenarioError::Read { .. }
             | ScenarioError::CoilDriveUnsupported { .. }
             | ScenarioError::NetlistRead { .. } => None,
@@ -1822,5 +2389,185 @@ high = 2.31
         let err = Scenario::load(Path::new("no/such/scenario.toml")).unwrap_err();
         assert!(matches!(err, ScenarioError::Read { .. }));
         assert!(err.to_string().contains("no/such/scenario.toml"), "{err}");
+    }
+    // [sweep] and set_number.
+
+    #[test]
+    fn set_number_sets_and_validates_by_the_loader_s_rules() {
+        let mut s = parse(VALID).unwrap();
+        s.set_number("mechanics.mass", 3.0e-4).unwrap();
+        assert_eq!(s.mechanics().unwrap().mass, 3.0e-4);
+        assert_eq!(s.number("mechanics.mass").unwrap(), Some(3.0e-4));
+        s.set_number("surface.stiffness", 9.0e4).unwrap();
+        assert!(
+            matches!(s.surface(), Surface::KelvinVoigt { stiffness, .. } if stiffness == 9.0e4)
+        );
+        s.set_number("probe[0].low", 1.2).unwrap();
+        assert_eq!(s.probes[0].low, 1.2);
+
+        let before = s.clone();
+        let err = s.set_number("mechanics.mass", -1.0).unwrap_err();
+        assert_eq!(err.key(), Some("mechanics.mass"));
+        let err = s.set_number("probe[0].low", 5.0).unwrap_err();
+        assert_eq!(err.key(), Some("probe[0].low"));
+        let err = s.set_number("surface.restitution", 0.5).unwrap_err();
+        assert!(matches!(err, ScenarioError::NotForLaw { .. }), "{err:?}");
+        assert_eq!(s, before, "a failed set leaves the scenario as it was");
+
+        // Together valid, one at a time not.
+        s.set_numbers(&[("contact.r_open", 20.0), ("contact.r_closed", 10.0)])
+            .unwrap();
+        assert!(s.set_number("contact.r_closed", 30.0).is_err());
+    }
+
+    #[test]
+    fn set_number_converts_a_hunt_crossley_restitution_again() {
+        let text = with_surface(
+            "law = \"hunt-crossley\"\nstiffness = 1e6\nrestitution = 0.85\nreference_velocity = 0.3",
+        );
+        let mut s = parse(&text).unwrap();
+        s.set_number("surface.restitution", 0.6).unwrap();
+        let chi = hunt_crossley_chi(0.6, 0.3).unwrap();
+        assert!(matches!(s.surface(), Surface::HuntCrossley { chi: c, .. } if c == chi));
+    }
+
+    #[test]
+    fn set_number_names_unknown_keys_and_missing_sections() {
+        let mut s = parse(VALID).unwrap();
+        let err = s.set_number("mechanics.mas", 1.0).unwrap_err();
+        assert!(
+            matches!(err, ScenarioError::UnknownNumber { .. }),
+            "{err:?}"
+        );
+        let msg = err.to_string();
+        assert!(
+            msg.contains("`mechanics.mas`") && msg.contains("mechanics.mass"),
+            "{msg}"
+        );
+        assert!(s.set_number("coil.resistance", 1.0).is_err());
+        assert!(s.set_number("contact.holm.r_ref", 1.0).is_err());
+        assert!(s.set_number("probe[3].low", 1.0).is_err());
+        assert!(s.number("surface.restitution").unwrap().is_none());
+    }
+
+    #[test]
+    fn every_number_key_reads_back_what_was_set() {
+        let text = format!("{VALID}\n[contact.holm]\nr_ref = 0.04\nf_ref = 1.0\n");
+        let s = parse(&text).unwrap();
+        for key in NUMBER_KEYS {
+            let Ok(Some(value)) = s.number(key) else {
+                continue;
+            };
+            let mut t = s.clone();
+            let new = if value == 0.0 { 1e-12 } else { value * 1.001 };
+            t.set_number(key, new)
+                .unwrap_or_else(|e| panic!("{key}: {e}"));
+            assert_eq!(t.number(key).unwrap(), Some(new), "{key}");
+        }
+    }
+
+    #[test]
+    fn sweep_section_parses() {
+        let text = format!(
+            "{VALID}\n[sweep]\nsamples = 50\nseed = 7\n[sweep.vary]\n\"mechanics.mass\" = 0.1\n\
+             \"surface.damping\" = {{ normal = 0.05 }}\n\"mechanics.force\" = {{ uniform = 0.2 }}\n"
+        );
+        let sweep = parse(&text).unwrap().sweep.unwrap();
+        assert_eq!((sweep.samples, sweep.seed), (Some(50), Some(7)));
+        let vary: Vec<_> = sweep.vary.iter().map(|(k, t)| (k.as_str(), *t)).collect();
+        assert_eq!(
+            vary,
+            [
+                ("mechanics.force", Tolerance::Uniform(0.2)),
+                ("mechanics.mass", Tolerance::Uniform(0.1)),
+                ("surface.damping", Tolerance::Normal(0.05)),
+            ]
+        );
+        let grid = format!(
+            "{VALID}\n[sweep.grid]\n\"mechanics.force\" = {{ from = 0.5, to = 2.0, steps = 4 }}\n"
+        );
+        let axis = parse(&grid).unwrap().sweep.unwrap().grid["mechanics.force"];
+        let values: Vec<f64> = (0..4).map(|j| axis.value(j)).collect();
+        assert_eq!(values, [0.5, 1.0, 1.5, 2.0]);
+        let log = GridAxis {
+            from: 1.0,
+            to: 100.0,
+            steps: 3,
+            log: true,
+        };
+        assert!((log.value(1) - 10.0).abs() < 1e-12);
+        assert_eq!(log.value(2), 100.0);
+    }
+
+    #[test]
+    fn sweep_rules() {
+        let with = |body: &str| format!("{VALID}\n{body}\n");
+        let err = fails_on(
+            &with("[sweep.vary]\n\"mechanics.mas\" = 0.1"),
+            "mechanics.mas",
+        );
+        assert!(
+            matches!(err, ScenarioError::UnknownNumber { .. }),
+            "{err:?}"
+        );
+        assert_eq!(line_of(&err), Some(22));
+        let msg = err.to_string();
+        assert!(
+            msg.contains("[sweep.vary]") && msg.contains("surface.damping"),
+            "{msg}"
+        );
+        fails_on(
+            &with("[sweep.grid]\n\"bogus\" = { from = 1, to = 2, steps = 2 }"),
+            "bogus",
+        );
+        fails_on(
+            &with("[sweep.vary]\n\"mechanics.mass\" = 1.5"),
+            "sweep.vary.\"mechanics.mass\"",
+        );
+        fails_on(
+            &with("[sweep.vary]\n\"mechanics.mass\" = { normal = 0.3 }"),
+            "sweep.vary.\"mechanics.mass\"",
+        );
+        fails_on(
+            &with("[sweep.vary]\n\"mechanics.mass\" = { sigma = 0.3 }"),
+            "sweep.vary.mechanics.mass",
+        );
+        fails_on(
+            &with("[sweep.vary]\n\"mechanics.preload\" = 0.1"),
+            "sweep.vary.\"mechanics.preload\"",
+        );
+        fails_on(
+            &with("[sweep.vary]\n\"surface.restitution\" = 0.1"),
+            "sweep.vary.\"surface.restitution\"",
+        );
+        fails_on(&with("[sweep]\nsamples = 0"), "sweep.samples");
+        fails_on(
+            &with(
+                "[sweep.vary]\n\"mechanics.mass\" = 0.1\n[sweep.grid]\n\"mechanics.force\" = { from = 0.5, to = 2.0, steps = 4 }",
+            ),
+            "sweep.grid",
+        );
+        fails_on(
+            &with(
+                "[sweep]\nsamples = 3\n[sweep.grid]\n\"mechanics.force\" = { from = 0.5, to = 2.0, steps = 4 }",
+            ),
+            "sweep.samples",
+        );
+        fails_on(
+            &with("[sweep.grid]\n\"mechanics.force\" = { from = -0.5, to = 2.0, steps = 4 }"),
+            "sweep.grid.\"mechanics.force\".from",
+        );
+        fails_on(
+            &with("[sweep.grid]\n\"mechanics.force\" = { from = 0.5, to = 2.0, steps = 0 }"),
+            "sweep.grid.\"mechanics.force\".steps",
+        );
+        fails_on(
+            &with(
+                "[sweep.grid]\n\"mechanics.force\" = { from = 0.5, to = 2.0, steps = 4 }\n\
+                 \"mechanics.mass\" = { from = 1e-4, to = 2e-4, steps = 2 }\n\
+                 \"mechanics.gap\" = { from = 1e-4, to = 2e-4, steps = 2 }",
+            ),
+            "sweep.grid",
+        );
     }
 }
