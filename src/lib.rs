@@ -18,6 +18,7 @@ pub mod rawfile;
 pub mod report;
 pub mod scenario;
 pub mod spice;
+pub mod sweep;
 pub mod waveform;
 
 pub use chatter::{Chatter, ContactState, Impact, Interval, Outcome};

@@ -1,0 +1,317 @@
+//! Running a sweep: every sample of a shard, on `jobs` threads, its rows
+//! written in index order as they come in.
+//!
+//! Workers claim chunks of consecutive samples (512 for the mechanics
+//! alone, where a sample takes microseconds; 1 with ngspice, where it
+//! takes tens of milliseconds), evaluate them with their own copy of the
+//! scenario, and format the chunk's CSV rows themselves. The calling
+//! thread only puts the chunks in order, writes them and flushes: so a
+//! sweep cut short leaves the header and whole rows, and
+//! `--mechanics-only` is not held back by one thread formatting numbers.
+//! A chunk that finishes early waits in memory until the ones before it
+//! are written.
+//!
+//! With ngspice a sample is one ngspice process: a sweep reads the bounced
+//! run's probes only, so it does not run the ideal contact that `run`
+//! compares with, and `jobs` is the number of ngspice processes at once.
+
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::num::NonZeroUsize;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::mpsc;
+
+use crate::mechanics::simulate;
+use crate::pipeline::{self, RunOptions};
+use crate::scenario::Scenario;
+use crate::spice::Runner;
+
+use super::sample::Sampler;
+use super::summary::Collected;
+use super::table;
+use super::verdict::{Verdict, verdict};
+use super::{ProbeRecord, Record, Shard, SweepError};
+
+/// What each sample runs.
+#[derive(Clone, Copy)]
+pub enum Mode<'r> {
+    /// The mechanics alone: outcome, bounces, times; no probes.
+    Mechanics,
+    /// The whole pipeline with this runner (e.g. [`Ngspice`](crate::spice::Ngspice)).
+    Circuit(&'r dyn Runner),
+}
+
+impl std::fmt::Debug for Mode<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Mode::Mechanics => f.write_str("Mechanics"),
+            Mode::Circuit(_) => f.write_str("Circuit(..)"),
+        }
+    }
+}
+
+/// How to run a sweep.
+#[derive(Debug, Clone)]
+pub struct SweepOptions<'r> {
+    pub mode: Mode<'r>,
+    /// Threads evaluating samples (with ngspice: ngspice processes at once).
+    pub jobs: NonZeroUsize,
+    pub shard: Shard,
+    /// Each sample's pipeline options; the ideal-contact run is off by
+    /// default (see the module overview).
+    pub run: RunOptions,
+}
+
+impl SweepOptions<'_> {
+    /// `mode` on one thread per core, the whole sweep.
+    pub fn new(mode: Mode<'_>) -> SweepOptions<'_> {
+        SweepOptions {
+            mode,
+            jobs: std::thread::available_parallelism().unwrap_or(NonZeroUsize::MIN),
+            shard: Shard::WHOLE,
+            run: RunOptions {
+                compare_ideal: false,
+                ..RunOptions::default()
+            },
+        }
+    }
+}
+
+/// Told how far a sweep has got (e.g. a progress bar). Called from the
+/// thread that called [`run`].
+pub trait Progress {
+    /// The sweep is about to run `total` samples.
+    fn start(&self, total: u64) {
+        let _ = total;
+    }
+    /// `done` more samples are written.
+    fn advance(&self, done: u64) {
+        let _ = done;
+    }
+    /// Every sample is written.
+    fn finish(&self) {}
+}
+
+/// No progress reporting.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoProgress;
+
+impl Progress for NoProgress {}
+
+/// Samples per chunk a worker claims.
+fn chunk_len(mode: Mode<'_>) -> u64 {
+    match mode {
+        Mode::Mechanics => 512,
+        Mode::Circuit(_) => 1,
+    }
+}
+
+/// Run the samples of `options.shard` of `sampler`'s sweep of `scenario`,
+/// writing the CSV header and then each row, in index order, to `out`
+/// (flushed after every chunk). Returns the collected results for the
+/// summary. A sample that fails is a row with its error; only a failure
+/// to write, or a scenario that cannot run at all, is an error.
+pub fn run(
+    scenario: &Scenario,
+    sampler: &Sampler,
+    options: &SweepOptions<'_>,
+    out: &mut dyn Write,
+    progress: &dyn Progress,
+) -> Result<Collected, SweepError> {
+    let signals: Vec<String> = match options.mode {
+        Mode::Mechanics => Vec::new(),
+        Mode::Circuit(_) => {
+            if scenario.circuit.is_none() || scenario.probes.is_empty() {
+                return Err(SweepError::NeedsCircuit {
+                    path: scenario.origin.clone(),
+                });
+            }
+            // A netlist that cannot be read would fail every sample.
+            if let Some(Err(e)) = scenario.netlist() {
+                return Err(e.into());
+            }
+            scenario.probes.iter().map(|p| p.signal.clone()).collect()
+        }
+    };
+    let header = table::header(sampler.keys(), &signals);
+    out.write_all(&header)
+        .and_then(|()| out.flush())
+        .map_err(SweepError::Write)?;
+
+    let total = options.shard.len(sampler.count());
+    let chunk = chunk_len(options.mode);
+    let chunks = total.div_ceil(chunk);
+    let mut collected = Collected::new(sampler.keys().to_vec(), signals);
+    progress.start(total);
+
+    let next = AtomicU64::new(0);
+    let stop = AtomicBool::new(false);
+    let jobs = options.jobs.get();
+    let (tx, rx) = mpsc::sync_channel::<(u64, Vec<u8>, Vec<Record>)>(4 * jobs);
+    let written = std::thread::scope(|scope| {
+        for _ in 0..jobs {
+            let tx = tx.clone();
+            let (next, stop) = (&next, &stop);
+            scope.spawn(move || {
+                let mut worker = Worker::new(scenario, sampler, options);
+                loop {
+                    let c = next.fetch_add(1, Ordering::Relaxed);
+                    if c >= chunks || stop.load(Ordering::Relaxed) {
+                        break;
+                    }
+                    let positions = c * chunk..((c + 1) * chunk).min(total);
+                    let records: Vec<Record> = positions
+                        .map(|p| worker.evaluate(options.shard.sample(p)))
+                        .collect();
+                    let rows = table::rows(&records);
+                    if tx.send((c, rows, records)).is_err() {
+                        break;
+                    }
+                }
+            });
+        }
+        drop(tx);
+        let mut pending = BTreeMap::new();
+        let mut expected = 0;
+        for (c, rows, records) in rx.iter() {
+            pending.insert(c, (rows, records));
+            while let Some((rows, records)) = pending.remove(&expected) {
+                if let Err(e) = out.write_all(&rows).and_then(|()| out.flush()) {
+                    stop.store(true, Ordering::Relaxed);
+                    return Err(SweepError::Write(e));
+                }
+                for record in &records {
+                    collected.add(record);
+                }
+                progress.advance(records.len() as u64);
+                expected += 1;
+            }
+        }
+        Ok(())
+    });
+    written?;
+    progress.finish();
+    Ok(collected)
+}
+
+/// Evaluate sample `index` of `sampler`'s sweep of `scenario` on its own
+/// (the sweep's workers reuse one scenario copy instead).
+pub fn evaluate(
+    scenario: &Scenario,
+    sampler: &Sampler,
+    index: u64,
+    options: &SweepOptions<'_>,
+) -> Record {
+    Worker::new(scenario, sampler, options).evaluate(index)
+}
+
+/// One thread's state: its own scenario, whose varied keys every sample
+/// sets anew.
+struct Worker<'a, 'r> {
+    scenario: Scenario,
+    sampler: &'a Sampler,
+    options: &'a SweepOptions<'r>,
+    values: Vec<f64>,
+}
+
+impl<'a, 'r> Worker<'a, 'r> {
+    fn new(scenario: &Scenario, sampler: &'a Sampler, options: &'a SweepOptions<'r>) -> Self {
+        Worker {
+            scenario: scenario.clone(),
+            sampler,
+            options,
+            values: vec![0.0; sampler.keys().len()],
+        }
+    }
+
+    fn evaluate(&mut self, index: u64) -> Record {
+        let mut record = Record {
+            index,
+            values: Vec::new(),
+            outcome: None,
+            bounce_count: None,
+            first_impact: None,
+            settle_time: None,
+            bounce_time: None,
+            probes: Vec::new(),
+            verdict: Verdict::Error,
+            error: None,
+        };
+        if let Err(e) = self.sampler.values(index, &mut self.values) {
+            record.error = Some(one_line(&e));
+            return record;
+        }
+        record.values = self.values.clone();
+        let keys = self.sampler.keys();
+        // Small: one pair per varied key.
+        let pairs: Vec<(&str, f64)> = keys
+            .iter()
+            .map(String::as_str)
+            .zip(self.values.iter().copied())
+            .collect();
+        if let Err(e) = self.scenario.set_numbers(&pairs) {
+            record.error = Some(format!("invalid sample: {}", one_line(&e)));
+            return record;
+        }
+        let scenario = &self.scenario;
+        let chatter = match scenario
+            .mechanics()
+            .map_err(|e| one_line(&e))
+            .and_then(|m| {
+                simulate(&m, &scenario.surface(), &scenario.settings()).map_err(|e| one_line(&e))
+            }) {
+            Ok(chatter) => chatter,
+            Err(e) => {
+                record.error = Some(e);
+                return record;
+            }
+        };
+        record.outcome = Some(chatter.outcome);
+        record.bounce_count = Some(chatter.bounce_count);
+        record.first_impact = chatter.first_impact;
+        record.settle_time = chatter.settle_time;
+        record.bounce_time = chatter
+            .first_impact
+            .zip(chatter.settle_time)
+            .filter(|_| chatter.outcome.is_closed())
+            .map(|(first, settle)| settle - first);
+        match self.options.mode {
+            Mode::Mechanics => {
+                record.verdict = verdict(scenario, &chatter, None);
+            }
+            Mode::Circuit(runner) => match pipeline::run(scenario, runner, &self.options.run) {
+                Ok(result) => {
+                    record.probes = result
+                        .probes
+                        .iter()
+                        .map(|p| ProbeRecord {
+                            edges: p.analysis.edges,
+                            peak: p.analysis.max.abs().max(p.analysis.min.abs()),
+                        })
+                        .collect();
+                    record.verdict = verdict(scenario, &chatter, Some(&result));
+                }
+                Err(e) => record.error = Some(one_line(&e)),
+            },
+        }
+        record
+    }
+}
+
+/// An error and its causes on one line, each cause's first line only:
+/// later lines carry work directories and log tails, which differ from
+/// run to run and would make the CSV depend on more than the samples.
+pub fn one_line(err: &dyn std::error::Error) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    let mut cause = Some(err);
+    while let Some(e) = cause {
+        let text = e.to_string();
+        let first = text.lines().next().unwrap_or_default().trim().to_owned();
+        // A transparent wrapper repeats its source.
+        if !first.is_empty() && parts.last() != Some(&first) {
+            parts.push(first);
+        }
+        cause = e.source();
+    }
+    parts.join(": ")
+}

@@ -1,0 +1,438 @@
+//! What a sweep found, in a few numbers: the distribution of bounces,
+//! bounce times and probe edges and peaks (min, median, p95, max, mean),
+//! the worst sample and its values, and how many samples failed.
+//!
+//! [`Collected`] keeps a few numbers per sample as rows are written (not
+//! the rows themselves), in index order; [`Collected::summary`] reduces
+//! them. Quantiles are nearest-rank: the p-quantile of n sorted values is
+//! the value at rank ⌈p·n⌉, so it is always one of the samples. The worst
+//! sample, among those that ran, is the one with the highest
+//! (failed a limit, did not end closed, edges over all probes, bounce
+//! time), the lowest index on a tie.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+use serde::Serialize;
+
+use crate::chatter::Outcome;
+
+use super::sample::Sampler;
+use super::verdict::Verdict;
+use super::{Record, SweepError};
+
+/// How many error messages the summary quotes.
+const QUOTED_ERRORS: usize = 5;
+
+/// Per-sample numbers for the summary and the plot, in index order.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Collected {
+    pub keys: Vec<String>,
+    pub signals: Vec<String>,
+    pub index: Vec<u64>,
+    pub outcome: Vec<Option<Outcome>>,
+    pub bounce_count: Vec<Option<u32>>,
+    /// s
+    pub bounce_time: Vec<Option<f64>>,
+    /// s
+    pub settle_time: Vec<Option<f64>>,
+    /// `[probe][sample]`
+    pub edges: Vec<Vec<Option<u32>>>,
+    /// `[probe][sample]`, max |value|.
+    pub peak: Vec<Vec<Option<f64>>>,
+    pub verdict: Vec<Verdict>,
+    /// The first errors, with their sample index.
+    pub first_errors: Vec<(u64, String)>,
+}
+
+impl Collected {
+    /// Nothing yet, for a sweep of `keys` with probes `signals`.
+    pub fn new(keys: Vec<String>, signals: Vec<String>) -> Collected {
+        let n = signals.len();
+        Collected {
+            keys,
+            signals,
+            edges: vec![Vec::new(); n],
+            peak: vec![Vec::new(); n],
+            ..Collected::default()
+        }
+    }
+
+    /// Add the next sample.
+    pub fn add(&mut self, r: &Record) {
+        self.index.push(r.index);
+        self.outcome.push(r.outcome);
+        self.bounce_count
+            .push(r.bounce_count.map(|n| u32::try_from(n).unwrap_or(u32::MAX)));
+        self.bounce_time.push(r.bounce_time);
+        self.settle_time.push(r.settle_time);
+        for (p, (edges, peak)) in self.edges.iter_mut().zip(&mut self.peak).enumerate() {
+            let probe = r.probes.get(p);
+            edges.push(probe.map(|x| u32::try_from(x.edges).unwrap_or(u32::MAX)));
+            peak.push(probe.map(|x| x.peak));
+        }
+        self.verdict.push(r.verdict);
+        if let Some(e) = &r.error {
+            if self.first_errors.len() < QUOTED_ERRORS {
+                self.first_errors.push((r.index, e.clone()));
+            }
+        }
+    }
+
+    /// Samples collected.
+    pub fn len(&self) -> usize {
+        self.index.len()
+    }
+
+    /// Whether none were.
+    pub fn is_empty(&self) -> bool {
+        self.index.is_empty()
+    }
+
+    /// The summary; `sampler` gives the worst sample's values.
+    pub fn summary(&self, sampler: &Sampler) -> Result<Summary, SweepError> {
+        let n = self.len() as u64;
+        let mut outcomes = BTreeMap::new();
+        for o in &self.outcome {
+            *outcomes
+                .entry(o.map_or("none", Outcome::as_str))
+                .or_insert(0) += 1;
+        }
+        let mut verdicts = BTreeMap::new();
+        for v in &self.verdict {
+            *verdicts.entry(v.as_str()).or_insert(0) += 1;
+        }
+        let count = |v: Verdict| self.verdict.iter().filter(|&&x| x == v).count() as u64;
+        let (failing, errors) = (count(Verdict::Fail), count(Verdict::Error));
+        let probes = self
+            .signals
+            .iter()
+            .enumerate()
+            .map(|(p, signal)| ProbeSummary {
+                signal: signal.clone(),
+                edges: Distribution::of(self.edges[p].iter().flatten().map(|&e| f64::from(e))),
+                peak: Distribution::of(self.peak[p].iter().flatten().copied()),
+            })
+            .collect();
+        let worst = match self.worst() {
+            Some(i) => {
+                let index = self.index[i];
+                let values = sampler.values_vec(index)?;
+                Some(Worst {
+                    index,
+                    outcome: self.outcome[i].map(Outcome::as_str),
+                    bounce_count: self.bounce_count[i],
+                    bounce_time: self.bounce_time[i],
+                    edges: self.edges.iter().map(|e| e[i]).collect(),
+                    values: self.keys.iter().cloned().zip(values).collect(),
+                    verdict: self.verdict[i].as_str(),
+                })
+            }
+            None => None,
+        };
+        Ok(Summary {
+            samples: n,
+            kind: if sampler.is_grid() { "grid" } else { "random" },
+            seed: sampler.seed(),
+            keys: self.keys.clone(),
+            outcomes,
+            verdicts,
+            failing,
+            errors,
+            fraction_failing: if n == 0 {
+                0.0
+            } else {
+                (failing + errors) as f64 / n as f64
+            },
+            bounce_count: Distribution::of(
+                self.bounce_count.iter().flatten().map(|&b| f64::from(b)),
+            ),
+            bounce_time: Distribution::of(self.bounce_time.iter().flatten().copied()),
+            settle_time: Distribution::of(self.settle_time.iter().flatten().copied()),
+            probes,
+            worst,
+            first_errors: self
+                .first_errors
+                .iter()
+                .map(|(index, error)| SampleError {
+                    index: *index,
+                    error: error.clone(),
+                })
+                .collect(),
+        })
+    }
+
+    /// The position of the worst sample that ran (see the module overview).
+    fn worst(&self) -> Option<usize> {
+        let key = |i: usize| {
+            let edges: u64 = self
+                .edges
+                .iter()
+                .map(|e| u64::from(e[i].unwrap_or(0)))
+                .sum();
+            (
+                self.verdict[i] == Verdict::Fail,
+                !self.outcome[i].is_some_and(Outcome::is_closed),
+                edges,
+                self.bounce_time[i].unwrap_or(0.0),
+            )
+        };
+        let mut best: Option<(usize, (bool, bool, u64, f64))> = None;
+        for i in 0..self.len() {
+            if self.verdict[i] == Verdict::Error {
+                continue;
+            }
+            let k = key(i);
+            let better = best.as_ref().is_none_or(|(_, b)| {
+                (k.0, k.1, k.2)
+                    .cmp(&(b.0, b.1, b.2))
+                    .then(k.3.total_cmp(&b.3))
+                    == std::cmp::Ordering::Greater
+            });
+            if better {
+                best = Some((i, k));
+            }
+        }
+        best.map(|(i, _)| i)
+    }
+}
+
+/// min, median, p95, max and mean of some samples' values.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Distribution {
+    /// How many samples had a value.
+    pub count: u64,
+    pub min: f64,
+    pub median: f64,
+    pub p95: f64,
+    pub max: f64,
+    pub mean: f64,
+}
+
+impl Distribution {
+    /// `None` without values.
+    pub fn of(values: impl Iterator<Item = f64>) -> Option<Distribution> {
+        let mut v: Vec<f64> = values.filter(|x| x.is_finite()).collect();
+        if v.is_empty() {
+            return None;
+        }
+        let mean = v.iter().sum::<f64>() / v.len() as f64;
+        v.sort_by(f64::total_cmp);
+        let rank = |p: f64| v[((p * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1];
+        Some(Distribution {
+            count: v.len() as u64,
+            min: v[0],
+            median: rank(0.5),
+            p95: rank(0.95),
+            max: v[v.len() - 1],
+            mean,
+        })
+    }
+}
+
+/// One probe's distributions.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ProbeSummary {
+    pub signal: String,
+    pub edges: Option<Distribution>,
+    pub peak: Option<Distribution>,
+}
+
+/// The worst sample.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Worst {
+    pub index: u64,
+    pub outcome: Option<&'static str>,
+    pub bounce_count: Option<u32>,
+    pub bounce_time: Option<f64>,
+    /// Per probe.
+    pub edges: Vec<Option<u32>>,
+    pub verdict: &'static str,
+    /// Its values of the varied keys.
+    pub values: BTreeMap<String, f64>,
+}
+
+/// A sample that failed, and why.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SampleError {
+    pub index: u64,
+    pub error: String,
+}
+
+/// `summary.json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Summary {
+    pub samples: u64,
+    /// `random` or `grid`.
+    pub kind: &'static str,
+    pub seed: Option<u64>,
+    pub keys: Vec<String>,
+    /// Samples per chatter outcome (`none`: failed before the mechanics).
+    pub outcomes: BTreeMap<&'static str, u64>,
+    /// Samples per verdict.
+    pub verdicts: BTreeMap<&'static str, u64>,
+    /// Samples that failed a limit.
+    pub failing: u64,
+    /// Samples that could not run.
+    pub errors: u64,
+    /// (failing + errors) / samples.
+    pub fraction_failing: f64,
+    pub bounce_count: Option<Distribution>,
+    /// s
+    pub bounce_time: Option<Distribution>,
+    /// s
+    pub settle_time: Option<Distribution>,
+    pub probes: Vec<ProbeSummary>,
+    pub worst: Option<Worst>,
+    /// The first few errors.
+    pub first_errors: Vec<SampleError>,
+}
+
+impl Summary {
+    /// Pretty JSON, `\n`-terminated.
+    pub fn to_json(&self) -> String {
+        let mut text = serde_json::to_string_pretty(self).expect("a summary serializes");
+        text.push('\n');
+        text
+    }
+
+    /// A few lines for a person at a terminal.
+    pub fn render_table(&self) -> String {
+        let mut out = String::new();
+        let what = match self.seed {
+            Some(seed) => format!("random, seed {seed}"),
+            None => "grid".to_owned(),
+        };
+        let _ = writeln!(
+            out,
+            "{} samples ({what}) of {}",
+            self.samples,
+            self.keys.join(", ")
+        );
+        let counts = |m: &BTreeMap<&str, u64>| {
+            m.iter()
+                .map(|(k, v)| format!("{k} {v}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let _ = writeln!(out, "outcomes: {}", counts(&self.outcomes));
+        let _ = writeln!(
+            out,
+            "failing a limit: {}, errors: {} ({:.1} % failing)",
+            self.failing,
+            self.errors,
+            100.0 * self.fraction_failing
+        );
+        let _ = writeln!(
+            out,
+            "\n{:<16}{:>12}{:>12}{:>12}{:>12}",
+            "", "min", "median", "p95", "max"
+        );
+        let mut row = |name: &str, d: &Option<Distribution>, unit: &str| {
+            if let Some(d) = d {
+                let _ = writeln!(
+                    out,
+                    "{name:<16}{:>12}{:>12}{:>12}{:>12}",
+                    eng(d.min, unit),
+                    eng(d.median, unit),
+                    eng(d.p95, unit),
+                    eng(d.max, unit)
+                );
+            }
+        };
+        row("bounces", &self.bounce_count, "");
+        row("bounce time", &self.bounce_time, "s");
+        row("settle time", &self.settle_time, "s");
+        for p in &self.probes {
+            row(&format!("{} edges", p.signal), &p.edges, "");
+            row(&format!("{} peak", p.signal), &p.peak, "");
+        }
+        if let Some(w) = &self.worst {
+            let values = w
+                .values
+                .iter()
+                .map(|(k, v)| format!("{k} = {v:?}"))
+                .collect::<Vec<_>>()
+                .join(", ");
+            let mut what = vec![w.outcome.unwrap_or("none").to_owned()];
+            if let Some(t) = w.bounce_time {
+                what.push(format!("bounce time {}", eng(t, "s")));
+            }
+            if let Some(b) = w.bounce_count {
+                what.push(format!("{b} bounces"));
+            }
+            for (p, e) in self.probes.iter().zip(&w.edges) {
+                if let Some(e) = e {
+                    what.push(format!("{} {e} edges", p.signal));
+                }
+            }
+            let _ = writeln!(
+                out,
+                "\nworst: sample {} ({}): {values}",
+                w.index,
+                what.join(", ")
+            );
+        }
+        for e in &self.first_errors {
+            let _ = writeln!(out, "error in sample {}: {}", e.index, e.error);
+        }
+        out
+    }
+}
+
+/// `value` with three significant digits and an SI prefix; integers
+/// (counts, no unit) as they are.
+fn eng(value: f64, unit: &str) -> String {
+    if unit.is_empty() {
+        return if value.fract() == 0.0 && value.abs() < 1e15 {
+            format!("{value}")
+        } else {
+            format!("{value:.3}")
+        };
+    }
+    if value == 0.0 || !value.is_finite() {
+        return format!("0 {unit}");
+    }
+    let exponent = (3.0 * (value.abs().log10() / 3.0).floor()).clamp(-12.0, 9.0) as i32;
+    let prefix = match exponent {
+        -12 => "p",
+        -9 => "n",
+        -6 => "µ",
+        -3 => "m",
+        3 => "k",
+        6 => "M",
+        9 => "G",
+        _ => "",
+    };
+    let scaled = value / 10f64.powi(exponent);
+    let decimals = if scaled.abs() >= 100.0 {
+        0
+    } else if scaled.abs() >= 10.0 {
+        1
+    } else {
+        2
+    };
+    format!("{scaled:.decimals$} {prefix}{unit}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nearest_rank_quantiles() {
+        let d = Distribution::of((1..=100).map(f64::from)).unwrap();
+        assert_eq!((d.min, d.median, d.p95, d.max), (1.0, 50.0, 95.0, 100.0));
+        assert_eq!(d.mean, 50.5);
+        let one = Distribution::of([3.0].into_iter()).unwrap();
+        assert_eq!((one.median, one.p95), (3.0, 3.0));
+        assert!(Distribution::of(std::iter::empty()).is_none());
+    }
+
+    #[test]
+    fn engineering_units() {
+        assert_eq!(eng(1.234e-3, "s"), "1.23 ms");
+        assert_eq!(eng(12.0, ""), "12");
+        assert_eq!(eng(3.3, "V"), "3.30 V");
+    }
+}
