@@ -5,7 +5,8 @@
 //! `main` turns them into a message and an exit code. To add a command,
 //! add a variant to [`Command`], its `Args` struct, and a handler.
 
-use std::io::{self, Read, Write};
+use std::io::{self, IsTerminal, Read, Write};
+use std::num::NonZeroUsize;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
@@ -21,6 +22,7 @@ use chatterspice::report::{self, Format};
 use chatterspice::scenario::Scenario;
 use chatterspice::simulate;
 use chatterspice::spice::Ngspice;
+use chatterspice::sweep::{self, Mode, Sampler, Shard, SweepOptions};
 use chatterspice::waveform::{ContactModel, Waveform, read_state_csv};
 
 /// Relay contact bounce from physics, into circuit simulation.
@@ -42,6 +44,11 @@ pub enum Command {
     Pwl(PwlArgs),
     /// Print a SPICE raw file: one plot as CSV, or a JSON summary of every plot.
     Raw(RawArgs),
+    /// Run the scenario many times with the numbers of its [sweep] varied
+    /// (Monte Carlo or a grid): sweep.csv, summary.json, sweep.svg.
+    Sweep(SweepArgs),
+    /// Join the CSVs of a sweep's shards (--shard K/N) into the CSV of one run.
+    Merge(MergeArgs),
 }
 
 impl Command {
@@ -51,6 +58,8 @@ impl Command {
             Command::Bounce(args) => bounce(args),
             Command::Pwl(args) => pwl(args),
             Command::Raw(args) => raw(args),
+            Command::Sweep(args) => sweep(args),
+            Command::Merge(args) => merge(args),
         }
     }
 }
@@ -429,4 +438,229 @@ fn raw(args: &RawArgs) -> Result<()> {
         Err(e) if e.is_broken_pipe() => Ok(()),
         result => Ok(result?),
     }
+}
+
+#[derive(Debug, Args)]
+pub struct SweepArgs {
+    /// Scenario file (TOML) with a [sweep] section; `-` reads it from stdin.
+    #[arg(value_name = "SCENARIO")]
+    pub scenario: PathBuf,
+
+    /// Random samples to run [default: `sweep.samples`, else 100]. Not
+    /// with a [sweep.grid], which runs each of its points.
+    #[arg(long, value_name = "N")]
+    pub samples: Option<u64>,
+
+    /// Seed of the random draws [default: `sweep.seed`, else 0].
+    #[arg(long, value_name = "S")]
+    pub seed: Option<u64>,
+
+    /// Samples run at once [default: one per core]. With ngspice, each
+    /// sample is one ngspice process.
+    #[arg(short = 'j', long, value_name = "J")]
+    pub jobs: Option<NonZeroUsize>,
+
+    /// Directory for sweep.csv, summary.json and sweep.svg (created if
+    /// needed) [default: the current directory]. Existing files there are
+    /// an error unless --force.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+
+    /// Simulate the mechanics only (bounces and times, no circuit, no
+    /// ngspice): microseconds per sample.
+    #[arg(long)]
+    pub mechanics_only: bool,
+
+    /// Run only the K-th of N slices (samples i with i % N == K-1) into
+    /// sweep.K-of-N.csv; join the slices with `chatterspice merge`.
+    #[arg(long, value_name = "K/N", value_parser = parse_shard)]
+    pub shard: Option<Shard>,
+
+    /// Replace files that already exist in DIR.
+    #[arg(long)]
+    pub force: bool,
+
+    /// Wall-clock limit of each ngspice run, in seconds; a sample that
+    /// reaches it is recorded as an error.
+    #[arg(long, value_name = "S", default_value_t = 60.0, value_parser = parse_timeout)]
+    pub timeout: f64,
+
+    /// How the contact is emitted: pwl, event-ramp or switch [default:
+    /// pwl, or event-ramp for sequences of more than 2000 points].
+    #[arg(long, value_name = "ELEMENT", value_parser = parse_element)]
+    pub element: Option<ContactElement>,
+
+    /// The ngspice program [default: $CHATTERSPICE_NGSPICE, else ngspice
+    /// on PATH].
+    #[arg(long, value_name = "PROGRAM")]
+    pub ngspice: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// The merged CSV to write. An existing file is an error unless --force.
+    #[arg(value_name = "OUT.csv")]
+    pub output: PathBuf,
+
+    /// The shards' CSVs, in any order.
+    #[arg(value_name = "IN.csv", required = true)]
+    pub inputs: Vec<PathBuf>,
+
+    /// The sweep's number of samples, so that missing last samples are
+    /// found too [default: up to the largest index present].
+    #[arg(long, value_name = "N")]
+    pub samples: Option<u64>,
+
+    /// Write the rows there are even when samples are missing.
+    #[arg(long)]
+    pub allow_missing: bool,
+
+    /// Replace OUT.csv if it already exists.
+    #[arg(long)]
+    pub force: bool,
+}
+
+fn parse_shard(text: &str) -> Result<Shard, String> {
+    text.parse::<Shard>().map_err(|e| e.to_string())
+}
+
+/// The sweep's file names in `--out`: a shard writes its CSV alone.
+fn sweep_files(shard: Option<Shard>) -> Vec<String> {
+    match shard {
+        Some(s) => vec![format!("sweep.{}-of-{}.csv", s.index, s.count)],
+        None => vec![
+            "sweep.csv".to_owned(),
+            "summary.json".to_owned(),
+            "sweep.svg".to_owned(),
+        ],
+    }
+}
+
+/// An indicatif bar on a terminal's stderr.
+struct Bar(indicatif::ProgressBar);
+
+impl sweep::Progress for Bar {
+    fn start(&self, total: u64) {
+        self.0.set_length(total);
+    }
+    fn advance(&self, done: u64) {
+        self.0.inc(done);
+    }
+    fn finish(&self) {
+        self.0.finish_and_clear();
+    }
+}
+
+fn sweep(args: &SweepArgs) -> Result<()> {
+    let scenario = load_scenario(Some(&args.scenario))?;
+    let sampler = Sampler::new(&scenario, args.samples, args.seed)?;
+    let dir = args.out.clone().unwrap_or_else(|| PathBuf::from("."));
+    let names = sweep_files(args.shard);
+    if !args.force {
+        if let Some(existing) = names.iter().map(|n| dir.join(n)).find(|p| p.exists()) {
+            bail!(
+                "{}: already exists; pass --force to overwrite the sweep's files, or choose another --out",
+                existing.display()
+            );
+        }
+    }
+    let ngspice = if args.mechanics_only {
+        None
+    } else {
+        Some(Ngspice::locate(args.ngspice.as_deref())?)
+    };
+    let mut options = SweepOptions::new(match &ngspice {
+        Some(n) => Mode::Circuit(n),
+        None => Mode::Mechanics,
+    });
+    if let Some(jobs) = args.jobs {
+        options.jobs = jobs;
+    }
+    options.shard = args.shard.unwrap_or(Shard::WHOLE);
+    options.run.timeout = Duration::from_secs_f64(args.timeout);
+    options.run.element = args.element;
+
+    std::fs::create_dir_all(&dir)
+        .with_context(|| format!("{}: cannot create the output directory", dir.display()))?;
+    let csv_path = dir.join(&names[0]);
+    let mut open = std::fs::OpenOptions::new();
+    open.write(true);
+    if args.force {
+        open.create(true).truncate(true);
+    } else {
+        open.create_new(true);
+    }
+    let mut csv = open
+        .open(&csv_path)
+        .with_context(|| format!("{}: cannot create the sweep's CSV", csv_path.display()))?;
+
+    let bar = if io::stderr().is_terminal() {
+        let bar = indicatif::ProgressBar::new(0);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{bar:40} {pos}/{len} samples, {per_sec}, {eta} left",
+            )
+            .expect("a valid template"),
+        );
+        Some(Bar(bar))
+    } else {
+        None
+    };
+    let progress: &dyn sweep::Progress = match &bar {
+        Some(b) => b,
+        None => &sweep::NoProgress,
+    };
+    let collected = sweep::run(&scenario, &sampler, &options, &mut csv, progress)
+        .with_context(|| format!("{}: the sweep stopped", csv_path.display()))?;
+    let summary = collected.summary(&sampler)?;
+    if args.shard.is_none() {
+        report::write_new_file(
+            &dir.join(&names[1]),
+            summary.to_json().as_bytes(),
+            args.force,
+        )?;
+        let svg = sweep::plot::render(&collected, &sampler)?;
+        report::write_new_file(&dir.join(&names[2]), svg.as_bytes(), args.force)?;
+    }
+    let mut text = summary.render_table();
+    text.push_str(&format!(
+        "\nwritten: {}\n",
+        names
+            .iter()
+            .map(|n| dir.join(n).display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    ));
+    emit(&text, None, false)
+}
+
+fn merge(args: &MergeArgs) -> Result<()> {
+    let report = sweep::table::merge_files(
+        &args.output,
+        &args.inputs,
+        args.samples,
+        args.allow_missing,
+        args.force,
+    )?;
+    if !report.duplicates.is_empty() {
+        eprintln!(
+            "note: {} sample(s) were in more than one input, with the same row: {}",
+            report.duplicates.len(),
+            sweep::table::ranges(&report.duplicates)
+        );
+    }
+    if !report.missing.is_empty() {
+        eprintln!(
+            "warning: {} sample(s) missing: {}",
+            report.missing.len(),
+            sweep::table::ranges(&report.missing)
+        );
+    }
+    eprintln!(
+        "{}: {} rows from {} file(s)",
+        args.output.display(),
+        report.rows,
+        args.inputs.len()
+    );
+    Ok(())
 }

@@ -18,10 +18,10 @@ use super::summary::Collected;
 
 const WIDTH: f64 = 760.0;
 const LEFT: f64 = 80.0;
-const RIGHT: f64 = 150.0;
+const RIGHT: f64 = 190.0;
 const PANEL: f64 = 220.0;
 const GAP: f64 = 70.0;
-const TOP: f64 = 50.0;
+const TOP: f64 = 75.0;
 const PLOT_WIDTH: f64 = WIDTH - LEFT - RIGHT;
 const COLORS: [&str; 8] = [
     "#1f5fa8", "#c0392b", "#2a8a3a", "#e67e22", "#8e44ad", "#16a085", "#7f8c8d", "#d35400",
@@ -29,8 +29,8 @@ const COLORS: [&str; 8] = [
 /// Histogram bars of a continuous value.
 const BINS: usize = 30;
 
-/// A named polyline of (x, y) points; `None` breaks the line.
-type Series = (String, Vec<Option<(f64, f64)>>);
+/// A named polyline of (x, y) points; a `None` y breaks the line.
+type Series = (String, Vec<(f64, Option<f64>)>);
 
 /// One panel's content.
 enum Content {
@@ -138,7 +138,7 @@ fn grid_panels(c: &Collected, sampler: &Sampler) -> Result<Vec<Panel>, SweepErro
     for &index in &c.index {
         let values = sampler.values_vec(index)?;
         if let Some(&b) = values.get(1) {
-            series_names[(index % inner as u64) as usize] = format!("{} = {b:.4e}", keys[1]);
+            series_names[(index % inner as u64) as usize] = format!("{} = {b:?}", keys[1]);
         }
         xs.push(values[0]);
     }
@@ -148,9 +148,7 @@ fn grid_panels(c: &Collected, sampler: &Sampler) -> Result<Vec<Panel>, SweepErro
             .map(|n| (n.clone(), Vec::new()))
             .collect();
         for (i, &index) in c.index.iter().enumerate() {
-            out[(index % inner as u64) as usize]
-                .1
-                .push(y(i).map(|y| (xs[i], y)));
+            out[(index % inner as u64) as usize].1.push((xs[i], y(i)));
         }
         out
     };
@@ -184,11 +182,8 @@ fn draw(out: &mut String, panel: &Panel, top: f64) {
             ),
         ),
         Content::Lines(lines) => {
-            let points: Vec<(f64, f64)> = lines
-                .iter()
-                .flat_map(|l| l.1.iter().flatten())
-                .copied()
-                .collect();
+            let points: Vec<(f64, Option<f64>)> =
+                lines.iter().flat_map(|l| l.1.iter()).copied().collect();
             let span = |v: Vec<f64>| match (
                 v.iter().copied().reduce(f64::min),
                 v.iter().copied().reduce(f64::max),
@@ -196,7 +191,7 @@ fn draw(out: &mut String, panel: &Panel, top: f64) {
                 (Some(a), Some(b)) => (a, b),
                 _ => (0.0, 1.0),
             };
-            let (y0, y1) = span(points.iter().map(|p| p.1).collect());
+            let (y0, y1) = span(points.iter().filter_map(|p| p.1).collect());
             (
                 span(points.iter().map(|p| p.0).collect()),
                 (y0.min(0.0), y1),
@@ -205,8 +200,9 @@ fn draw(out: &mut String, panel: &Panel, top: f64) {
     };
     let (x0, x1) = widen(x_range);
     let (y0, y1) = widen(y_range);
-    let x_ticks = ticks(x0, x1);
-    let y_ticks = ticks(y0, y1);
+    let x_ticks = ticks(x0, x1, false);
+    // Counts have whole ticks.
+    let y_ticks = ticks(y0, y1, matches!(panel.content, Content::Bars(_)));
     let (x0, x1) = (x0.min(x_ticks[0]), x1.max(*x_ticks.last().unwrap_or(&x1)));
     let (y0, y1) = (y0.min(y_ticks[0]), y1.max(*y_ticks.last().unwrap_or(&y1)));
     let px = |x: f64| LEFT + (x - x0) / (x1 - x0) * PLOT_WIDTH;
@@ -273,7 +269,7 @@ fn draw(out: &mut String, panel: &Panel, top: f64) {
                 let mut pen_down = false;
                 for point in points {
                     match point {
-                        Some((x, y)) => {
+                        (x, Some(y)) => {
                             let _ = write!(
                                 path,
                                 "{}{:.1},{:.1} ",
@@ -289,7 +285,7 @@ fn draw(out: &mut String, panel: &Panel, top: f64) {
                                 py(*y)
                             );
                         }
-                        None => pen_down = false,
+                        (_, None) => pen_down = false,
                     }
                 }
                 let _ = writeln!(
@@ -322,9 +318,11 @@ fn widen((a, b): (f64, f64)) -> (f64, f64) {
     }
 }
 
-/// Round ticks (1, 2, 5 × 10ⁿ apart) covering [a, b], about five.
-fn ticks(a: f64, b: f64) -> Vec<f64> {
+/// Round ticks (1, 2, 5 × 10ⁿ apart, at least 1 when `whole`) covering
+/// [a, b], about five.
+fn ticks(a: f64, b: f64, whole: bool) -> Vec<f64> {
     let raw = (b - a) / 5.0;
+    let raw = if whole { raw.max(1.0) } else { raw };
     let magnitude = 10f64.powf(raw.log10().floor());
     let step = [1.0, 2.0, 5.0, 10.0]
         .iter()
