@@ -1,0 +1,326 @@
+//! `chatterspice sweep` and `chatterspice merge` end to end: the CSV is
+//! the same for any `--jobs` (mechanics only, and a small sweep on real
+//! ngspice), samples that never close are recorded, shards merged equal
+//! one run byte for byte, and bad input is exit code 2 naming the key.
+//!
+//! Tests that need ngspice skip with a note when it is missing, and fail
+//! when `REQUIRE_NGSPICE=1` (CI sets it).
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use assert_cmd::Command;
+use predicates::prelude::*;
+
+fn chatterspice() -> Command {
+    Command::cargo_bin("chatterspice").unwrap()
+}
+
+/// The built-in relay and circuit with `sweep` appended, written to
+/// `dir/relay.toml` (its netlist named by absolute path).
+fn scenario(dir: &Path, sweep: &str) -> PathBuf {
+    let netlist = Path::new(env!("CARGO_MANIFEST_DIR")).join("netlists/mcu_input.cir");
+    let text = chatterspice::scenario::DEFAULT_SCENARIO_TOML
+        .replace("../netlists/mcu_input.cir", &netlist.to_string_lossy());
+    let path = dir.join("relay.toml");
+    std::fs::write(&path, format!("{text}\n{sweep}\n")).unwrap();
+    path
+}
+
+const VARY: &str = "[sweep]\nsamples = 6\nseed = 11\n[sweep.vary]\n\"mechanics.mass\" = 0.1\n\
+                    \"surface.damping\" = { normal = 0.1 }\n\"mechanics.force\" = 0.2";
+
+/// Run `sweep` with `args` into `dir/name`, returning the CSV.
+fn sweep_csv(scenario: &Path, dir: &Path, name: &str, args: &[&str]) -> Vec<u8> {
+    let out = dir.join(name);
+    chatterspice()
+        .arg("sweep")
+        .arg(scenario)
+        .arg("--out")
+        .arg(&out)
+        .args(args)
+        .assert()
+        .success();
+    std::fs::read(out.join("sweep.csv")).unwrap()
+}
+
+#[test]
+fn mechanics_only_csv_is_the_same_for_one_and_two_jobs() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = scenario(dir.path(), VARY);
+    let args = ["--mechanics-only", "--samples", "2000"];
+    let one = sweep_csv(
+        &s,
+        dir.path(),
+        "j1",
+        &[&args[..], &["--jobs", "1"]].concat(),
+    );
+    let two = sweep_csv(
+        &s,
+        dir.path(),
+        "j2",
+        &[&args[..], &["--jobs", "2"]].concat(),
+    );
+    assert_eq!(one, two);
+    assert_eq!(String::from_utf8(one).unwrap().lines().count(), 2001);
+    for file in ["summary.json", "sweep.svg"] {
+        assert_eq!(
+            std::fs::read(dir.path().join("j1").join(file)).unwrap(),
+            std::fs::read(dir.path().join("j2").join(file)).unwrap(),
+            "{file}"
+        );
+    }
+}
+
+#[test]
+fn ngspice_csv_is_the_same_for_one_and_two_jobs() {
+    let _ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    let s = scenario(dir.path(), VARY);
+    let one = sweep_csv(&s, dir.path(), "j1", &["--jobs", "1"]);
+    let two = sweep_csv(&s, dir.path(), "j2", &["--jobs", "2"]);
+    assert_eq!(one, two);
+    let text = String::from_utf8(one).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "index,mechanics.force,mechanics.mass,surface.damping,outcome,bounce_count,\
+         first_impact,settle_time,bounce_time,v(in).edges,v(in).peak,verdict,error"
+    );
+    let rows: Vec<&str> = lines.collect();
+    assert_eq!(rows.len(), 6);
+    for (i, row) in rows.iter().enumerate() {
+        assert!(row.starts_with(&format!("{i},")), "{row}");
+        assert!(row.ends_with(",pass,"), "every sample ran: {row}");
+        // The bounce makes extra edges at the MCU pin.
+        let edges: usize = row.split(',').nth(9).unwrap().parse().unwrap();
+        assert!(edges >= 1, "{row}");
+    }
+}
+
+#[test]
+fn an_ngspice_sweep_with_samples_that_never_close_completes_and_records_them() {
+    let _ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    // Up to 0.3 N the armature cannot reach the gap; from 0.4 N it
+    // touches but falls back open (ends_open) until, from 0.7 N, it stays.
+    let s = scenario(
+        dir.path(),
+        "[sweep.grid]\n\"mechanics.force\" = { from = 0.1, to = 1.0, steps = 10 }",
+    );
+    let out = dir.path().join("out");
+    chatterspice()
+        .args(["sweep", "--jobs", "2", "--out"])
+        .arg(&out)
+        .arg(&s)
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("never_closes 3"));
+    let text = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+    let rows: Vec<&str> = text.lines().skip(1).collect();
+    assert_eq!(rows.len(), 10, "{text}");
+    for row in &rows[..3] {
+        // Recorded: the outcome, no bounce, and a pin that never moved.
+        assert!(row.contains(",never_closes,0,,,,0,"), "{row}");
+        assert!(row.ends_with(",pass,"), "{row}");
+    }
+    assert!(rows[3].contains(",ends_open,"), "{}", rows[3]);
+    for row in &rows[7..] {
+        assert!(
+            row.contains(",stuck,") || row.contains(",resolved,"),
+            "{row}"
+        );
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["outcomes"]["never_closes"], 3);
+    assert_eq!(summary["kind"], "grid");
+}
+
+#[test]
+fn an_ngspice_failure_is_a_row_and_the_sweep_goes_on() {
+    let _ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    // A probe of a node the circuit does not have fails every sample's
+    // analysis, after ngspice ran.
+    let s = scenario(dir.path(), VARY);
+    let text = std::fs::read_to_string(&s)
+        .unwrap()
+        .replace("signal = \"v(in)\"", "signal = \"v(nowhere)\"");
+    std::fs::write(&s, text).unwrap();
+    let out = dir.path().join("out");
+    chatterspice()
+        .args(["sweep", "--samples", "2", "--out"])
+        .arg(&out)
+        .arg(&s)
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("errors: 2"));
+    let text = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+    let rows: Vec<&str> = text.lines().skip(1).collect();
+    assert_eq!(rows.len(), 2);
+    for row in rows {
+        assert!(row.contains(",stuck,") && row.contains(",error,"), "{row}");
+        assert!(row.contains("v(nowhere)"), "{row}");
+    }
+}
+
+fn shards_then_merge(dir: &Path, s: &Path, extra: &[&str]) {
+    let whole = sweep_csv(s, dir, "whole", extra);
+    let shard_dir = dir.join("shards");
+    for k in ["2/3", "1/3", "3/3"] {
+        chatterspice()
+            .arg("sweep")
+            .arg(s)
+            .args(["--shard", k, "--out"])
+            .arg(&shard_dir)
+            .args(extra)
+            .assert()
+            .success();
+    }
+    assert!(!shard_dir.join("summary.json").exists());
+    let merged = dir.join("merged.csv");
+    chatterspice()
+        .arg("merge")
+        .arg(&merged)
+        .args(["3", "1", "2"].map(|k| shard_dir.join(format!("sweep.{k}-of-3.csv"))))
+        .assert()
+        .success();
+    assert_eq!(std::fs::read(&merged).unwrap(), whole);
+}
+
+#[test]
+fn shards_merged_equal_one_run_byte_for_byte() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = scenario(dir.path(), VARY);
+    shards_then_merge(dir.path(), &s, &["--mechanics-only", "--samples", "1500"]);
+}
+
+#[test]
+fn ngspice_shards_merged_equal_one_run_byte_for_byte() {
+    let _ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    let s = scenario(dir.path(), VARY);
+    shards_then_merge(dir.path(), &s, &["--samples", "5"]);
+}
+
+#[test]
+fn merge_reports_missing_samples_and_refuses_to_write() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = scenario(dir.path(), VARY);
+    let out = dir.path().join("shards");
+    chatterspice()
+        .arg("sweep")
+        .arg(&s)
+        .args(["--mechanics-only", "--shard", "1/2", "--out"])
+        .arg(&out)
+        .assert()
+        .success();
+    let merged = dir.path().join("merged.csv");
+    chatterspice()
+        .arg("merge")
+        .arg(&merged)
+        .arg(out.join("sweep.1-of-2.csv"))
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("missing: 1, 3"));
+    assert!(!merged.exists());
+    chatterspice()
+        .arg("merge")
+        .arg(&merged)
+        .arg(out.join("sweep.1-of-2.csv"))
+        .args(["--allow-missing", "--samples", "6"])
+        .assert()
+        .success()
+        .stderr(predicate::str::contains("3 sample(s) missing: 1, 3, 5"));
+}
+
+#[test]
+fn an_unknown_vary_key_is_exit_2_naming_the_key_and_listing_the_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = scenario(dir.path(), "[sweep.vary]\n\"mechanics.mas\" = 0.1");
+    chatterspice()
+        .arg("sweep")
+        .arg(&s)
+        .arg("--mechanics-only")
+        .assert()
+        .code(2)
+        .stderr(
+            predicate::str::contains("`mechanics.mas`")
+                .and(predicate::str::contains("relay.toml:"))
+                .and(predicate::str::contains(
+                    "mechanics.mass, mechanics.stiffness",
+                )),
+        );
+}
+
+#[test]
+fn bad_input_is_exit_2_with_what_to_change() {
+    let dir = tempfile::tempdir().unwrap();
+    let no_sweep = scenario(dir.path(), "");
+    chatterspice()
+        .arg("sweep")
+        .arg(&no_sweep)
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("[sweep.vary]"));
+    let s = scenario(dir.path(), VARY);
+    for (args, message) in [
+        (&["--shard", "3/2"][..], "--shard"),
+        (&["--shard", "x"][..], "K/N"),
+        (&["--jobs", "0"][..], "--jobs"),
+    ] {
+        chatterspice()
+            .arg("sweep")
+            .arg(&s)
+            .args(args)
+            .assert()
+            .code(2)
+            .stderr(predicate::str::contains(message));
+    }
+    let grid = scenario(
+        dir.path(),
+        "[sweep.grid]\n\"mechanics.force\" = { from = 0.5, to = 1.0, steps = 3 }",
+    );
+    chatterspice()
+        .arg("sweep")
+        .arg(&grid)
+        .args(["--samples", "10", "--mechanics-only"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("grid"));
+}
+
+#[test]
+fn existing_files_are_not_overwritten_without_force() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = scenario(dir.path(), VARY);
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join("summary.json"), "mine").unwrap();
+    chatterspice()
+        .arg("sweep")
+        .arg(&s)
+        .args(["--mechanics-only", "--out"])
+        .arg(&out)
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("--force"));
+    assert_eq!(
+        std::fs::read_to_string(out.join("summary.json")).unwrap(),
+        "mine"
+    );
+    assert!(!out.join("sweep.csv").exists());
+    chatterspice()
+        .arg("sweep")
+        .arg(&s)
+        .args(["--mechanics-only", "--force", "--out"])
+        .arg(&out)
+        .assert()
+        .success();
+    assert_ne!(
+        std::fs::read_to_string(out.join("summary.json")).unwrap(),
+        "mine"
+    );
+}
