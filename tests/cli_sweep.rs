@@ -324,3 +324,49 @@ fn existing_files_are_not_overwritten_without_force() {
         "mine"
     );
 }
+
+#[test]
+fn an_interrupted_sweep_leaves_the_header_and_whole_rows() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = scenario(dir.path(), VARY);
+    let out = dir.path().join("out");
+    let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("chatterspice"))
+        .arg("sweep")
+        .arg(&s)
+        .args([
+            "--mechanics-only",
+            "--jobs",
+            "1",
+            "--samples",
+            "100000000",
+            "--out",
+        ])
+        .arg(&out)
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let csv = out.join("sweep.csv");
+    // Until some rows are on disk, then stop it as a scheduler would.
+    let started = std::time::Instant::now();
+    while std::fs::metadata(&csv).map_or(0, |m| m.len()) < 100_000 {
+        assert!(started.elapsed().as_secs() < 60, "no rows written");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let text = std::fs::read_to_string(&csv).unwrap();
+    // Whole lines only; a kill inside a write(2) could cut the last one,
+    // which a reader then drops.
+    let whole = &text[..=text.rfind('\n').unwrap()];
+    let mut reader = csv::Reader::from_reader(whole.as_bytes());
+    let width = reader.headers().unwrap().len();
+    let mut rows = 0u64;
+    for (i, row) in reader.records().enumerate() {
+        let row = row.unwrap();
+        assert_eq!(row.len(), width);
+        assert_eq!(row[0].parse::<u64>().unwrap(), i as u64);
+        rows += 1;
+    }
+    assert!(rows > 500, "{rows}");
+    assert!(!out.join("summary.json").exists());
+}
