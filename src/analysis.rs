@@ -711,11 +711,7 @@ mod tests {
     use super::*;
 
     fn probe(signal: &str, low: f64, high: f64) -> Probe {
-        Probe {
-            signal: signal.to_owned(),
-            low,
-            high,
-        }
+        Probe::new(signal, low, high)
     }
 
     /// `n` points evenly spaced over [0, t_end].

@@ -14,6 +14,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use std::time::Duration;
 
+use chatterspice::check;
 use chatterspice::mechanics::Dimensionless;
 use chatterspice::netlist::{self, ContactElement};
 use chatterspice::pipeline::{self, RunOptions};
@@ -42,6 +43,9 @@ pub enum Command {
     Bounce(BounceArgs),
     /// Print the ngspice include file with the contact subcircuit.
     Pwl(PwlArgs),
+    /// Hold the scenario's [limits] and probe limits against the run:
+    /// exit 0 when all hold, 1 when any fails, 2 on bad input.
+    Check(CheckArgs),
     /// Print a SPICE raw file: one plot as CSV, or a JSON summary of every plot.
     Raw(RawArgs),
     /// Run the scenario many times with the numbers of its [sweep] varied
@@ -51,15 +55,26 @@ pub enum Command {
     Merge(MergeArgs),
 }
 
+/// How a command that did its job ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Status {
+    Success,
+    /// `check` ran, and a limit failed (exit code 1); or a `sweep` ran and
+    /// a sample failed a limit or could not run.
+    CheckFailed,
+}
+
 impl Command {
-    pub fn run(&self) -> Result<()> {
+    pub fn run(&self) -> Result<Status> {
+        let done = |r: Result<()>| r.map(|()| Status::Success);
         match self {
-            Command::Run(args) => run(args),
-            Command::Bounce(args) => bounce(args),
-            Command::Pwl(args) => pwl(args),
-            Command::Raw(args) => raw(args),
+            Command::Run(args) => done(run(args)),
+            Command::Bounce(args) => done(bounce(args)),
+            Command::Pwl(args) => done(pwl(args)),
+            Command::Check(args) => check(args),
+            Command::Raw(args) => done(raw(args)),
             Command::Sweep(args) => sweep(args),
-            Command::Merge(args) => merge(args),
+            Command::Merge(args) => done(merge(args)),
         }
     }
 }
@@ -129,6 +144,31 @@ pub struct RunArgs {
     /// Keep ngspice's work directories and print where they are.
     #[arg(long)]
     pub keep_workdir: bool,
+
+    /// The ngspice program [default: $CHATTERSPICE_NGSPICE, else ngspice
+    /// on PATH].
+    #[arg(long, value_name = "PROGRAM")]
+    pub ngspice: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub struct CheckArgs {
+    /// Scenario file (TOML) with [limits] and/or probe limits; `-` reads
+    /// it from stdin.
+    #[arg(value_name = "SCENARIO")]
+    pub scenario: Option<PathBuf>,
+
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = RunFormat::Table)]
+    pub format: RunFormat,
+
+    /// Wall-clock limit of each ngspice run, in seconds.
+    #[arg(long, value_name = "S", default_value_t = 60.0, value_parser = parse_timeout)]
+    pub timeout: f64,
+
+    /// How the contact is emitted (see `run`).
+    #[arg(long, value_name = "ELEMENT", value_parser = parse_element)]
+    pub element: Option<ContactElement>,
 
     /// The ngspice program [default: $CHATTERSPICE_NGSPICE, else ngspice
     /// on PATH].
@@ -293,6 +333,37 @@ fn run(args: &RunArgs) -> Result<()> {
         report::write_bundle(dir, &files, args.force)?;
     }
     emit(&text, None, false)
+}
+
+fn check(args: &CheckArgs) -> Result<Status> {
+    let scenario = load_scenario(args.scenario.as_deref())?;
+    let needs_ngspice = scenario.probes.iter().any(|p| p.has_limits());
+    let options = RunOptions {
+        timeout: Duration::from_secs_f64(args.timeout),
+        element: args.element,
+        ..RunOptions::default()
+    };
+    let (verdict, evidence) = if needs_ngspice {
+        let ngspice = Ngspice::locate(args.ngspice.as_deref())?;
+        check::run_with(&scenario, &ngspice, &options)?
+    } else {
+        // The relay's limits alone: no circuit, no ngspice needed.
+        check::relay_only(&scenario)?
+    };
+    let dimensionless = scenario
+        .mechanics()
+        .ok()
+        .map(|m| Dimensionless::of(&m, &scenario.surface()));
+    let text = match args.format {
+        RunFormat::Json => report::json::render_check(&verdict, &evidence, dimensionless.as_ref()),
+        RunFormat::Table => report::table::render_check(&verdict, evidence.chatter()),
+    };
+    emit(&text, None, false)?;
+    Ok(if verdict.passed {
+        Status::Success
+    } else {
+        Status::CheckFailed
+    })
 }
 
 /// Fail before any work if `--out DIR` already holds a file the run
@@ -551,7 +622,9 @@ impl sweep::Progress for Bar {
     }
 }
 
-fn sweep(args: &SweepArgs) -> Result<()> {
+/// Exit status 1 when a sample failed a limit or could not run: the
+/// sweep's files are written either way.
+fn sweep(args: &SweepArgs) -> Result<Status> {
     let scenario = load_scenario(Some(&args.scenario))?;
     let sampler = Sampler::new(&scenario, args.samples, args.seed)?;
     let dir = args.out.clone().unwrap_or_else(|| PathBuf::from("."));
@@ -631,7 +704,12 @@ fn sweep(args: &SweepArgs) -> Result<()> {
             .collect::<Vec<_>>()
             .join(", ")
     ));
-    emit(&text, None, false)
+    emit(&text, None, false)?;
+    Ok(if summary.failing + summary.errors > 0 {
+        Status::CheckFailed
+    } else {
+        Status::Success
+    })
 }
 
 fn merge(args: &MergeArgs) -> Result<()> {

@@ -11,6 +11,7 @@
 
 pub mod analysis;
 pub mod chatter;
+pub mod check;
 pub mod mechanics;
 pub mod netlist;
 pub mod pipeline;

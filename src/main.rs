@@ -8,6 +8,9 @@ use std::process::ExitCode;
 
 use clap::Parser;
 
+/// Exit code for a `check` whose limits did not all hold.
+const EXIT_CHECK_FAILED: u8 = 1;
+
 /// Exit code for bad input or a failure to run (interfaces.md §2).
 const EXIT_FAILURE: u8 = 2;
 
@@ -25,7 +28,8 @@ fn main() -> ExitCode {
         }
     };
     match cli.command.run() {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(cli::Status::Success) => ExitCode::SUCCESS,
+        Ok(cli::Status::CheckFailed) => ExitCode::from(EXIT_CHECK_FAILED),
         Err(err) => {
             report_error(&err);
             ExitCode::from(EXIT_FAILURE)

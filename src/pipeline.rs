@@ -319,6 +319,12 @@ fn run_chatter(
         .transpose()?;
 
     let closures = analysis::closures(&chatter);
+    // The ideal contact's one closure: from the first impact on.
+    let ideal_closures: Vec<(f64, f64)> = chatter
+        .first_impact
+        .map(|t| (t, chatter.t_end.max(t)))
+        .into_iter()
+        .collect();
     let mut probes = Vec::with_capacity(scenario.probes.len());
     for probe in &scenario.probes {
         let probe_error = |run, source| RunError::Probe {
@@ -331,7 +337,7 @@ fn run_chatter(
             .map_err(|e| probe_error("bounced", e))?;
         let ideal_analysis = ideal
             .as_ref()
-            .map(|sim| analysis::analyze(&sim.plot, probe, &closures))
+            .map(|sim| analysis::analyze(&sim.plot, probe, &ideal_closures))
             .transpose()
             .map_err(|e| probe_error("ideal", e))?;
         let comparison = ideal_analysis

@@ -262,16 +262,70 @@ fn default_coil_subckt() -> String {
     "COIL".to_owned()
 }
 
-/// `[[probe]]`: a measured signal and its Schmitt thresholds.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+/// `[[probe]]`: a measured signal, its Schmitt thresholds, and the limits
+/// `check` holds it to (all optional).
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Probe {
     /// An ngspice vector name, e.g. `v(in)`.
     pub signal: String,
-    /// V
+    /// V (A for a current): the Schmitt thresholds.
     pub low: f64,
-    /// V
     pub high: f64,
+    /// Most Schmitt edges allowed (1 = one clean transition).
+    #[serde(default)]
+    pub max_edges: Option<u64>,
+    /// Most glitches allowed (edges − 1).
+    #[serde(default)]
+    pub max_glitches: Option<u64>,
+    /// Largest |value| allowed, in the signal's unit (inrush, spikes).
+    #[serde(default)]
+    pub max_peak: Option<f64>,
+    /// Highest value allowed (e.g. an input's absolute maximum rating).
+    #[serde(default)]
+    pub max_value: Option<f64>,
+    /// Lowest value allowed (e.g. −0.3 V below ground on an input).
+    #[serde(default)]
+    pub min_value: Option<f64>,
+    /// s, the last edge must come by then (the signal has settled).
+    #[serde(default)]
+    pub max_last_edge: Option<f64>,
+}
+
+impl Probe {
+    /// A probe with thresholds and no limits.
+    pub fn new(signal: impl Into<String>, low: f64, high: f64) -> Probe {
+        Probe {
+            signal: signal.into(),
+            low,
+            high,
+            ..Probe::default()
+        }
+    }
+
+    /// Whether any limit is set.
+    pub fn has_limits(&self) -> bool {
+        self.max_edges.is_some()
+            || self.max_glitches.is_some()
+            || self.max_peak.is_some()
+            || self.max_value.is_some()
+            || self.min_value.is_some()
+            || self.max_last_edge.is_some()
+    }
+}
+
+/// `[limits]`: what `check` holds the relay to. SI units; all optional.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LimitsSection {
+    /// s, settle time − first impact.
+    pub max_bounce_time: Option<f64>,
+    /// Most bounces (openings after the first impact).
+    pub max_bounces: Option<u64>,
+    /// s, the settle time: from the force step to closed for good.
+    pub max_operate_time: Option<f64>,
+    /// s, the first impact (first make).
+    pub max_first_make: Option<f64>,
 }
 
 /// The file as serde sees it; [`Scenario`] adds the origin and the
@@ -289,6 +343,7 @@ struct Document {
     circuit: Option<CircuitSection>,
     #[serde(default)]
     probe: Vec<Probe>,
+    limits: Option<LimitsSection>,
     sweep: Option<SweepSection>,
 }
 
@@ -305,6 +360,8 @@ pub struct Scenario {
     pub circuit: Option<CircuitSection>,
     /// The `[[probe]]` tables, in file order.
     pub probes: Vec<Probe>,
+    /// `[limits]`, for `check`.
+    pub limits: Option<LimitsSection>,
     /// `[sweep]`, for `chatterspice sweep`.
     pub sweep: Option<SweepSection>,
     /// Computed once during validation: converting a Hunt–Crossley
@@ -510,6 +567,7 @@ impl Scenario {
             simulation: document.simulation,
             circuit,
             probes: document.probe,
+            limits: document.limits,
             sweep: document.sweep,
             resolved_surface,
             embedded_netlist: None,
@@ -861,6 +919,9 @@ impl Check<'_> {
         }
         for (i, probe) in d.probe.iter().enumerate() {
             self.probe(i, probe)?;
+        }
+        if let Some(limits) = &d.limits {
+            self.limits(limits)?;
         }
         Ok(surface)
     }
@@ -1242,7 +1303,61 @@ impl Check<'_> {
                 "must be below `probe[{i}].high` = {:?} V: the Schmitt thresholds need low < high",
                 p.high
             ),
-        )
+        )?;
+        if let Some(v) = p.max_peak {
+            self.number(
+                &key("max_peak"),
+                v,
+                v > 0.0,
+                "must be > 0: the largest |value| allowed, in the signal's unit",
+            )?;
+        }
+        if let Some(v) = p.max_last_edge {
+            self.number(
+                &key("max_last_edge"),
+                v,
+                v > 0.0,
+                "must be > 0: the time by which the signal must have settled, in s",
+            )?;
+        }
+        if let Some(v) = p.max_value {
+            self.number(&key("max_value"), v, true, "")?;
+        }
+        if let Some(v) = p.min_value {
+            let max = p.max_value.unwrap_or(f64::INFINITY);
+            self.number(
+                &key("min_value"),
+                v,
+                v < max,
+                format!("must be below `probe[{i}].max_value` = {max:?}"),
+            )?;
+        }
+        Ok(())
+    }
+
+    fn limits(&self, l: &LimitsSection) -> Result<(), ScenarioError> {
+        for (key, value, what) in [
+            (
+                "limits.max_bounce_time",
+                l.max_bounce_time,
+                "the longest bounce time allowed (settle − first impact), in s",
+            ),
+            (
+                "limits.max_operate_time",
+                l.max_operate_time,
+                "the latest settle time allowed, in s",
+            ),
+            (
+                "limits.max_first_make",
+                l.max_first_make,
+                "the latest first impact allowed, in s",
+            ),
+        ] {
+            if let Some(v) = value {
+                self.number(key, v, v > 0.0, format!("must be > 0: {what}"))?;
+            }
+        }
+        Ok(())
     }
 }
 
@@ -2015,14 +2130,7 @@ high = 2.31
             Path::new(env!("CARGO_MANIFEST_DIR")).join("netlists/mcu_input.cir")
         );
         assert!(netlist.is_file(), "{netlist:?}");
-        assert_eq!(
-            s.probes,
-            vec![Probe {
-                signal: "v(in)".into(),
-                low: 0.99,
-                high: 2.31
-            }]
-        );
+        assert_eq!(s.probes, vec![Probe::new("v(in)", 0.99, 2.31)]);
     }
 
     #[test]

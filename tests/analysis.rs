@@ -22,11 +22,7 @@ fn transient(raw: &RawFile) -> &Plot {
 }
 
 fn probe(signal: &str, low: f64, high: f64) -> Probe {
-    Probe {
-        signal: signal.to_owned(),
-        low,
-        high,
-    }
+    Probe::new(signal, low, high)
 }
 
 const R: f64 = 1e3; // Ω

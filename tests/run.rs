@@ -219,6 +219,9 @@ fn the_capacitive_load_takes_its_charge_in_several_bites() {
         held,
         drawn
     );
+    // The ideal contact delivers it in one closure.
+    let ideal = result.probes[0].ideal.as_ref().unwrap();
+    assert_eq!(ideal.current.as_ref().unwrap().per_closure.len(), 1);
     // The capacitor voltage itself crosses its thresholds once: the bounce
     // adds no edge there.
     let v = &result.probes[1];

@@ -11,6 +11,7 @@ use serde::Serialize;
 
 use crate::analysis::{Comparison, ProbeAnalysis};
 use crate::chatter::Chatter;
+use crate::check::{Evidence, Verdict};
 use crate::mechanics::Dimensionless;
 use crate::pipeline::{RunResult, Simulation};
 
@@ -154,6 +155,36 @@ impl<'a> RunJson<'a> {
             warnings: &run.warnings,
         }
     }
+}
+
+/// The `check` document: the verdict (`passed`, `failed`, `checks`), the
+/// bounce, and the whole run when the circuit was simulated (`null` when
+/// the limits needed the mechanics only).
+#[derive(Debug, Serialize)]
+pub struct CheckJson<'a> {
+    #[serde(flatten)]
+    verdict: &'a Verdict,
+    bounce: BounceJson<'a>,
+    run: Option<RunJson<'a>>,
+}
+
+/// The `check` result as pretty-printed JSON with a trailing newline.
+pub fn render_check(
+    verdict: &Verdict,
+    evidence: &Evidence,
+    dimensionless: Option<&Dimensionless>,
+) -> String {
+    let doc = CheckJson {
+        verdict,
+        bounce: BounceJson::new(evidence.chatter(), dimensionless),
+        run: match evidence {
+            Evidence::Run(run) => Some(RunJson::new(run, dimensionless)),
+            Evidence::Mechanics(_) => None,
+        },
+    };
+    let mut text = serde_json::to_string_pretty(&doc).expect("a check result always serializes");
+    text.push('\n');
+    text
 }
 
 /// The `run` result as pretty-printed JSON with a trailing newline.

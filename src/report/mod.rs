@@ -18,7 +18,7 @@ pub mod csv;
 pub mod json;
 pub mod svg;
 pub mod table;
-mod units;
+pub(crate) mod units;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};

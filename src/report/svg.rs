@@ -762,11 +762,7 @@ mod tests {
     }
 
     fn demo<'a>(time: &'a [f64], value: &'a [f64], intervals: &'a [Interval]) -> SvgPlot<'a> {
-        let probe = Probe {
-            signal: "v(in)".to_owned(),
-            low: 0.99,
-            high: 2.31,
-        };
+        let probe = Probe::new("v(in)", 0.99, 2.31);
         let a = analyze_samples(&probe, ProbeKind::Voltage, time, value, &[]).unwrap();
         SvgPlot {
             title: "MCU input <relay K1> & \"bounce\"".to_owned(),

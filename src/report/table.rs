@@ -11,6 +11,7 @@ use std::fmt::Write;
 use super::units::engineering;
 use crate::analysis::ProbeAnalysis;
 use crate::chatter::{Chatter, Impact, Outcome};
+use crate::check::{Bound, Verdict, quantity};
 use crate::pipeline::RunResult;
 
 /// Summary and impact table, `\n`-terminated.
@@ -66,7 +67,7 @@ pub fn render(chatter: &Chatter) -> String {
     for (n, impact) in chatter.impacts.iter().enumerate() {
         rows.push(impact_row(n + 1, impact));
     }
-    out.push_str(&align(&rows, false));
+    out.push_str(&align(&rows, 0));
     out
 }
 
@@ -148,7 +149,7 @@ pub fn render_run(run: &RunResult) -> String {
             rows.push(probe_row("  ideal contact", ideal));
         }
     }
-    out.push_str(&align(&rows, true));
+    out.push_str(&align(&rows, 1));
 
     for p in &run.probes {
         let a = &p.analysis;
@@ -215,13 +216,76 @@ pub fn render_run(run: &RunResult) -> String {
                     engineering(k.charge, "C"),
                 ]);
             }
-            out.push_str(&align(&rows, true));
+            out.push_str(&align(&rows, 1));
         }
     }
     for warning in &run.warnings {
         let _ = writeln!(out, "warning: {warning}");
     }
     out
+}
+
+/// A check for a person: the verdict, the relay in one line, then one row
+/// per limit with its margin, failures marked.
+pub fn render_check(verdict: &Verdict, chatter: &Chatter) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "{}: {} of {} limits failed",
+        if verdict.passed { "PASS" } else { "FAIL" },
+        verdict.failed,
+        verdict.checks.len()
+    );
+    let _ = writeln!(
+        out,
+        "relay: {}, {} bounces, first make {}, settled {}",
+        chatter.outcome,
+        chatter.bounce_count,
+        ms(chatter.first_impact),
+        ms(chatter.settle_time)
+    );
+    out.push('\n');
+    let mut rows =
+        vec![["", "limit", "quantity", "actual", "", "limit", "margin"].map(String::from)];
+    for c in &verdict.checks {
+        let margin = match (c.margin, &c.note) {
+            (Some(m), _) => {
+                let relative = if c.limit != 0.0 {
+                    format!(" ({:+.0} %)", 100.0 * m / c.limit.abs())
+                } else {
+                    String::new()
+                };
+                format!("{}{relative}", signed(m, c.unit))
+            }
+            (None, Some(note)) => note.clone(),
+            (None, None) => ABSENT.to_owned(),
+        };
+        rows.push([
+            if c.passed { "pass" } else { "FAIL" }.to_owned(),
+            c.key.clone(),
+            c.quantity.clone(),
+            c.actual
+                .map_or_else(|| ABSENT.to_owned(), |a| quantity(a, c.unit)),
+            match c.bound {
+                Bound::Max => "<=".to_owned(),
+                Bound::Min => ">=".to_owned(),
+            },
+            quantity(c.limit, c.unit),
+            margin,
+        ]);
+    }
+    out.push_str(&align(&rows, 3));
+    out
+}
+
+/// A margin with its sign.
+fn signed(value: f64, unit: &str) -> String {
+    let text = quantity(value.abs(), unit);
+    if value < 0.0 {
+        format!("-{text}")
+    } else {
+        format!("+{text}")
+    }
 }
 
 fn probe_row(label: &str, a: &ProbeAnalysis) -> [String; 8] {
@@ -265,9 +329,9 @@ fn impact_row(n: usize, i: &Impact) -> [String; 10] {
 }
 
 /// Right-aligned columns two spaces apart.
-/// Right-aligned columns, except the first when `names_first` (a column
-/// of names reads better left-aligned).
-fn align<const N: usize>(rows: &[[String; N]], names_first: bool) -> String {
+/// Right-aligned columns (numbers), except the first `left` columns
+/// (names read better left-aligned).
+fn align<const N: usize>(rows: &[[String; N]], left: usize) -> String {
     let width = |c: usize| rows.iter().map(|r| r[c].chars().count()).max().unwrap_or(0);
     let widths: Vec<usize> = (0..N).map(width).collect();
     let mut out = String::new();
@@ -277,7 +341,7 @@ fn align<const N: usize>(rows: &[[String; N]], names_first: bool) -> String {
             .zip(&widths)
             .enumerate()
             .map(|(i, (cell, &w))| {
-                if i == 0 && names_first {
+                if i < left {
                     format!("{cell:<w$}")
                 } else {
                     format!("{cell:>w$}")

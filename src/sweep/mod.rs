@@ -173,6 +173,8 @@ pub struct Record {
     /// results; empty otherwise.
     pub probes: Vec<ProbeRecord>,
     pub verdict: Verdict,
+    /// The keys of the limits that failed, in the scenario's order.
+    pub failed_limits: Vec<String>,
     /// Why the sample failed: the error and its causes, one line.
     pub error: Option<String>,
 }

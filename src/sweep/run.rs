@@ -235,6 +235,7 @@ impl<'a, 'r> Worker<'a, 'r> {
             bounce_time: None,
             probes: Vec::new(),
             verdict: Verdict::Error,
+            failed_limits: Vec::new(),
             error: None,
         };
         if let Err(e) = self.sampler.values(index, &mut self.values) {
@@ -277,7 +278,7 @@ impl<'a, 'r> Worker<'a, 'r> {
             .map(|(first, settle)| settle - first);
         match self.options.mode {
             Mode::Mechanics => {
-                record.verdict = verdict(scenario, &chatter, None);
+                (record.verdict, record.failed_limits) = verdict(scenario, &chatter, None);
             }
             Mode::Circuit(runner) => match pipeline::run(scenario, runner, &self.options.run) {
                 Ok(result) => {
@@ -289,7 +290,8 @@ impl<'a, 'r> Worker<'a, 'r> {
                             peak: p.analysis.max.abs().max(p.analysis.min.abs()),
                         })
                         .collect();
-                    record.verdict = verdict(scenario, &chatter, Some(&result));
+                    (record.verdict, record.failed_limits) =
+                        verdict(scenario, &chatter, Some(&result));
                 }
                 Err(e) => record.error = Some(one_line(&e)),
             },

@@ -41,6 +41,8 @@ pub struct Collected {
     /// `[probe][sample]`, max |value|.
     pub peak: Vec<Vec<Option<f64>>>,
     pub verdict: Vec<Verdict>,
+    /// Samples that failed each limit, by limit key.
+    pub failed_limits: BTreeMap<String, u64>,
     /// The first errors, with their sample index.
     pub first_errors: Vec<(u64, String)>,
 }
@@ -72,6 +74,9 @@ impl Collected {
             peak.push(probe.map(|x| x.peak));
         }
         self.verdict.push(r.verdict);
+        for key in &r.failed_limits {
+            *self.failed_limits.entry(key.clone()).or_insert(0) += 1;
+        }
         if let Some(e) = &r.error {
             if self.first_errors.len() < QUOTED_ERRORS {
                 self.first_errors.push((r.index, e.clone()));
@@ -139,6 +144,14 @@ impl Collected {
             verdicts,
             failing,
             errors,
+            limits: self
+                .failed_limits
+                .iter()
+                .map(|(key, &failing)| {
+                    let fraction = failing as f64 / n.max(1) as f64;
+                    (key.clone(), LimitFailures { failing, fraction })
+                })
+                .collect(),
             fraction_failing: if n == 0 {
                 0.0
             } else {
@@ -252,6 +265,14 @@ pub struct Worst {
     pub values: BTreeMap<String, f64>,
 }
 
+/// The samples that failed one limit.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LimitFailures {
+    pub failing: u64,
+    /// failing / samples.
+    pub fraction: f64,
+}
+
 /// A sample that failed, and why.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SampleError {
@@ -275,6 +296,9 @@ pub struct Summary {
     pub failing: u64,
     /// Samples that could not run.
     pub errors: u64,
+    /// Per limit key that some sample failed: how many, and the fraction
+    /// of all samples.
+    pub limits: BTreeMap<String, LimitFailures>,
     /// (failing + errors) / samples.
     pub fraction_failing: f64,
     pub bounce_count: Option<Distribution>,
@@ -323,6 +347,14 @@ impl Summary {
             self.errors,
             100.0 * self.fraction_failing
         );
+        for (key, f) in &self.limits {
+            let _ = writeln!(
+                out,
+                "  {key}: failed by {} ({:.1} %)",
+                f.failing,
+                100.0 * f.fraction
+            );
+        }
         let _ = writeln!(
             out,
             "\n{:<16}{:>12}{:>12}{:>12}{:>12}",

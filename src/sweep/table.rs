@@ -4,8 +4,10 @@
 //! sorted order), `outcome`, `bounce_count`, `first_impact`,
 //! `settle_time`, `bounce_time` (s, settle − first impact), then per probe
 //! `<signal>.edges` and `<signal>.peak` (max |value|, V or A), then
-//! `verdict` (`pass`, `fail`, `error`) and `error` (why the sample failed,
-//! one line). An absent value is an empty cell. Numbers are SI in Rust's
+//! `verdict` (`pass`, `fail`, `error`; see [`super::verdict`]),
+//! `failed_limits` (the keys of the limits that failed, space-separated,
+//! e.g. `limits.max_bounce_time probe[0].max_edges`) and `error` (why the
+//! sample could not run, one line). An absent value is an empty cell. Numbers are SI in Rust's
 //! shortest round-trip form; quoting (a signal `v(a,b)`, an error with a
 //! comma) is the `csv` crate's, so every row parses back.
 //!
@@ -42,6 +44,7 @@ pub fn header(keys: &[String], signals: &[String]) -> Vec<u8> {
         names.push(format!("{s}.peak"));
     }
     names.push("verdict".to_owned());
+    names.push("failed_limits".to_owned());
     names.push("error".to_owned());
     w.write_record(&names).expect("writing to memory");
     w.into_inner().expect("writing to memory")
@@ -80,6 +83,8 @@ pub fn rows(records: &[Record]) -> Vec<u8> {
             number(&mut w, Some(p.peak));
         }
         w.write_field(r.verdict.as_str())
+            .expect("writing to memory");
+        w.write_field(r.failed_limits.join(" "))
             .expect("writing to memory");
         w.write_field(r.error.as_deref().unwrap_or(""))
             .expect("writing to memory");
@@ -425,6 +430,7 @@ mod tests {
                 peak: 3.3,
             }],
             verdict: Verdict::Pass,
+            failed_limits: vec![],
             error: None,
         }
     }
@@ -436,7 +442,7 @@ mod tests {
         assert_eq!(
             String::from_utf8(h).unwrap(),
             "index,mechanics.mass,surface.damping,outcome,bounce_count,first_impact,settle_time,\
-             bounce_time,\"v(a,b).edges\",\"v(a,b).peak\",verdict,error\n"
+             bounce_time,\"v(a,b).edges\",\"v(a,b).peak\",verdict,failed_limits,error\n"
         );
         let mut failed = record(1);
         failed.probes.clear();
@@ -448,11 +454,11 @@ mod tests {
         let text = String::from_utf8(rows(&[record(0)])).unwrap();
         assert_eq!(
             text,
-            "0,0.00015,0.25,stuck,3,0.001,0.002,0.001,5,3.3,pass,\n"
+            "0,0.00015,0.25,stuck,3,0.001,0.002,0.001,5,3.3,pass,,\n"
         );
         let text = String::from_utf8(rows(&[failed])).unwrap();
         assert!(
-            text.ends_with(",error,\"ngspice failed: timeout, 60 s\"\n"),
+            text.ends_with(",error,,\"ngspice failed: timeout, 60 s\"\n"),
             "{text}"
         );
     }

@@ -1,14 +1,15 @@
 //! The verdict of one sample: did the design hold?
 //!
-//! [`verdict`] is the single place where a sample is judged. The limits
-//! (`[limits]`, `chatterspice check`) are being written on another
-//! branch; until they arrive every sample that ran passes, and a sample
-//! that could not run is [`Verdict::Error`]. Plugging the check in means
-//! changing only the body of [`verdict`]: it already receives the
-//! scenario (whose limits apply), the chatter and, for a circuit sweep,
-//! the whole run.
+//! [`verdict`] is the single place where a sample is judged, by the same
+//! rules as `chatterspice check` ([`crate::check`]): a circuit sweep holds
+//! each sample's run against `[limits]` and every probe's limits; a
+//! `--mechanics-only` sweep has no circuit, so it holds the chatter
+//! against `[limits]` alone and ignores probe limits. Without limits every
+//! sample that ran passes. A sample that could not run is
+//! [`Verdict::Error`], whatever its limits.
 
 use crate::chatter::Chatter;
+use crate::check;
 use crate::pipeline::RunResult;
 use crate::scenario::Scenario;
 
@@ -43,10 +44,25 @@ impl Verdict {
     }
 }
 
-/// The verdict of a sample that ran: `run` is `None` for a
-/// mechanics-only sweep.
-pub fn verdict(scenario: &Scenario, chatter: &Chatter, run: Option<&RunResult>) -> Verdict {
-    // No limits yet (see the module overview): nothing can fail.
-    let _ = (scenario, chatter, run);
-    Verdict::Pass
+/// The verdict of a sample that ran, and the keys of the limits it
+/// failed (`limits.max_bounce_time`, `probe[0].max_edges`, …) in the
+/// scenario's order: `run` is `None` for a mechanics-only sweep.
+pub fn verdict(
+    scenario: &Scenario,
+    chatter: &Chatter,
+    run: Option<&RunResult>,
+) -> (Verdict, Vec<String>) {
+    let checked = match run {
+        Some(run) => check::evaluate(scenario, run),
+        None => match &scenario.limits {
+            Some(limits) => check::Verdict::new(check::relay_checks(limits, chatter)),
+            None => return (Verdict::Pass, Vec::new()),
+        },
+    };
+    let failed: Vec<String> = checked.failures().map(|c| c.key.clone()).collect();
+    if failed.is_empty() {
+        (Verdict::Pass, failed)
+    } else {
+        (Verdict::Fail, failed)
+    }
 }

@@ -1,0 +1,457 @@
+//! Design checks: a scenario's limits held against what the relay and the
+//! circuit did (`chatterspice check`, and a library call for a user's own
+//! `cargo test`).
+//!
+//! Limits come from `[limits]` (the relay: bounces, bounce time, first make,
+//! operate time) and from each `[[probe]]` (edges, glitches, peak, value
+//! range, the time of the last edge). Every limit becomes one
+//! [`LimitCheck`] with its margin, the room left before it fails: limit −
+//! actual for an upper limit, actual − limit for a lower one, so a
+//! negative margin is by how much it failed. A quantity that does not
+//! exist (a relay that never settles has no settle time) fails its limit
+//! with no margin.
+//!
+//! ```no_run
+//! use chatterspice::{check, scenario::Scenario, spice::Ngspice};
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let scenario = Scenario::load("relay.toml".as_ref())?;
+//! let verdict = check::run(&scenario, &Ngspice::find()?)?;
+//! assert!(verdict.passed, "{verdict}");
+//! # Ok(())
+//! # }
+//! ```
+
+use std::fmt;
+use std::path::PathBuf;
+
+use serde::Serialize;
+use thiserror::Error;
+
+use crate::analysis::ProbeAnalysis;
+use crate::chatter::Chatter;
+use crate::mechanics::{MechanicsError, simulate};
+use crate::pipeline::{self, RunError, RunOptions, RunResult};
+use crate::report::units::engineering;
+use crate::scenario::{LimitsSection, Probe, Scenario, ScenarioError};
+use crate::spice::Runner;
+
+/// Which side a limit bounds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Bound {
+    /// The quantity must not exceed the limit.
+    Max,
+    /// The quantity must not fall below the limit.
+    Min,
+}
+
+/// One limit against its quantity.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LimitCheck {
+    /// The scenario key that set the limit, e.g. `limits.max_bounces` or
+    /// `probe[0].max_edges`.
+    pub key: String,
+    /// What was measured, e.g. `bounces` or `v(in) edges`.
+    pub quantity: String,
+    /// SI unit symbol of `limit`, `actual` and `margin`; empty for counts.
+    pub unit: &'static str,
+    pub bound: Bound,
+    pub limit: f64,
+    /// `None` when the quantity does not exist (the check then fails).
+    pub actual: Option<f64>,
+    pub passed: bool,
+    /// Room left before the limit (negative: by how much it failed).
+    pub margin: Option<f64>,
+    /// Why `actual` is absent, when it is.
+    pub note: Option<String>,
+}
+
+impl LimitCheck {
+    fn new(
+        key: String,
+        quantity: String,
+        unit: &'static str,
+        bound: Bound,
+        limit: f64,
+        actual: Result<f64, String>,
+    ) -> LimitCheck {
+        let (actual, note) = match actual {
+            Ok(v) => (Some(v), None),
+            Err(why) => (None, Some(why)),
+        };
+        let margin = actual.map(|a| match bound {
+            Bound::Max => limit - a,
+            Bound::Min => a - limit,
+        });
+        LimitCheck {
+            key,
+            quantity,
+            unit,
+            bound,
+            limit,
+            actual,
+            passed: margin.is_some_and(|m| m >= 0.0),
+            margin,
+            note,
+        }
+    }
+}
+
+/// Every limit of a scenario, checked.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Verdict {
+    /// All limits held.
+    pub passed: bool,
+    /// Number of limits that failed.
+    pub failed: usize,
+    /// In scenario order: `[limits]` first, then each probe's.
+    pub checks: Vec<LimitCheck>,
+}
+
+impl Verdict {
+    pub fn new(checks: Vec<LimitCheck>) -> Verdict {
+        let failed = checks.iter().filter(|c| !c.passed).count();
+        Verdict {
+            passed: failed == 0,
+            failed,
+            checks,
+        }
+    }
+
+    /// The checks that failed.
+    pub fn failures(&self) -> impl Iterator<Item = &LimitCheck> {
+        self.checks.iter().filter(|c| !c.passed)
+    }
+}
+
+impl fmt::Display for Verdict {
+    /// One line per limit: `PASS`/`FAIL`, key, actual against limit, and
+    /// the margin.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "{}: {} of {} limits failed",
+            if self.passed { "PASS" } else { "FAIL" },
+            self.failed,
+            self.checks.len()
+        )?;
+        for c in &self.checks {
+            writeln!(
+                f,
+                "  {} {}: {} {} {}{}",
+                if c.passed { "pass" } else { "FAIL" },
+                c.key,
+                c.actual
+                    .map_or_else(|| "-".to_owned(), |a| quantity(a, c.unit)),
+                match c.bound {
+                    Bound::Max => "<=",
+                    Bound::Min => ">=",
+                },
+                quantity(c.limit, c.unit),
+                match (&c.margin, &c.note) {
+                    (Some(m), _) => format!(" (margin {})", quantity(*m, c.unit)),
+                    (None, Some(note)) => format!(" ({note})"),
+                    (None, None) => String::new(),
+                }
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// A count as an integer, anything else in engineering notation.
+pub fn quantity(value: f64, unit: &str) -> String {
+    if unit.is_empty() && value.fract() == 0.0 && value.abs() < 1e15 {
+        format!("{value:.0}")
+    } else {
+        engineering(value, unit)
+    }
+}
+
+/// Why a check could not be made (as opposed to failing).
+#[derive(Debug, Error)]
+pub enum CheckError {
+    #[error(
+        "{}: nothing to check: add a [limits] section (max_bounce_time, max_bounces, \
+         max_operate_time, max_first_make) or limits on a [[probe]] (max_edges, \
+         max_glitches, max_peak, max_value, min_value, max_last_edge)",
+        path.display()
+    )]
+    NoLimits { path: PathBuf },
+    #[error(transparent)]
+    Scenario(#[from] ScenarioError),
+    #[error("{}: the mechanics simulation failed", path.display())]
+    Mechanics {
+        path: PathBuf,
+        #[source]
+        source: MechanicsError,
+    },
+    #[error(transparent)]
+    Run(#[from] Box<RunError>),
+}
+
+/// The relay's limits against a chatter sequence.
+pub fn relay_checks(limits: &LimitsSection, chatter: &Chatter) -> Vec<LimitCheck> {
+    let never = |what: &str| format!("the contact {what} ({})", chatter.outcome);
+    let settle = chatter
+        .settle_time
+        .ok_or_else(|| never("never closes for good"));
+    let first = chatter.first_impact.ok_or_else(|| never("never touches"));
+    let mut out = Vec::new();
+    if let Some(limit) = limits.max_bounces {
+        out.push(LimitCheck::new(
+            "limits.max_bounces".into(),
+            "bounces".into(),
+            "",
+            Bound::Max,
+            limit as f64,
+            first.clone().map(|_| chatter.bounce_count as f64),
+        ));
+    }
+    if let Some(limit) = limits.max_bounce_time {
+        let bounce_time = match (&first, &settle) {
+            (Ok(f), Ok(s)) => Ok(s - f),
+            (Err(e), _) | (_, Err(e)) => Err(e.clone()),
+        };
+        out.push(LimitCheck::new(
+            "limits.max_bounce_time".into(),
+            "bounce time".into(),
+            "s",
+            Bound::Max,
+            limit,
+            bounce_time,
+        ));
+    }
+    if let Some(limit) = limits.max_first_make {
+        out.push(LimitCheck::new(
+            "limits.max_first_make".into(),
+            "first make".into(),
+            "s",
+            Bound::Max,
+            limit,
+            first.clone(),
+        ));
+    }
+    if let Some(limit) = limits.max_operate_time {
+        out.push(LimitCheck::new(
+            "limits.max_operate_time".into(),
+            "operate time".into(),
+            "s",
+            Bound::Max,
+            limit,
+            settle,
+        ));
+    }
+    out
+}
+
+/// Probe `index`'s limits against its analysis.
+pub fn probe_checks(index: usize, probe: &Probe, a: &ProbeAnalysis) -> Vec<LimitCheck> {
+    let key = |name: &str| format!("probe[{index}].{name}");
+    let what = |q: &str| format!("{} {q}", probe.signal);
+    let unit = a.kind.unit();
+    let mut out = Vec::new();
+    if let Some(limit) = probe.max_edges {
+        out.push(LimitCheck::new(
+            key("max_edges"),
+            what("edges"),
+            "",
+            Bound::Max,
+            limit as f64,
+            Ok(a.edges as f64),
+        ));
+    }
+    if let Some(limit) = probe.max_glitches {
+        out.push(LimitCheck::new(
+            key("max_glitches"),
+            what("glitches"),
+            "",
+            Bound::Max,
+            limit as f64,
+            Ok(a.glitches as f64),
+        ));
+    }
+    if let Some(limit) = probe.max_peak {
+        out.push(LimitCheck::new(
+            key("max_peak"),
+            what("peak |value|"),
+            unit,
+            Bound::Max,
+            limit,
+            Ok(a.max.abs().max(a.min.abs())),
+        ));
+    }
+    if let Some(limit) = probe.max_value {
+        out.push(LimitCheck::new(
+            key("max_value"),
+            what("maximum"),
+            unit,
+            Bound::Max,
+            limit,
+            Ok(a.max),
+        ));
+    }
+    if let Some(limit) = probe.min_value {
+        out.push(LimitCheck::new(
+            key("min_value"),
+            what("minimum"),
+            unit,
+            Bound::Min,
+            limit,
+            Ok(a.min),
+        ));
+    }
+    if let Some(limit) = probe.max_last_edge {
+        out.push(LimitCheck::new(
+            key("max_last_edge"),
+            what("last edge"),
+            "s",
+            Bound::Max,
+            limit,
+            a.last_edge
+                .ok_or_else(|| "the signal never crosses its thresholds".to_owned()),
+        ));
+    }
+    out
+}
+
+/// Every limit of `scenario` against a finished run.
+pub fn evaluate(scenario: &Scenario, run: &RunResult) -> Verdict {
+    let mut checks = scenario
+        .limits
+        .as_ref()
+        .map(|l| relay_checks(l, &run.chatter))
+        .unwrap_or_default();
+    for (i, (probe, result)) in scenario.probes.iter().zip(&run.probes).enumerate() {
+        checks.extend(probe_checks(i, probe, &result.analysis));
+    }
+    Verdict::new(checks)
+}
+
+/// What [`run`] did to reach its verdict.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Evidence {
+    /// Only the mechanics: no probe has a limit.
+    Mechanics(Chatter),
+    /// The whole pipeline through ngspice.
+    Run(Box<RunResult>),
+}
+
+impl Evidence {
+    pub fn chatter(&self) -> &Chatter {
+        match self {
+            Evidence::Mechanics(c) => c,
+            Evidence::Run(r) => &r.chatter,
+        }
+    }
+}
+
+/// Check `scenario`: the mechanics alone when only `[limits]` are set,
+/// the whole `run` through `runner` when a probe has a limit.
+pub fn run(scenario: &Scenario, runner: &dyn Runner) -> Result<Verdict, CheckError> {
+    run_with(scenario, runner, &RunOptions::default()).map(|(verdict, _)| verdict)
+}
+
+/// [`run`] with run options, returning the evidence too.
+pub fn run_with(
+    scenario: &Scenario,
+    runner: &dyn Runner,
+    options: &RunOptions,
+) -> Result<(Verdict, Evidence), CheckError> {
+    let probe_limits = scenario.probes.iter().any(Probe::has_limits);
+    if scenario.limits.is_none() && !probe_limits {
+        return Err(CheckError::NoLimits {
+            path: scenario.origin.clone(),
+        });
+    }
+    if probe_limits {
+        let result = pipeline::run(scenario, runner, options).map_err(Box::new)?;
+        return Ok((evaluate(scenario, &result), Evidence::Run(Box::new(result))));
+    }
+    relay_only(scenario)
+}
+
+/// The `[limits]` of `scenario` on the mechanics alone, without ngspice;
+/// probe limits are not looked at (use [`run_with`] for those).
+pub fn relay_only(scenario: &Scenario) -> Result<(Verdict, Evidence), CheckError> {
+    if scenario.limits.is_none() {
+        return Err(CheckError::NoLimits {
+            path: scenario.origin.clone(),
+        });
+    }
+    let chatter = simulate(
+        &scenario.mechanics()?,
+        &scenario.surface(),
+        &scenario.settings(),
+    )
+    .map_err(|source| CheckError::Mechanics {
+        path: scenario.origin.clone(),
+        source,
+    })?;
+    let checks = scenario
+        .limits
+        .as_ref()
+        .map(|l| relay_checks(l, &chatter))
+        .unwrap_or_default();
+    Ok((Verdict::new(checks), Evidence::Mechanics(chatter)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::fixtures;
+
+    #[test]
+    fn margins_are_room_left_and_negative_when_failed() {
+        let chatter = fixtures::stuck(); // 2 bounces, 0.4 ms bounce time
+        let limits = LimitsSection {
+            max_bounces: Some(1),
+            max_bounce_time: Some(1e-3),
+            max_operate_time: Some(1e-3),
+            max_first_make: None,
+        };
+        let checks = relay_checks(&limits, &chatter);
+        let by_key = |k: &str| checks.iter().find(|c| c.key == k).unwrap();
+        let bounces = by_key("limits.max_bounces");
+        assert!(!bounces.passed);
+        assert_eq!(bounces.margin, Some(1.0 - chatter.bounce_count as f64));
+        let time = by_key("limits.max_bounce_time");
+        let bt = chatter.settle_time.unwrap() - chatter.first_impact.unwrap();
+        assert!(time.passed);
+        assert_eq!(time.margin, Some(1e-3 - bt));
+        let operate = by_key("limits.max_operate_time");
+        assert_eq!(operate.passed, chatter.settle_time.unwrap() <= 1e-3);
+        let v = Verdict::new(checks.clone());
+        assert!(!v.passed);
+        assert_eq!(v.failed, checks.iter().filter(|c| !c.passed).count());
+        assert!(v.to_string().contains("FAIL limits.max_bounces"), "{v}");
+    }
+
+    #[test]
+    fn a_relay_that_never_closes_fails_every_relay_limit_with_a_reason() {
+        let chatter = fixtures::never_closes();
+        let limits = LimitsSection {
+            max_bounces: Some(10),
+            max_bounce_time: Some(1.0),
+            max_operate_time: Some(1.0),
+            max_first_make: Some(1.0),
+        };
+        let checks = relay_checks(&limits, &chatter);
+        assert_eq!(checks.len(), 4);
+        for c in &checks {
+            assert!(!c.passed, "{c:?}");
+            assert!(c.margin.is_none());
+            assert!(c.note.as_deref().unwrap().contains("never"), "{c:?}");
+        }
+    }
+
+    #[test]
+    fn a_limit_met_exactly_passes_with_zero_margin() {
+        let c = LimitCheck::new("k".into(), "q".into(), "", Bound::Max, 3.0, Ok(3.0));
+        assert!(c.passed);
+        assert_eq!(c.margin, Some(0.0));
+        let low = LimitCheck::new("k".into(), "q".into(), "V", Bound::Min, -0.3, Ok(-0.5));
+        assert!(!low.passed);
+        assert!((low.margin.unwrap() + 0.2).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,179 @@
+//! `chatterspice check` end to end: exit 0 when every limit holds, 1 when
+//! one fails, 2 on bad input; margins against values worked out here from
+//! the chatter (a bare pull-up shows 1 + 2 × bounces edges).
+//!
+//! Tests that need ngspice skip with a note when it is missing, and fail
+//! when `REQUIRE_NGSPICE=1` (CI sets it).
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use assert_cmd::Command;
+use predicates::prelude::*;
+use serde_json::Value;
+
+use chatterspice::scenario::DEFAULT_SCENARIO_TOML;
+
+fn chatterspice() -> Command {
+    Command::cargo_bin("chatterspice").unwrap()
+}
+
+/// The default relay on a bare pull-up, with `probe_limits` added to its
+/// probe and `limits` as its `[limits]` body (no section when empty).
+fn scenario(dir: &Path, probe_limits: &str, limits: &str) -> PathBuf {
+    std::fs::write(
+        dir.join("pullup.cir"),
+        "pull-up\nVDD vdd 0 DC 3.3\nR1 vdd sw 10k\nX1 sw 0 CONTACT\n.tran 100n 5m\n.end\n",
+    )
+    .unwrap();
+    let cut = DEFAULT_SCENARIO_TOML.find("[circuit]").unwrap();
+    let mut text = format!(
+        "{}[circuit]\nnetlist = \"pullup.cir\"\n\n[[probe]]\nsignal = \"v(sw)\"\nlow = 0.99\nhigh = 2.31\n{probe_limits}\n",
+        &DEFAULT_SCENARIO_TOML[..cut]
+    );
+    if !limits.is_empty() {
+        text.push_str(&format!("\n[limits]\n{limits}\n"));
+    }
+    let path = dir.join("relay.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn check_json(path: &Path, code: i32) -> Value {
+    let out = chatterspice()
+        .args(["check", path.to_str().unwrap(), "--format", "json"])
+        .assert()
+        .code(code);
+    serde_json::from_slice(&out.get_output().stdout).unwrap()
+}
+
+fn check_of<'a>(v: &'a Value, key: &str) -> &'a Value {
+    v["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["key"] == key)
+        .unwrap_or_else(|| panic!("no check {key} in {v}"))
+}
+
+#[test]
+fn generous_limits_pass_with_their_margins() {
+    let _ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    let path = scenario(
+        dir.path(),
+        "max_edges = 20\nmax_value = 3.6\nmin_value = -0.3",
+        "max_bounces = 8\nmax_bounce_time = 5e-3",
+    );
+    let v = check_json(&path, 0);
+    assert_eq!(v["passed"], true);
+    assert_eq!(v["failed"], 0);
+    let bounces = v["bounce"]["bounce_count"].as_f64().unwrap();
+    assert_eq!(check_of(&v, "limits.max_bounces")["margin"], 8.0 - bounces);
+    // Unfiltered, every bounce is an edge pair.
+    assert_eq!(
+        check_of(&v, "probe[0].max_edges")["margin"],
+        20.0 - (1.0 + 2.0 * bounces)
+    );
+    let bounce_time = v["bounce"]["settle_time"].as_f64().unwrap()
+        - v["bounce"]["first_impact"].as_f64().unwrap();
+    let margin = check_of(&v, "limits.max_bounce_time")["margin"]
+        .as_f64()
+        .unwrap();
+    assert!((margin - (5e-3 - bounce_time)).abs() < 1e-15);
+    // The pull-up's high level: 3.3 V through 10 kΩ into 1 GΩ open.
+    let max = check_of(&v, "probe[0].max_value")["actual"]
+        .as_f64()
+        .unwrap();
+    assert!((max - 3.3 * 1e9 / (1e9 + 1e4)).abs() < 1e-6, "{max}");
+    assert!(v["run"]["probes"][0]["edges"].as_u64().is_some());
+}
+
+#[test]
+fn a_failed_limit_exits_1_and_says_which_and_by_how_much() {
+    let _ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    let path = scenario(dir.path(), "max_edges = 1", "max_bounces = 8");
+    let v = check_json(&path, 1);
+    assert_eq!(v["passed"], false);
+    assert_eq!(v["failed"], 1);
+    let bounces = v["bounce"]["bounce_count"].as_f64().unwrap();
+    let edges = check_of(&v, "probe[0].max_edges");
+    assert_eq!(edges["passed"], false);
+    assert_eq!(edges["margin"], 1.0 - (1.0 + 2.0 * bounces));
+    assert_eq!(check_of(&v, "limits.max_bounces")["passed"], true);
+
+    chatterspice()
+        .args(["check", path.to_str().unwrap()])
+        .assert()
+        .code(1)
+        .stdout(
+            predicate::str::contains("FAIL: 1 of 2 limits failed")
+                .and(predicate::str::is_match(r"FAIL\s+probe\[0\]\.max_edges").unwrap())
+                .and(predicate::str::contains(format!("-{}", 2.0 * bounces))),
+        );
+}
+
+#[test]
+fn relay_limits_alone_need_no_ngspice() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = scenario(dir.path(), "", "max_bounces = 4\nmax_operate_time = 2e-3");
+    let out = chatterspice()
+        .args([
+            "check",
+            path.to_str().unwrap(),
+            "--format",
+            "json",
+            "--ngspice",
+            "/nonexistent/ngspice",
+        ])
+        .assert()
+        .code(1);
+    let v: Value = serde_json::from_slice(&out.get_output().stdout).unwrap();
+    // The default relay bounces 5 times and settles at 1.23 ms.
+    assert_eq!(check_of(&v, "limits.max_bounces")["passed"], false);
+    assert_eq!(check_of(&v, "limits.max_operate_time")["passed"], true);
+    assert_eq!(v["run"], Value::Null);
+}
+
+#[test]
+fn nothing_to_check_or_a_bad_limit_is_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = scenario(dir.path(), "", "");
+    chatterspice()
+        .args(["check", path.to_str().unwrap()])
+        .assert()
+        .code(2)
+        .stderr(
+            predicate::str::contains("nothing to check").and(predicate::str::contains("[limits]")),
+        );
+    let path = scenario(dir.path(), "", "max_bounce_time = -1.0");
+    chatterspice()
+        .args(["check", path.to_str().unwrap()])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("limits.max_bounce_time"));
+    let path = scenario(dir.path(), "max_edge = 1", "");
+    chatterspice()
+        .args(["check", path.to_str().unwrap()])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("max_edge"));
+}
+
+#[test]
+fn the_library_check_is_usable_from_a_user_s_own_tests() {
+    let ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    let path = scenario(dir.path(), "max_glitches = 0", "");
+    let scenario = chatterspice::scenario::Scenario::load(&path).unwrap();
+    let verdict = chatterspice::check::run(&scenario, &ng).unwrap();
+    assert!(!verdict.passed);
+    let failure = verdict.failures().next().unwrap();
+    assert_eq!(failure.key, "probe[0].max_glitches");
+    assert!(
+        verdict.to_string().contains("FAIL probe[0].max_glitches"),
+        "{verdict}"
+    );
+}
