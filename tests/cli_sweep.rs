@@ -172,9 +172,16 @@ fn an_ngspice_failure_is_a_row_and_the_sweep_goes_on() {
     let rows: Vec<&str> = text.lines().skip(1).collect();
     assert_eq!(rows.len(), 2);
     for row in rows {
-        assert!(row.contains(",stuck,") && row.contains(",error,"), "{row}");
+        // The probe's cells are there, empty.
+        assert!(
+            row.contains(",stuck,") && row.contains(",,,error,,"),
+            "{row}"
+        );
         assert!(row.contains("v(nowhere)"), "{row}");
     }
+    // Every row has the header's width: the file reads back.
+    let mut reader = csv::Reader::from_path(out.join("sweep.csv")).unwrap();
+    assert_eq!(reader.records().filter_map(Result::ok).count(), 2);
 }
 
 fn shards_then_merge(dir: &Path, s: &Path, extra: &[&str]) {

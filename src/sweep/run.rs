@@ -134,6 +134,7 @@ pub fn run(
         }
     };
     let header = table::header(sampler.keys(), &signals);
+    let probes = signals.len();
     out.write_all(&header)
         .and_then(|()| out.flush())
         .map_err(SweepError::Write)?;
@@ -163,7 +164,7 @@ pub fn run(
                     let records: Vec<Record> = positions
                         .map(|p| worker.evaluate(options.shard.sample(p)))
                         .collect();
-                    let rows = table::rows(&records);
+                    let rows = table::rows(&records, sampler.keys().len(), probes);
                     if tx.send((c, rows, records)).is_err() {
                         break;
                     }

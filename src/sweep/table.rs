@@ -50,9 +50,11 @@ pub fn header(keys: &[String], signals: &[String]) -> Vec<u8> {
     w.into_inner().expect("writing to memory")
 }
 
-/// The rows of `records`, each `\n`-terminated. `keys` columns without a
-/// value (a sample whose values could not be drawn) are empty.
-pub fn rows(records: &[Record]) -> Vec<u8> {
+/// The rows of `records` for a sweep of `keys` varied keys and `probes`
+/// probes, each `\n`-terminated. A record without values or probes (a
+/// sample that failed before them) has empty cells there, so every row
+/// has the header's width.
+pub fn rows(records: &[Record], keys: usize, probes: usize) -> Vec<u8> {
     let mut w = Writer::from_writer(Vec::with_capacity(records.len() * 96));
     let mut cell = String::new();
     let mut number = |w: &mut Writer<Vec<u8>>, value: Option<f64>| {
@@ -63,11 +65,10 @@ pub fn rows(records: &[Record]) -> Vec<u8> {
         }
         w.write_field(&cell).expect("writing to memory");
     };
-    let width = records.iter().map(|r| r.values.len()).max().unwrap_or(0);
     for r in records {
         w.write_field(r.index.to_string())
             .expect("writing to memory");
-        for i in 0..width {
+        for i in 0..keys {
             number(&mut w, r.values.get(i).copied());
         }
         w.write_field(r.outcome.map_or("", |o| o.as_str()))
@@ -77,10 +78,11 @@ pub fn rows(records: &[Record]) -> Vec<u8> {
         number(&mut w, r.first_impact);
         number(&mut w, r.settle_time);
         number(&mut w, r.bounce_time);
-        for p in &r.probes {
-            w.write_field(p.edges.to_string())
+        for i in 0..probes {
+            let p = r.probes.get(i);
+            w.write_field(p.map_or_else(String::new, |p| p.edges.to_string()))
                 .expect("writing to memory");
-            number(&mut w, Some(p.peak));
+            number(&mut w, p.map(|p| p.peak));
         }
         w.write_field(r.verdict.as_str())
             .expect("writing to memory");
@@ -451,15 +453,16 @@ mod tests {
         failed.verdict = Verdict::Error;
         failed.error = Some("ngspice failed: timeout, 60 s".to_owned());
         failed.probes = vec![];
-        let text = String::from_utf8(rows(&[record(0)])).unwrap();
+        let text = String::from_utf8(rows(&[record(0)], 2, 1)).unwrap();
         assert_eq!(
             text,
             "0,0.00015,0.25,stuck,3,0.001,0.002,0.001,5,3.3,pass,,\n"
         );
-        let text = String::from_utf8(rows(&[failed])).unwrap();
-        assert!(
-            text.ends_with(",error,,\"ngspice failed: timeout, 60 s\"\n"),
-            "{text}"
+        failed.values.clear();
+        let text = String::from_utf8(rows(&[failed], 2, 1)).unwrap();
+        assert_eq!(
+            text,
+            "1,,,,,0.001,0.002,0.001,,,error,,\"ngspice failed: timeout, 60 s\"\n"
         );
     }
 
@@ -473,7 +476,7 @@ mod tests {
                 ..record(i)
             })
             .collect();
-        out.extend(rows(&records));
+        out.extend(rows(&records, 1, 0));
         out
     }
 
