@@ -252,3 +252,38 @@ fn the_summary_finds_the_worst_sample_and_the_plot_draws() {
     assert!(!svg.contains("NaN"));
     assert!(summary.render_table().contains("worst: sample"));
 }
+
+/// A disk that fills up after `room` bytes.
+struct Full {
+    room: usize,
+}
+
+impl std::io::Write for Full {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        if buf.len() > self.room {
+            return Err(std::io::Error::other("no space left"));
+        }
+        self.room -= buf.len();
+        Ok(buf.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+#[test]
+fn a_failing_output_stops_the_sweep_with_an_error_instead_of_hanging() {
+    let s = scenario("[sweep.vary]\n\"mechanics.mass\" = 0.1");
+    let sampler = Sampler::new(&s, Some(1_000_000), None).unwrap();
+    let mut options = SweepOptions::new(Mode::Mechanics);
+    options.jobs = NonZeroUsize::new(2).unwrap();
+    let err = sweep::run(
+        &s,
+        &sampler,
+        &options,
+        &mut Full { room: 200_000 },
+        &NoProgress,
+    )
+    .unwrap_err();
+    assert!(matches!(err, sweep::SweepError::Write(_)), "{err}");
+}

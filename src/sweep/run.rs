@@ -174,7 +174,9 @@ pub fn run(
         drop(tx);
         let mut pending = BTreeMap::new();
         let mut expected = 0;
-        for (c, rows, records) in rx.iter() {
+        // `rx` is moved in: returning early drops it, so that a worker
+        // blocked on a full channel gets an error and stops.
+        for (c, rows, records) in rx {
             pending.insert(c, (rows, records));
             while let Some((rows, records)) = pending.remove(&expected) {
                 if let Err(e) = out.write_all(&rows).and_then(|()| out.flush()) {
