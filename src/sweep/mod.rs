@@ -8,7 +8,7 @@
 //! - [`sample`]: the values of sample `i` — random draws (`[sweep.vary]`,
 //!   deterministic in (seed, key, i)) or the points of a one- or two-key
 //!   grid (`[sweep.grid]`);
-//! - [`run`]: every sample through [`pipeline::run`](crate::pipeline::run)
+//! - [`mod@run`]: every sample through [`pipeline::run`](crate::pipeline::run)
 //!   (mechanics → contact → netlist → ngspice → analysis) or through the
 //!   mechanics alone, on several threads, each sample's outcome a
 //!   [`Record`] — a failing sample (never closes, ngspice error, timeout)
