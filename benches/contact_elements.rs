@@ -1,7 +1,7 @@
 //! Whole-process benchmark of the contact elements: each run writes the
 //! include and a deck, runs `ngspice -b -r` through the real runner and
 //! times the process (wall clock). Prints Markdown tables for
-//! `notes/contact-elements.md`.
+//! `docs/contact-elements.md`.
 //!
 //! A plain timed program, not criterion: one 10 000-bounce PWL run takes
 //! minutes, far beyond criterion's sampling.

@@ -2,7 +2,7 @@
 //! a two-terminal element whose conductance follows a [`Waveform`].
 //!
 //! Three elements are available ([`ContactElement`]); the comparison that
-//! chose the default is in `notes/contact-elements.md` (which also
+//! chose the default is in `docs/contact-elements.md` (which also
 //! measured an XSPICE `filesource`: without breakpoints, G jumps within a
 //! time step and the integrator rings, so it is not offered):
 //!
@@ -60,7 +60,7 @@ use crate::waveform::{Point, Waveform, format_time};
 pub const DEFAULT_POINTS_PER_SOURCE: usize = 256;
 
 /// Above this many points [`ContactElement::for_waveform`] picks
-/// event-ramp. Measured (notes/contact-elements.md): 100 bounces (404
+/// event-ramp. Measured (docs/contact-elements.md): 100 bounces (404
 /// points) run in 0.07 s as PWL and 0.13 s as event-ramp, 1000 bounces
 /// (4004 points) in 2.5 s and 1.1 s; the crossover lies near 500 bounces.
 pub const EVENT_RAMP_ABOVE_POINTS: usize = 2000;
@@ -406,7 +406,7 @@ fn emit_chain(
 }
 
 /// `+ t v t v ...` continuation lines, closed with `)`.
-fn pairs(out: &mut String, values: impl Iterator<Item = (f64, f64)>) {
+pub(super) fn pairs(out: &mut String, values: impl Iterator<Item = (f64, f64)>) {
     let mut current = String::from("+");
     for (t, v) in values {
         let pair = format!(" {} {}", format_time(t), format_time(v));
@@ -427,13 +427,13 @@ fn reciprocal(g: f64) -> f64 {
     format!("{r:.14e}").parse().unwrap_or(r)
 }
 
-fn line(out: &mut String, text: &str) {
+pub(super) fn line(out: &mut String, text: &str) {
     out.push_str(text);
     out.push('\n');
 }
 
 /// `* ` comment lines, wrapped at word boundaries.
-fn comment(out: &mut String, text: &str) {
+pub(super) fn comment(out: &mut String, text: &str) {
     let mut current = String::from("*");
     for word in text.split_whitespace() {
         if current.len() > 1 && current.len() + 1 + word.len() > LINE_WIDTH {
