@@ -14,6 +14,7 @@
 //!
 //! Everything here is text in, text out, and deterministic.
 
+pub mod coil;
 pub mod contact;
 pub mod deck;
 pub mod number;
@@ -36,6 +37,17 @@ pub use number::parse_number;
 /// line; every message says what to change.
 #[derive(Debug, Error)]
 pub enum NetlistError {
+    #[error("the armature trajectory for the coil is empty: give at least one (time, x) point")]
+    EmptyTrajectory,
+    #[error(
+        "armature trajectory point {index} at {time:?} s does not follow {previous:?} s \
+         (or its position is not finite): times must strictly increase"
+    )]
+    BadTrajectory {
+        index: usize,
+        time: f64,
+        previous: f64,
+    },
     #[error(
         "contact subcircuit name {name:?} {problem}: use a SPICE identifier (a letter or `_`, \
          then letters, digits or `_`) such as CONTACT, instantiated as `X1 a b CONTACT`"

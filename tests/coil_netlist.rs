@@ -1,0 +1,88 @@
+//! The coil subcircuit in real ngspice: with the armature held, the plain
+//! RL step; with the armature moving, the back-EMF of a changing
+//! inductance, against the closed form of a flux linkage held constant.
+//!
+//! Tests that need ngspice skip with a note when it is missing, and fail
+//! when `REQUIRE_NGSPICE=1` (CI sets it).
+
+mod common;
+
+use chatterspice::netlist::coil::{MU0, coil_include};
+use chatterspice::rawfile::Vector;
+use chatterspice::scenario::CoilSection;
+use chatterspice::spice::{RunRequest, Runner};
+
+/// The coil of model.md §7's reference case.
+const COIL: CoilSection = CoilSection {
+    resistance: 70.0,
+    turns: 3000,
+    pole_area: 2e-5,
+    air_gap: 6e-4,
+    iron_gap: 5e-5,
+};
+
+fn inductance(x: f64) -> f64 {
+    MU0 * 9e6 * 2e-5 / (6e-4 - x + 5e-5)
+}
+
+/// (time, coil current) of `deck` with the coil following `trajectory`.
+fn current(deck: &str, trajectory: &[(f64, f64)]) -> Option<(Vec<f64>, Vec<f64>)> {
+    let ng = common::ngspice()?;
+    let mut req = RunRequest::new(deck);
+    req.includes.push((
+        "coil.inc".into(),
+        coil_include(&COIL, "COIL", trajectory).unwrap(),
+    ));
+    let out = ng.run(&req).unwrap();
+    let plot = out.raw.plot_named("transient analysis").unwrap();
+    let time = match plot.scale() {
+        Some(Vector::Real(t)) => t.to_vec(),
+        _ => panic!("no time"),
+    };
+    Some((time, plot.real("i(v.x2.vi)").unwrap().to_vec()))
+}
+
+#[test]
+fn a_held_armature_is_the_plain_rl_step() {
+    let deck = "coil held\n.include coil.inc\nV1 a 0 PWL(0 0 1n 5)\nX2 a 0 COIL\n\
+                .tran 10u 20m 0 10u\n.end\n";
+    let Some((t, i)) = current(deck, &[(0.0, 0.0), (1.0, 0.0)]) else {
+        return;
+    };
+    let tau = inductance(0.0) / 70.0;
+    let mut worst: f64 = 0.0;
+    for (t, i) in t.iter().zip(&i) {
+        let exact = 5.0 / 70.0 * (1.0 - (-(t - 1e-9).max(0.0) / tau).exp());
+        worst = worst.max((i - exact).abs());
+    }
+    // ngspice's RELTOL (1e-3) of the 71 mA final current.
+    assert!(worst < 1e-3 * 5.0 / 70.0, "worst error {worst} A");
+}
+
+#[test]
+fn a_moving_armature_changes_the_current_at_constant_flux() {
+    // Drive the coil to a steady current, then close the armature fast:
+    // over a time much shorter than L/R the flux linkage ψ = L·i stays
+    // put, so the current falls as the inductance rises (the pull-in dip).
+    let deck = "coil closing\n.include coil.inc\nV1 a 0 DC 5\nX2 a 0 COIL\n\
+                .tran 1u 20.2m 0 1u\n.end\n";
+    // Held until 20 ms (five L/R: steady), then closed by 0.4 mm in 20 µs.
+    let trajectory = [(0.0, 0.0), (20e-3, 0.0), (20.02e-3, 4e-4), (1.0, 4e-4)];
+    let Some((t, i)) = current(deck, &trajectory) else {
+        return;
+    };
+    let at = |time: f64| {
+        let k = t.partition_point(|&x| x < time);
+        i[k]
+    };
+    let before = at(19.999e-3);
+    let after = at(20.021e-3);
+    // Steady state: V/R (the DC operating point makes the coil a short).
+    assert!((before - 5.0 / 70.0).abs() < 1e-6, "{before}");
+    // Flux conserved over 20 µs ≪ L/R = 5 ms, to the decay in that time.
+    let expected = before * inductance(0.0) / inductance(4e-4);
+    assert!(
+        (after / expected - 1.0).abs() < 0.01,
+        "{after} vs {expected}"
+    );
+}
