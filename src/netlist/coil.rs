@@ -43,7 +43,8 @@ pub fn coil_include(
         return Err(NetlistError::EmptyTrajectory);
     }
     for (index, w) in trajectory.windows(2).enumerate() {
-        if !(w[1].0 > w[0].0) || !w[1].1.is_finite() {
+        let forward = w[1].0 > w[0].0;
+        if !forward || !w[1].1.is_finite() {
             return Err(NetlistError::BadTrajectory {
                 index: index + 1,
                 time: w[1].0,
