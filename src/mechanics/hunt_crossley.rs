@@ -2,12 +2,28 @@
 //!
 //! In contact the motion is `m ẍ + c ẋ + k x = F − Fc`, with
 //! `Fc = ks δⁿ (1 + χ δ̇)` clamped at 0 and δ = x − g. There is no closed
-//! form, so the contact is integrated by [`Dopri5`] in the state (δ, δ̇)
-//! (δ rather than x, so the tiny penetration keeps its relative precision).
+//! form, so the contact is integrated by [`Dop853`].
+//!
+//! **Regularized variables.** With the Hertz exponent n = 3/2 the force
+//! grows like δ^1.5 from the touch, so the motion is not smooth at either
+//! end of the contact (δ(t) has a t^3.5 term), and a high-order method
+//! would need tiny steps there. The integration therefore runs in
+//! u = √δ and a fictitious time s with dt = u ds (a Sundman transform):
+//!
+//! ```text
+//! du/ds = v/2,   dv/ds = u·a(u², v),   dt/ds = u,
+//! a = (F − c v − k (g + u²) − ks·uⁿ'·max(0, 1 + χ v)) / m,   uⁿ' = δⁿ
+//! ```
+//!
+//! which is polynomial in (u, v) for n = 1 and 3/2: smooth through the
+//! touch (u = 0 at s = 0) and the release, where u crosses 0 as a simple
+//! root (du/ds = v/2 < 0). δ = u² keeps the tiny penetration's relative
+//! precision. At u = 0, dv/ds = dt/ds = 0, so the release velocity and
+//! time hardly depend on where exactly in s the root is placed.
 //!
 //! Two events end a contact:
-//! - release: δ returns to 0 moving out, located on the step's dense
-//!   output by bisection;
+//! - release: u returns to 0 moving out, located on the step's dense
+//!   output by Newton's method (du/ds = v/2 is known);
 //! - sticking: mechanical energy `E = ½mv² + ½kx² − Fx + ks δⁿ⁺¹/(n+1)`
 //!   never increases (both the viscous term and the clamp only remove
 //!   energy), and reaching δ = 0 needs `E ≥ U(g) = ½kg² − Fg`. Once
@@ -15,10 +31,11 @@
 //!   and happens in finite time whenever the in-contact equilibrium lies
 //!   past the surface (k0 < 1).
 
-use nalgebra::Vector2;
+use nalgebra::Vector3;
 
 use super::MechanicsError;
-use super::integrate::{Dopri5, Step, Tolerance};
+use super::dop853::{Dop853, Dop853Step};
+use super::integrate::Tolerance;
 use super::root;
 
 /// Everything the contact integration needs (SI units).
@@ -61,6 +78,9 @@ pub struct HcOutcome {
     pub min_force: f64,
 }
 
+/// The integrated state (u, v, t): u = √δ (√m), v = δ̇ (m/s), t (s).
+type State = Vector3<f64>;
+
 impl HcContact {
     /// Contact force at penetration δ and rate δ̇.
     pub fn force_at(&self, delta: f64, delta_dot: f64) -> f64 {
@@ -83,16 +103,17 @@ impl HcContact {
         }
     }
 
-    fn energy_margin(&self, y: &Vector2<f64>) -> f64 {
+    /// The contact force at the integrated state (u, v, t).
+    fn force_of(&self, y: &State) -> f64 {
+        self.force_at(y[0] * y[0], y[1])
+    }
+
+    fn energy_margin(&self, y: &State) -> f64 {
         // E − U(g), with x = g + δ: the spring and drive terms expand to
         // (k g − F) δ + ½ k δ², avoiding cancellation of large ½kx² terms.
-        let (d, v) = (y[0], y[1]);
+        let (d, v) = (y[0] * y[0], y[1]);
         let n = self.exponent;
-        let surface = if d > 0.0 {
-            self.surface_stiffness * d * self.power(d) / (n + 1.0)
-        } else {
-            0.0
-        };
+        let surface = self.surface_stiffness * d * self.power(d) / (n + 1.0);
         0.5 * self.mass * v * v
             + (self.stiffness * self.gap - self.force) * d
             + 0.5 * self.stiffness * d * d
@@ -102,25 +123,24 @@ impl HcContact {
     /// Integrate one contact that starts at δ = 0 with impact speed
     /// `v_hit` (> 0), for at most `budget` seconds.
     pub fn run(&self, v_hit: f64, budget: f64) -> Result<HcOutcome, MechanicsError> {
-        let m = *self;
-        let rhs = move |_t: f64, y: &Vector2<f64>| {
-            let (d, v) = (y[0], y[1]);
-            let fc = m.force_at(d, v);
-            let a = (m.force - m.damping * v - m.stiffness * (m.gap + d) - fc) / m.mass;
-            Vector2::new(v, a)
-        };
+        let equations = Regularized::of(self);
+        let rhs = move |_s: f64, y: &State| equations.rate(y);
         // Scales: the depth at which the surface alone would stop the
-        // impact (energy balance), and the time to get there.
+        // impact (energy balance), the time to get there, and the
+        // fictitious time s = t/u for it.
         let n = self.exponent;
         let depth = ((n + 1.0) * self.mass * v_hit * v_hit / (2.0 * self.surface_stiffness))
             .powf(1.0 / (n + 1.0));
         let t_scale = depth / v_hit;
+        let u_scale = depth.sqrt();
+        let s_scale = t_scale / u_scale;
         let rtol = 1e-9;
         let tol = Tolerance {
             rtol,
-            atol: Vector2::new(rtol * depth, rtol * v_hit),
+            atol: State::new(rtol * u_scale, rtol * v_hit, rtol * t_scale),
         };
-        let mut solver = Dopri5::new(rhs, 0.0, Vector2::new(0.0, v_hit), 1e-2 * t_scale, tol);
+        let h0 = H0 * s_scale;
+        let mut solver = Dop853::new(rhs, 0.0, State::new(0.0, v_hit, 0.0), h0, tol);
         let mut peak = Peak::default();
         let sticks_possible = self.stiffness * self.gap < self.force;
         // Sticking is tested with a small margin so that rounding can never
@@ -129,79 +149,196 @@ impl HcContact {
         // The force is clamped at 0, which it is at touch: nothing smaller
         // is ever seen.
         let min_force = 0.0;
+        let outcome = |end, peak_force| HcOutcome {
+            end,
+            peak_force,
+            min_force,
+        };
         loop {
-            let step = solver.step(budget)?;
-            peak.track(step, self.force_at(step.y1[0], step.y1[1]));
+            let step = match solver.step(f64::INFINITY) {
+                Ok(step) => step,
+                // Report the physical time, not the fictitious one.
+                Err(MechanicsError::StepSizeTooSmall { step, .. }) => {
+                    let y = solver.y();
+                    return Err(MechanicsError::StepSizeTooSmall {
+                        time: y[2],
+                        step: step * y[0].abs(),
+                    });
+                }
+                Err(e) => return Err(e),
+            };
             if step.y1[0] < 0.0 {
-                // Released inside this step: δ(t0) ≥ 0 > δ(t1).
-                let t_rel =
-                    root::bisect(|t| step.at(t)[0], step.t0, step.t1, 1e-15).unwrap_or(step.t1);
-                let y = step.at(t_rel);
-                return Ok(HcOutcome {
-                    end: HcEnd::Released {
-                        after: t_rel,
+                // Released inside this step: u(s0) ≥ 0 > u(s1).
+                let y = self.release(&step, &mut solver);
+                let end = if y[2] <= budget {
+                    HcEnd::Released {
+                        after: y[2],
                         velocity: y[1],
-                    },
-                    peak_force: self.refine_peak(&peak),
-                    min_force,
-                });
+                    }
+                } else {
+                    HcEnd::Horizon
+                };
+                peak.track(step, 0.0);
+                return Ok(outcome(end, self.refine_peak(&peak, &mut solver)));
+            }
+            peak.track(step, self.force_of(&step.y1));
+            if step.y1[2] >= budget {
+                let peak_force = self.refine_peak(&peak, &mut solver);
+                return Ok(outcome(HcEnd::Horizon, peak_force));
             }
             // Stuck is declared only once moving out again (past the
             // deepest penetration, so the force peak has been seen): the
             // reported peak force then does not depend on step sizes.
             let moving_out = step.y1[1] < 0.0;
             if sticks_possible && moving_out && self.energy_margin(&step.y1) < -stick_margin {
-                return Ok(HcOutcome {
-                    end: HcEnd::Stuck { after: step.t1 },
-                    peak_force: self.refine_peak(&peak),
-                    min_force,
-                });
-            }
-            if step.t1 >= budget {
-                return Ok(HcOutcome {
-                    end: HcEnd::Horizon,
-                    peak_force: self.refine_peak(&peak),
-                    min_force,
-                });
+                let end = HcEnd::Stuck { after: step.y1[2] };
+                return Ok(outcome(end, self.refine_peak(&peak, &mut solver)));
             }
         }
     }
 
-    /// Golden-section search for the force maximum on the dense output
-    /// around the largest step-end force.
-    fn refine_peak(&self, peak: &Peak) -> f64 {
-        let Some(step) = peak.step else {
-            return peak.force;
-        };
-        let next = peak.next.unwrap_or(step);
-        let fc = |t: f64| {
-            let y = if t <= step.t1 { step.at(t) } else { next.at(t) };
-            self.force_at(y[0], y[1])
-        };
-        let (mut a, mut b) = (step.t0, next.t1);
-        let r = 0.5 * (5f64.sqrt() - 1.0);
-        let mut c = b - r * (b - a);
-        let mut d = a + r * (b - a);
-        let (mut fc_c, mut fc_d) = (fc(c), fc(d));
-        // 0.618⁴⁰ ≈ 4e-9 of the bracket: the force is flat to ~1e-17 there.
-        for _ in 0..40 {
-            if fc_c > fc_d {
-                b = d;
-                d = c;
-                fc_d = fc_c;
-                c = b - r * (b - a);
-                fc_c = fc(c);
-            } else {
-                a = c;
-                c = d;
-                fc_c = fc_d;
-                d = a + r * (b - a);
-                fc_d = fc(d);
+    /// The state at release in a step where u changes sign, by Newton's
+    /// method on the dense output (du/ds = v/2) from the secant point.
+    fn release<F>(&self, step: &Dop853Step<3>, solver: &mut Dop853<3, F>) -> State
+    where
+        F: Fn(f64, &State) -> State,
+    {
+        let dense = solver.dense(step);
+        let (u0, u1) = (step.y0[0], step.y1[0]);
+        let mut s = step.t0 + (step.t1 - step.t0) * u0 / (u0 - u1);
+        let mut y = dense.at(s);
+        // A few iterations reach rounding: u is nearly linear in s there.
+        for _ in 0..4 {
+            let next = (s - y[0] / (0.5 * y[1])).clamp(step.t0, step.t1);
+            let done = (next - s).abs() <= 1e-14 * (step.t1 - step.t0);
+            s = next;
+            y = dense.at(s);
+            if done {
+                break;
             }
         }
-        peak.force.max(fc_c).max(fc_d)
+        y
+    }
+
+    /// The force maximum, on the dense output of the step that holds it:
+    /// where the force's rate of change goes through zero.
+    fn refine_peak<F>(&self, peak: &Peak, solver: &mut Dop853<3, F>) -> f64
+    where
+        F: Fn(f64, &State) -> State,
+    {
+        let Some(best) = peak.step else {
+            return peak.force;
+        };
+        let equations = Regularized::of(self);
+        let rate = |y: &State| equations.scaled_force_rate(y);
+        // The force rises and falls once: if it still rises at the end of
+        // the step with the largest end force, the maximum is in the next.
+        let step = if rate(&best.y1) > 0.0 {
+            match peak.next {
+                Some(next) => next,
+                None => return peak.force,
+            }
+        } else {
+            best
+        };
+        let (rate_lo, rate_hi) = (rate(&step.y0), rate(&step.y1));
+        if !(rate_lo > 0.0 && rate_hi < 0.0) {
+            // No interior maximum: the largest end force stands.
+            return peak.force;
+        }
+        let dense = solver.dense(&step);
+        let s = root::illinois(
+            |s| rate(&dense.at(s)),
+            (step.t0, rate_lo),
+            (step.t1, rate_hi),
+            1e-12,
+        );
+        peak.force.max(self.force_of(&dense.at(s)))
     }
 }
+
+/// The regularized equations of motion (module docs) with the constants
+/// divided through by the mass once: they are evaluated a dozen times a
+/// step, and the steps are latency-bound.
+#[derive(Clone, Copy)]
+struct Regularized {
+    /// m/s², (F − k g)/m: the net drive at the surface.
+    drive: f64,
+    /// 1/s, c/m.
+    damping: f64,
+    /// 1/s², k/m.
+    stiffness: f64,
+    /// ks/m.
+    surface: f64,
+    chi: f64,
+    exponent: f64,
+    power: Power,
+}
+
+/// δⁿ = u²ⁿ as a smooth function of u through 0, so that the integrator
+/// sees no kink where u changes sign at release: u³ for Hertz (odd), u²
+/// for the linear spring, |u|²ⁿ otherwise.
+#[derive(Clone, Copy)]
+enum Power {
+    Hertz,
+    Linear,
+    Other(f64),
+}
+
+impl Regularized {
+    fn of(c: &HcContact) -> Self {
+        let inv_mass = 1.0 / c.mass;
+        Regularized {
+            drive: (c.force - c.stiffness * c.gap) * inv_mass,
+            damping: c.damping * inv_mass,
+            stiffness: c.stiffness * inv_mass,
+            surface: c.surface_stiffness * inv_mass,
+            chi: c.chi,
+            exponent: c.exponent,
+            power: match c.exponent {
+                1.5 => Power::Hertz,
+                1.0 => Power::Linear,
+                n => Power::Other(n),
+            },
+        }
+    }
+
+    /// d(u, v, t)/ds.
+    #[inline]
+    fn rate(&self, y: &State) -> State {
+        let u = y[0];
+        State::new(0.5 * y[1], u * self.acceleration(y), u)
+    }
+
+    /// δ̈ (m/s²) at the state (u, v, t).
+    #[inline]
+    fn acceleration(&self, y: &State) -> f64 {
+        let (u, v) = (y[0], y[1]);
+        let d = u * u;
+        let spring = match self.power {
+            Power::Hertz => d * u,
+            Power::Linear => d,
+            Power::Other(n) => d.powf(n),
+        };
+        // The clamp Fc ≥ 0 acts only on the rate factor, so that the
+        // continuation past release (u < 0) stays smooth.
+        let rate_factor = 1.0 + self.chi * v;
+        let rate_factor = if rate_factor > 0.0 { rate_factor } else { 0.0 };
+        // Grouped so that the slow product is subtracted last.
+        (self.drive - self.damping * v - self.stiffness * d) - self.surface * spring * rate_factor
+    }
+
+    /// The force's rate of change dFc/dt divided by the positive ks δⁿ⁻¹:
+    /// n δ̇ (1 + χ δ̇) + χ δ δ̈, whose sign change marks the force maximum.
+    fn scaled_force_rate(&self, y: &State) -> f64 {
+        let (u, v) = (y[0], y[1]);
+        self.exponent * v * (1.0 + self.chi * v) + self.chi * u * u * self.acceleration(y)
+    }
+}
+
+/// The first trial step as a fraction of the contact's scale in s; the
+/// controller adjusts it within a step or two.
+const H0: f64 = 0.1;
 
 /// The largest contact force at a step end, the step that ended there and
 /// the step after it. The force rises and falls once, so its maximum lies
@@ -209,12 +346,12 @@ impl HcContact {
 #[derive(Default)]
 struct Peak {
     force: f64,
-    step: Option<Step<2>>,
-    next: Option<Step<2>>,
+    step: Option<Dop853Step<3>>,
+    next: Option<Dop853Step<3>>,
 }
 
 impl Peak {
-    fn track(&mut self, step: Step<2>, force_at_end: f64) {
+    fn track(&mut self, step: Dop853Step<3>, force_at_end: f64) {
         if force_at_end > self.force {
             *self = Peak {
                 force: force_at_end,
@@ -224,5 +361,63 @@ impl Peak {
         } else if self.step.is_some() && self.next.is_none() {
             self.next = Some(step);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mechanics::surface::hunt_crossley_restitution;
+
+    fn free(k: f64, n: f64, chi: f64) -> HcContact {
+        HcContact {
+            mass: 2e-4,
+            damping: 0.0,
+            stiffness: 0.0,
+            force: 0.0,
+            gap: 0.0,
+            surface_stiffness: k,
+            exponent: n,
+            chi,
+        }
+    }
+
+    #[test]
+    fn free_impact_restitution_is_exact_to_the_tolerance() {
+        let v = 0.3;
+        for n in [1.0, 1.5, 2.0] {
+            for chi_v in [1e-3, 0.05, 0.4, 0.9] {
+                let chi = chi_v / v;
+                let out = free(1e9, n, chi).run(v, 1.0).unwrap();
+                let HcEnd::Released { velocity, .. } = out.end else {
+                    panic!("a free impact releases")
+                };
+                let e = -velocity / v;
+                let exact = hunt_crossley_restitution(chi, v).unwrap();
+                assert!(
+                    ((e - exact) / exact).abs() < 1e-8,
+                    "n={n} χv={chi_v}: {e} vs {exact}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn undamped_linear_spring_is_half_a_sine() {
+        // n = 1, χ = 0: δ = (v/ω) sin ωt, ω = √(k/m): the contact lasts
+        // π/ω, returns the impact speed and peaks at k v/ω = v √(k m).
+        let (k, m, v) = (1e6, 2e-4, 0.7);
+        let c = HcContact {
+            mass: m,
+            ..free(k, 1.0, 0.0)
+        };
+        let out = c.run(v, 1.0).unwrap();
+        let w = (k / m).sqrt();
+        let HcEnd::Released { after, velocity } = out.end else {
+            panic!("releases")
+        };
+        assert!((after * w / std::f64::consts::PI - 1.0).abs() < 1e-8);
+        assert!((velocity / v + 1.0).abs() < 1e-8);
+        assert!((out.peak_force / (v * (k * m).sqrt()) - 1.0).abs() < 1e-8);
     }
 }

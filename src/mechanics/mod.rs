@@ -13,13 +13,15 @@
 //!   bracketed between consecutive extrema and polished by safeguarded
 //!   Newton iteration ([`root`]);
 //! - a nonlinear contact (Hunt–Crossley), integrated by an adaptive
-//!   Runge–Kutta method with dense output and event location
-//!   ([`integrate`]).
+//!   8th-order Runge–Kutta method with dense output and event location
+//!   ([`dop853`]), in variables that keep the motion smooth through touch
+//!   and release ([`hunt_crossley`]).
 //!
 //! Sign conventions: `x` is the displacement toward the fixed contact
 //! (m), velocities are positive toward it, and contact forces are the
 //! force the fixed contact puts on the moving one, positive pushing back.
 
+pub mod dop853;
 pub mod engine;
 pub mod hunt_crossley;
 pub mod integrate;
