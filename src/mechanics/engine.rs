@@ -24,7 +24,7 @@
 //! skipped flight `T`: that is the reported accumulation time.
 
 use super::hunt_crossley::{HcContact, HcEnd};
-use super::linear::LinearPiece;
+use super::linear::{LinearPiece, Mode};
 use super::{Mechanics, MechanicsError, Settings, Surface};
 use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome};
 
@@ -166,25 +166,33 @@ struct Engine<'a> {
     settings: &'a Settings,
     /// N, drive net of preload.
     f_net: f64,
+    /// Free flight's equation, and the surface's response to an impact.
+    flight: Mode,
+    law: Law,
     impacts: Vec<Impact>,
     intervals: Vec<Interval>,
 }
 
+/// Room for a typical sequence (a few dozen contacts) without regrowing.
+const TYPICAL_CONTACTS: usize = 32;
+
 impl<'a> Engine<'a> {
     fn new(m: &'a Mechanics, surface: &'a Surface, settings: &'a Settings) -> Self {
+        let f_net = m.force - m.preload;
         Engine {
             m,
             surface,
             settings,
-            f_net: m.force - m.preload,
-            impacts: Vec::new(),
-            intervals: Vec::new(),
+            f_net,
+            flight: Mode::new(m.mass, m.damping, m.stiffness, f_net),
+            law: Law::new(m, surface),
+            impacts: Vec::with_capacity(TYPICAL_CONTACTS),
+            intervals: Vec::with_capacity(2 * TYPICAL_CONTACTS + 1),
         }
     }
 
     fn flight(&self, x0: f64, v0: f64) -> LinearPiece {
-        let m = self.m;
-        LinearPiece::new(m.mass, m.damping, m.stiffness, self.f_net, x0, v0)
+        LinearPiece::start(&self.flight, x0, v0)
     }
 
     fn run(mut self) -> Result<Chatter, MechanicsError> {
@@ -293,7 +301,7 @@ impl<'a> Engine<'a> {
     /// fields of the last impact.
     fn contact(&mut self, t_hit: f64, v_hit: f64) -> Result<ContactEnd, MechanicsError> {
         let budget = self.settings.t_end - t_hit;
-        let r = impact_response(self.m, self.surface, v_hit, budget)?;
+        let r = self.law.respond(self.m, v_hit, budget)?;
         let last = self.impacts.last_mut().expect("the impact was pushed");
         last.peak_force = r.peak_force;
         last.min_force = r.min_force;
@@ -419,70 +427,46 @@ pub fn impact_response(
     v_hit: f64,
     budget: f64,
 ) -> Result<ImpactResponse, MechanicsError> {
-    let g = m.gap;
-    let f_net = m.force - m.preload;
-    match *surface {
-        Surface::Rigid { restitution } => {
-            let v_out = -restitution * v_hit;
-            let x_eq = f_net / m.stiffness;
-            if v_out == 0.0 && x_eq >= g {
-                // Held against the surface by the static overtravel force.
-                let static_force = m.stiffness * (x_eq - g);
-                return Ok(ImpactResponse {
-                    end: ResponseEnd::Stuck,
-                    peak_force: Some(static_force),
-                    min_force: Some(static_force),
-                });
-            }
-            Ok(ImpactResponse {
-                end: ResponseEnd::Released {
-                    contact_time: 0.0,
-                    velocity: v_out,
-                },
-                peak_force: None,
-                min_force: None,
-            })
-        }
-        Surface::KelvinVoigt { stiffness, damping } => {
-            let piece = LinearPiece::new(
-                m.mass,
-                m.damping + damping,
-                m.stiffness + stiffness,
-                f_net + stiffness * g,
-                g,
-                v_hit,
-            );
-            let release = piece.crossing(g, false);
-            let budget = budget.max(0.0);
-            // Where the force is last looked at: (time, x, ẋ).
-            let until = match release {
-                Some(c) if c.time <= budget => Some((c.time, g, c.velocity)),
-                _ if budget.is_finite() => {
-                    let (x, v) = piece.state(budget);
-                    Some((budget, x, v))
-                }
-                _ => None,
-            };
-            let (peak, min) = kv_force_extremes(&piece, g, stiffness, damping, until);
-            Ok(ImpactResponse {
-                end: match release {
-                    None => ResponseEnd::Stuck,
-                    Some(c) if c.time > budget => ResponseEnd::Horizon,
-                    Some(c) => ResponseEnd::Released {
-                        contact_time: c.time,
-                        velocity: c.velocity,
-                    },
-                },
-                peak_force: Some(peak),
-                min_force: Some(min),
-            })
-        }
-        Surface::HuntCrossley {
-            stiffness,
-            exponent,
-            chi,
-        } => {
-            let hc = HcContact {
+    Law::new(m, surface).respond(m, v_hit, budget)
+}
+
+/// A surface law with what depends only on the relay worked out once, so
+/// that a sequence of contacts does not redo it.
+enum Law {
+    Rigid {
+        restitution: f64,
+    },
+    KelvinVoigt {
+        /// The in-contact equation.
+        contact: Mode,
+        /// N/m and N·s/m, the surface's s0 and r0.
+        stiffness: f64,
+        damping: f64,
+    },
+    HuntCrossley(HcContact),
+}
+
+impl Law {
+    fn new(m: &Mechanics, surface: &Surface) -> Law {
+        let g = m.gap;
+        let f_net = m.force - m.preload;
+        match *surface {
+            Surface::Rigid { restitution } => Law::Rigid { restitution },
+            Surface::KelvinVoigt { stiffness, damping } => Law::KelvinVoigt {
+                contact: Mode::new(
+                    m.mass,
+                    m.damping + damping,
+                    m.stiffness + stiffness,
+                    f_net + stiffness * g,
+                ),
+                stiffness,
+                damping,
+            },
+            Surface::HuntCrossley {
+                stiffness,
+                exponent,
+                chi,
+            } => Law::HuntCrossley(HcContact {
                 mass: m.mass,
                 damping: m.damping,
                 stiffness: m.stiffness,
@@ -491,20 +475,86 @@ pub fn impact_response(
                 surface_stiffness: stiffness,
                 exponent,
                 chi,
-            };
-            let out = hc.run(v_hit, budget)?;
-            Ok(ImpactResponse {
-                end: match out.end {
-                    HcEnd::Released { after, velocity } => ResponseEnd::Released {
-                        contact_time: after,
-                        velocity,
+            }),
+        }
+    }
+
+    /// See [`impact_response`].
+    fn respond(
+        &self,
+        m: &Mechanics,
+        v_hit: f64,
+        budget: f64,
+    ) -> Result<ImpactResponse, MechanicsError> {
+        let g = m.gap;
+        match *self {
+            Law::Rigid { restitution } => {
+                let v_out = -restitution * v_hit;
+                let x_eq = (m.force - m.preload) / m.stiffness;
+                if v_out == 0.0 && x_eq >= g {
+                    // Held against the surface by the static overtravel force.
+                    let static_force = m.stiffness * (x_eq - g);
+                    return Ok(ImpactResponse {
+                        end: ResponseEnd::Stuck,
+                        peak_force: Some(static_force),
+                        min_force: Some(static_force),
+                    });
+                }
+                Ok(ImpactResponse {
+                    end: ResponseEnd::Released {
+                        contact_time: 0.0,
+                        velocity: v_out,
                     },
-                    HcEnd::Stuck { .. } => ResponseEnd::Stuck,
-                    HcEnd::Horizon => ResponseEnd::Horizon,
-                },
-                peak_force: Some(out.peak_force),
-                min_force: Some(out.min_force),
-            })
+                    peak_force: None,
+                    min_force: None,
+                })
+            }
+            Law::KelvinVoigt {
+                ref contact,
+                stiffness,
+                damping,
+            } => {
+                let piece = LinearPiece::start(contact, g, v_hit);
+                let release = piece.crossing(g, false);
+                let budget = budget.max(0.0);
+                // Where the force is last looked at: (time, x, ẋ).
+                let until = match release {
+                    Some(c) if c.time <= budget => Some((c.time, g, c.velocity)),
+                    _ if budget.is_finite() => {
+                        let (x, v) = piece.state(budget);
+                        Some((budget, x, v))
+                    }
+                    _ => None,
+                };
+                let (peak, min) = kv_force_extremes(&piece, g, stiffness, damping, until);
+                Ok(ImpactResponse {
+                    end: match release {
+                        None => ResponseEnd::Stuck,
+                        Some(c) if c.time > budget => ResponseEnd::Horizon,
+                        Some(c) => ResponseEnd::Released {
+                            contact_time: c.time,
+                            velocity: c.velocity,
+                        },
+                    },
+                    peak_force: Some(peak),
+                    min_force: Some(min),
+                })
+            }
+            Law::HuntCrossley(ref hc) => {
+                let out = hc.run(v_hit, budget)?;
+                Ok(ImpactResponse {
+                    end: match out.end {
+                        HcEnd::Released { after, velocity } => ResponseEnd::Released {
+                            contact_time: after,
+                            velocity,
+                        },
+                        HcEnd::Stuck { .. } => ResponseEnd::Stuck,
+                        HcEnd::Horizon => ResponseEnd::Horizon,
+                    },
+                    peak_force: Some(out.peak_force),
+                    min_force: Some(out.min_force),
+                })
+            }
         }
     }
 }
@@ -519,8 +569,9 @@ pub fn critical_impact_speed(
     surface: &Surface,
     rel_tol: f64,
 ) -> Result<f64, MechanicsError> {
+    let law = Law::new(m, surface);
     let releases = |v: f64| -> Result<bool, MechanicsError> {
-        let r = impact_response(m, surface, v, f64::INFINITY)?;
+        let r = law.respond(m, v, f64::INFINITY)?;
         Ok(matches!(r.end, ResponseEnd::Released { .. }))
     };
     let x_eq = (m.force - m.preload) / m.stiffness;

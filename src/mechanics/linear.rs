@@ -59,6 +59,63 @@ impl Iterator for Zeros {
     }
 }
 
+/// The constants of one equation `m ẍ + c ẋ + k x = F`, shared by every
+/// piece of motion under it: the engine works them out once per
+/// simulation (free flight and, for Kelvin–Voigt, contact) rather than
+/// once per piece.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Mode {
+    /// m, the equilibrium F/k.
+    pub x_eq: f64,
+    /// 1/s, decay rate a = c/(2m).
+    pub a: f64,
+    /// 1/s², ωn² = k/m.
+    pub omega2: f64,
+    /// 1/s², q = ωn² − a² (> 0 oscillatory).
+    pub q: f64,
+    /// 1/s, w = √|q|, and 1/w.
+    w: f64,
+    inv_w: f64,
+    /// s, π/w: the spacing of the zeros of any combination when
+    /// under-damped (∞ otherwise).
+    period: f64,
+    /// e^(−aπ/w) over half a period (1 unless under-damped).
+    half_period_decay: f64,
+    /// s, 1/ωn.
+    time_scale: f64,
+}
+
+impl Mode {
+    /// `mass` kg, `damping` c N·s/m, `stiffness` k N/m (> 0), `force` F N.
+    pub fn new(mass: f64, damping: f64, stiffness: f64, force: f64) -> Self {
+        let a = damping / (2.0 * mass);
+        let omega2 = stiffness / mass;
+        let q = omega2 - a * a;
+        let w = q.abs().sqrt();
+        let under_damped = q > 0.0;
+        let period = if under_damped {
+            std::f64::consts::PI / w
+        } else {
+            f64::INFINITY
+        };
+        Mode {
+            x_eq: force / stiffness,
+            a,
+            omega2,
+            q,
+            w,
+            inv_w: 1.0 / w,
+            period,
+            half_period_decay: if under_damped {
+                (-a * period).exp()
+            } else {
+                1.0
+            },
+            time_scale: 1.0 / omega2.sqrt(),
+        }
+    }
+}
+
 /// The motion `m ẍ + c ẋ + k x = F` from a given state at local time 0.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LinearPiece {
@@ -74,11 +131,8 @@ pub struct LinearPiece {
     pub omega2: f64,
     /// 1/s², q = ωn² − a² (> 0 oscillatory).
     pub q: f64,
-    /// 1/s, w = √|q|, the decay e^(−aπ/w) over half a period (1 unless
-    /// under-damped), and the y and ẏ combinations: every evaluation needs
-    /// them, so [`LinearPiece::new`] works them out once.
-    w: f64,
-    half_period_decay: f64,
+    mode: Mode,
+    /// The y and ẏ combinations: every evaluation needs them.
     y: Combo,
     v: Combo,
 }
@@ -106,25 +160,21 @@ pub struct Combo {
 impl LinearPiece {
     /// `mass` kg, `damping` c N·s/m, `stiffness` k N/m (> 0), `force` F N.
     pub fn new(mass: f64, damping: f64, stiffness: f64, force: f64, x0: f64, v0: f64) -> Self {
-        let a = damping / (2.0 * mass);
-        let omega2 = stiffness / mass;
-        let x_eq = force / stiffness;
-        let q = omega2 - a * a;
-        let y0 = x0 - x_eq;
-        let w = q.abs().sqrt();
+        LinearPiece::start(&Mode::new(mass, damping, stiffness, force), x0, v0)
+    }
+
+    /// The motion under `mode` from (`x0` m, `v0` m/s).
+    pub fn start(mode: &Mode, x0: f64, v0: f64) -> Self {
+        let (a, omega2) = (mode.a, mode.omega2);
+        let y0 = x0 - mode.x_eq;
         LinearPiece {
             x0,
             v0,
-            x_eq,
+            x_eq: mode.x_eq,
             a,
             omega2,
-            q,
-            w,
-            half_period_decay: if q > 0.0 {
-                (-a * std::f64::consts::PI / w).exp()
-            } else {
-                1.0
-            },
+            q: mode.q,
+            mode: *mode,
             y: Combo {
                 p: y0,
                 q: v0 + a * y0,
@@ -138,21 +188,21 @@ impl LinearPiece {
 
     /// (E(t), G(t)), the damped basis, evaluated without overflow.
     pub fn basis(&self, t: f64) -> (f64, f64) {
-        let (a, w) = (self.a, self.w);
+        let (a, w) = (self.a, self.mode.w);
         if self.q > 0.0 {
             let d = (-a * t).exp();
             let (s, c) = (w * t).sin_cos();
-            (d * c, d * s / w)
+            (d * c, d * s * self.mode.inv_w)
         } else if self.q < 0.0 {
             let wt = w * t;
             if wt < 1.0 {
                 let d = (-a * t).exp();
-                (d * wt.cosh(), d * wt.sinh() / w)
+                (d * wt.cosh(), d * wt.sinh() * self.mode.inv_w)
             } else {
                 // w < a, so both exponents are ≤ 0: no overflow.
                 let up = ((w - a) * t).exp();
                 let down = (-(w + a) * t).exp();
-                (0.5 * (up + down), 0.5 * (up - down) / w)
+                (0.5 * (up + down), 0.5 * (up - down) * self.mode.inv_w)
             }
         } else {
             let d = (-a * t).exp();
@@ -222,12 +272,11 @@ impl LinearPiece {
             return Zeros::NONE;
         }
         if self.q > 0.0 {
-            let w = self.w;
-            let qw = c.q / w;
+            let (w, inv_w, period) = (self.mode.w, self.mode.inv_w, self.mode.period);
+            let qw = c.q * inv_w;
             let phi = qw.atan2(c.p);
-            let period = std::f64::consts::PI / w;
             let floor = 64.0 * f64::EPSILON * period;
-            let mut t = (phi + std::f64::consts::FRAC_PI_2) / w;
+            let mut t = (phi + std::f64::consts::FRAC_PI_2) * inv_w;
             // (−1)ʲ for the zero finally chosen.
             let mut sign = 1.0;
             while t <= floor {
@@ -249,16 +298,16 @@ impl LinearPiece {
                 next: t,
                 period,
                 value,
-                factor: -self.half_period_decay,
+                factor: -self.mode.half_period_decay,
             }
         } else {
             let t = if self.q < 0.0 {
-                let w = self.w;
+                let w = self.mode.w;
                 let r = -c.p * w / c.q;
                 if !(r > 0.0 && r < 1.0) {
                     return Zeros::NONE;
                 }
-                r.atanh() / w
+                r.atanh() * self.mode.inv_w
             } else {
                 -c.p / c.q
             };
@@ -368,7 +417,7 @@ impl LinearPiece {
 
     /// A natural time scale of the motion (s): 1/ωn.
     pub fn time_scale(&self) -> f64 {
-        1.0 / self.omega2.sqrt()
+        self.mode.time_scale
     }
 
     /// For the last, unbounded monotone segment: a time by which x has
