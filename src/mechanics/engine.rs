@@ -24,7 +24,7 @@
 //! skipped flight `T`: that is the reported accumulation time.
 
 use super::hunt_crossley::{HcContact, HcEnd};
-use super::linear::{LinearPiece, Mode};
+use super::linear::{LinearPiece, Mode, Shift, Zeros};
 use super::{Mechanics, MechanicsError, Settings, Surface};
 use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome};
 
@@ -442,6 +442,9 @@ enum Law {
         /// N/m and N·s/m, the surface's s0 and r0.
         stiffness: f64,
         damping: f64,
+        /// The varying part of the force, s0·y + r0·ẏ, as shifted
+        /// position (under-damped contact only).
+        force_shift: Option<Shift>,
     },
     HuntCrossley(HcContact),
 }
@@ -452,16 +455,20 @@ impl Law {
         let f_net = m.force - m.preload;
         match *surface {
             Surface::Rigid { restitution } => Law::Rigid { restitution },
-            Surface::KelvinVoigt { stiffness, damping } => Law::KelvinVoigt {
-                contact: Mode::new(
+            Surface::KelvinVoigt { stiffness, damping } => {
+                let contact = Mode::new(
                     m.mass,
                     m.damping + damping,
                     m.stiffness + stiffness,
                     f_net + stiffness * g,
-                ),
-                stiffness,
-                damping,
-            },
+                );
+                Law::KelvinVoigt {
+                    contact,
+                    stiffness,
+                    damping,
+                    force_shift: contact.combination_shift(stiffness, damping),
+                }
+            }
             Surface::HuntCrossley {
                 stiffness,
                 exponent,
@@ -513,6 +520,7 @@ impl Law {
                 ref contact,
                 stiffness,
                 damping,
+                force_shift,
             } => {
                 let piece = LinearPiece::start(contact, g, v_hit);
                 let release = piece.crossing(g, false);
@@ -526,7 +534,22 @@ impl Law {
                     }
                     _ => None,
                 };
-                let (peak, min) = kv_force_extremes(&piece, g, stiffness, damping, until);
+                // The force's extrema: from the deepest point, where the
+                // release crossing turned, when the force is shifted
+                // position; else from the closed-form zeros of its rate.
+                let turn = release.and_then(|c| c.turned_at);
+                let extrema = match (force_shift, turn) {
+                    (Some(shift), Some((t, x))) => {
+                        piece.combination_extrema(shift, (t, x - piece.x_eq))
+                    }
+                    _ => {
+                        let rate = piece
+                            .combo(-damping * piece.omega2, stiffness - 2.0 * piece.a * damping);
+                        piece.zeros(rate, piece.combo(stiffness, damping))
+                    }
+                };
+                let (peak, min) =
+                    kv_force_extremes(&piece, g, (stiffness, damping), extrema, until);
                 Ok(ImpactResponse {
                     end: match release {
                         None => ResponseEnd::Stuck,
@@ -623,41 +646,37 @@ fn bounces(intervals: &[Interval]) -> usize {
 /// contact piece from local time 0 to `until` = (time, x, ẋ), the end
 /// state the caller already has (`None` for a contact that sticks: the
 /// force tends to its static value). The force is a constant plus a
-/// combination of y and ẏ, so its extrema are the closed-form zeros of its
-/// rate `s0 ẏ + r0 ÿ = (s0 − 2a r0) ẏ − r0 ωn² y`.
+/// combination of y and ẏ; `extrema` are that combination's extrema
+/// (local time, value) in order, from its closed-form rate zeros or as
+/// shifted position ([`Mode::combination_shift`]).
 fn kv_force_extremes(
     piece: &LinearPiece,
     g: f64,
-    s0: f64,
-    r0: f64,
+    (s0, r0): (f64, f64),
+    extrema: Zeros,
     until: Option<(f64, f64, f64)>,
 ) -> (f64, f64) {
     let force = |x: f64, v: f64| s0 * (x - g) + r0 * v;
-    let rate = piece.combo(-r0 * piece.omega2, s0 - 2.0 * piece.a * r0);
     let mut peak = force(piece.x0, piece.v0);
     let mut min = peak;
     let mut consider = |f: f64| {
         peak = peak.max(f);
         min = min.min(f);
     };
+    let at_rest = s0 * (piece.x_eq - g);
     let t_until = match until {
         Some((t, x, v)) => {
             consider(force(x, v));
             t
         }
         None => {
-            consider(s0 * (piece.x_eq - g));
+            consider(at_rest);
             f64::INFINITY
         }
     };
     // The force's own extrema decay like the motion: the first two (one
     // maximum, one minimum) bound every later one.
-    let at_rest = s0 * (piece.x_eq - g);
-    for (_, varying) in piece
-        .zeros(rate, piece.combo(s0, r0))
-        .take(2)
-        .take_while(|&(z, _)| z < t_until)
-    {
+    for (_, varying) in extrema.take(2).take_while(|&(z, _)| z < t_until) {
         consider(at_rest + varying);
     }
     (peak, min)
