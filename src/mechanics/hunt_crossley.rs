@@ -34,7 +34,7 @@
 use nalgebra::Vector3;
 
 use super::MechanicsError;
-use super::dop853::{Dop853, Dop853Step};
+use super::dop853::{Dense, Dop853, Dop853Step};
 use super::integrate::Tolerance;
 use super::root;
 
@@ -141,7 +141,6 @@ impl HcContact {
         };
         let h0 = H0 * s_scale;
         let mut solver = Dop853::new(rhs, 0.0, State::new(0.0, v_hit, 0.0), h0, tol);
-        let mut peak = Peak::default();
         let sticks_possible = self.stiffness * self.gap < self.force;
         // Sticking is tested with a small margin so that rounding can never
         // call a contact stuck that will still release.
@@ -149,11 +148,11 @@ impl HcContact {
         // The force is clamped at 0, which it is at touch: nothing smaller
         // is ever seen.
         let min_force = 0.0;
-        let outcome = |end, peak_force| HcOutcome {
-            end,
-            peak_force,
-            min_force,
-        };
+        // The force rises from 0 at touch to one maximum and falls: its peak
+        // is located (on the dense output) in the step where its rate turns
+        // negative. The largest step-end force also counts, as a guard.
+        let mut peak_force: f64 = 0.0;
+        let mut peak_found = false;
         loop {
             let step = match solver.step(f64::INFINITY) {
                 Ok(step) => step,
@@ -169,7 +168,8 @@ impl HcContact {
             };
             if step.y1[0] < 0.0 {
                 // Released inside this step: u(s0) ≥ 0 > u(s1).
-                let y = self.release(&step, &mut solver);
+                let (y, peak) = self.release_in_step(&equations, &step, &mut solver, !peak_found);
+                peak_force = peak_force.max(peak);
                 let end = if y[2] <= budget {
                     HcEnd::Released {
                         after: y[2],
@@ -178,83 +178,118 @@ impl HcContact {
                 } else {
                     HcEnd::Horizon
                 };
-                peak.track(step, 0.0);
-                return Ok(outcome(end, self.refine_peak(&peak, &mut solver)));
+                return Ok(HcOutcome {
+                    end,
+                    peak_force,
+                    min_force,
+                });
             }
-            peak.track(step, self.force_of(&step.y1));
-            if step.y1[2] >= budget {
-                let peak_force = self.refine_peak(&peak, &mut solver);
-                return Ok(outcome(HcEnd::Horizon, peak_force));
-            }
+            peak_force = peak_force.max(self.force_of(&step.y1));
             // Stuck is declared only once moving out again (past the
-            // deepest penetration, so the force peak has been seen): the
-            // reported peak force then does not depend on step sizes.
+            // deepest penetration, so the force peak has been seen).
             let moving_out = step.y1[1] < 0.0;
-            if sticks_possible && moving_out && self.energy_margin(&step.y1) < -stick_margin {
-                let end = HcEnd::Stuck { after: step.y1[2] };
-                return Ok(outcome(end, self.refine_peak(&peak, &mut solver)));
+            let stuck =
+                sticks_possible && moving_out && self.energy_margin(&step.y1) < -stick_margin;
+            let horizon = step.y1[2] >= budget;
+            if !peak_found && (equations.scaled_force_rate(&step.y1) <= 0.0 || stuck || horizon) {
+                peak_force = peak_force.max(self.peak_in_step(&equations, &step, &mut solver));
+                peak_found = true;
+            }
+            if horizon || stuck {
+                let end = if horizon {
+                    HcEnd::Horizon
+                } else {
+                    HcEnd::Stuck { after: step.y1[2] }
+                };
+                return Ok(HcOutcome {
+                    end,
+                    peak_force,
+                    min_force,
+                });
             }
         }
     }
 
-    /// The state at release in a step where u changes sign, by Newton's
-    /// method on the dense output (du/ds = v/2) from the secant point.
-    fn release<F>(&self, step: &Dop853Step<3>, solver: &mut Dop853<3, F>) -> State
+    /// The state at release inside the step the solver just took and, if
+    /// `find_peak`, the force maximum between the step's start and the
+    /// release (else 0).
+    #[inline(never)]
+    fn release_in_step<F>(
+        &self,
+        equations: &Regularized,
+        step: &Dop853Step<3>,
+        solver: &mut Dop853<3, F>,
+        find_peak: bool,
+    ) -> (State, f64)
     where
         F: Fn(f64, &State) -> State,
     {
-        let dense = solver.dense(step);
-        let (u0, u1) = (step.y0[0], step.y1[0]);
-        let mut s = step.t0 + (step.t1 - step.t0) * u0 / (u0 - u1);
-        let mut y = dense.at(s);
-        // A few iterations reach rounding: u is nearly linear in s there.
-        for _ in 0..4 {
-            let next = (s - y[0] / (0.5 * y[1])).clamp(step.t0, step.t1);
-            let done = (next - s).abs() <= 1e-14 * (step.t1 - step.t0);
-            s = next;
-            y = dense.at(s);
-            if done {
-                break;
-            }
-        }
-        y
-    }
-
-    /// The force maximum, on the dense output of the step that holds it:
-    /// where the force's rate of change goes through zero.
-    fn refine_peak<F>(&self, peak: &Peak, solver: &mut Dop853<3, F>) -> f64
-    where
-        F: Fn(f64, &State) -> State,
-    {
-        let Some(best) = peak.step else {
-            return peak.force;
-        };
-        let equations = Regularized::of(self);
-        let rate = |y: &State| equations.scaled_force_rate(y);
-        // The force rises and falls once: if it still rises at the end of
-        // the step with the largest end force, the maximum is in the next.
-        let step = if rate(&best.y1) > 0.0 {
-            match peak.next {
-                Some(next) => next,
-                None => return peak.force,
-            }
+        let dense = solver.dense();
+        let (s_rel, y) = release(step, &dense);
+        let peak = if find_peak {
+            self.peak_in(equations, &dense, (step.t0, step.y0), (s_rel, y))
         } else {
-            best
+            0.0
         };
-        let (rate_lo, rate_hi) = (rate(&step.y0), rate(&step.y1));
-        if !(rate_lo > 0.0 && rate_hi < 0.0) {
-            // No interior maximum: the largest end force stands.
-            return peak.force;
-        }
-        let dense = solver.dense(&step);
-        let s = root::illinois(
-            |s| rate(&dense.at(s)),
-            (step.t0, rate_lo),
-            (step.t1, rate_hi),
-            1e-12,
-        );
-        peak.force.max(self.force_of(&dense.at(s)))
+        (y, peak)
     }
+
+    /// The force maximum inside the step the solver just took.
+    #[inline(never)]
+    fn peak_in_step<F>(
+        &self,
+        equations: &Regularized,
+        step: &Dop853Step<3>,
+        solver: &mut Dop853<3, F>,
+    ) -> f64
+    where
+        F: Fn(f64, &State) -> State,
+    {
+        let dense = solver.dense();
+        self.peak_in(equations, &dense, (step.t0, step.y0), (step.t1, step.y1))
+    }
+
+    /// The force maximum inside one step, given its dense output and the
+    /// (s, state) at the two ends of the stretch to search: where the
+    /// force's rate goes from rising to falling, or the larger end force
+    /// if it does not turn there.
+    fn peak_in(
+        &self,
+        equations: &Regularized,
+        dense: &Dense<3>,
+        (s0, y0): (f64, State),
+        (s1, y1): (f64, State),
+    ) -> f64 {
+        let rate = |y: &State| equations.scaled_force_rate(y);
+        let (rate0, rate1) = (rate(&y0), rate(&y1));
+        let ends = self.force_of(&y0).max(self.force_of(&y1));
+        if !(rate0 > 0.0 && rate1 < 0.0) {
+            return ends;
+        }
+        // The force is flat at its maximum: placing it to 1e-7 of the step
+        // gives the force to rounding.
+        let s = root::illinois(|s| rate(&dense.at(s)), (s0, rate0), (s1, rate1), 1e-7);
+        ends.max(self.force_of(&dense.at(s)))
+    }
+}
+
+/// The (s, state) at release in a step where u changes sign, by Newton's
+/// method on the dense output (du/ds = v/2) from the secant point.
+fn release(step: &Dop853Step<3>, dense: &Dense<3>) -> (f64, State) {
+    let (u0, u1) = (step.y0[0], step.y1[0]);
+    let mut s = step.t0 + (step.t1 - step.t0) * u0 / (u0 - u1);
+    let mut y = dense.at(s);
+    // A few iterations reach rounding: u is nearly linear in s there.
+    for _ in 0..4 {
+        let next = (s - y[0] / (0.5 * y[1])).clamp(step.t0, step.t1);
+        let done = (next - s).abs() <= 1e-14 * (step.t1 - step.t0);
+        s = next;
+        y = dense.at(s);
+        if done {
+            break;
+        }
+    }
+    (s, y)
 }
 
 /// The regularized equations of motion (module docs) with the constants
@@ -339,30 +374,6 @@ impl Regularized {
 /// The first trial step as a fraction of the contact's scale in s; the
 /// controller adjusts it within a step or two.
 const H0: f64 = 0.1;
-
-/// The largest contact force at a step end, the step that ended there and
-/// the step after it. The force rises and falls once, so its maximum lies
-/// between the start of the first and the end of the second.
-#[derive(Default)]
-struct Peak {
-    force: f64,
-    step: Option<Dop853Step<3>>,
-    next: Option<Dop853Step<3>>,
-}
-
-impl Peak {
-    fn track(&mut self, step: Dop853Step<3>, force_at_end: f64) {
-        if force_at_end > self.force {
-            *self = Peak {
-                force: force_at_end,
-                step: Some(step),
-                next: None,
-            };
-        } else if self.step.is_some() && self.next.is_none() {
-            self.next = Some(step);
-        }
-    }
-}
 
 #[cfg(test)]
 mod tests {
