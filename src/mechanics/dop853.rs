@@ -297,6 +297,13 @@ where
     }
 
     /// Advance one accepted step, never past `t_stop`.
+    ///
+    /// Always inlined: a caller has one call site per right-hand side, in
+    /// its loop, and inlined there the step's state stays in registers
+    /// from one step to the next (10 % on the Hunt–Crossley benchmark,
+    /// where the compiler otherwise declines once there are several
+    /// right-hand sides).
+    #[inline(always)]
     pub fn step(&mut self, t_stop: f64) -> Result<Dop853Step<N>, MechanicsError> {
         let f = &self.f;
         let (t, y, k1) = (self.t, self.y, self.k1);

@@ -123,7 +123,29 @@ impl HcContact {
     /// Integrate one contact that starts at δ = 0 with impact speed
     /// `v_hit` (> 0), for at most `budget` seconds.
     pub fn run(&self, v_hit: f64, budget: f64) -> Result<HcOutcome, MechanicsError> {
-        let equations = Regularized::of(self);
+        // δⁿ = u²ⁿ as a smooth function of u through 0, so that the
+        // integrator sees no kink where u changes sign at release: u³ for
+        // Hertz (odd), u² for the linear spring, |u|²ⁿ otherwise. One copy
+        // of the integration per law, so that the right-hand side,
+        // evaluated a dozen times a step, has no branch on n.
+        match self.exponent {
+            1.5 => self.integrate(Regularized::of(self, |d, u| d * u), v_hit, budget),
+            1.0 => self.integrate(Regularized::of(self, |d, _| d), v_hit, budget),
+            n => self.integrate(
+                Regularized::of(self, move |d: f64, _| d.powf(n)),
+                v_hit,
+                budget,
+            ),
+        }
+    }
+
+    /// [`HcContact::run`] for one spring law.
+    fn integrate<P: Spring>(
+        &self,
+        equations: Regularized<P>,
+        v_hit: f64,
+        budget: f64,
+    ) -> Result<HcOutcome, MechanicsError> {
         let rhs = move |_s: f64, y: &State| equations.rate(y);
         // Scales: the depth at which the surface alone would stop the
         // impact (energy balance), the time to get there, and the
@@ -214,9 +236,9 @@ impl HcContact {
     /// `find_peak`, the force maximum between the step's start and the
     /// release (else 0).
     #[inline(never)]
-    fn release_in_step<F>(
+    fn release_in_step<F, P: Spring>(
         &self,
-        equations: &Regularized,
+        equations: &Regularized<P>,
         step: &Dop853Step<3>,
         solver: &mut Dop853<3, F>,
         find_peak: bool,
@@ -236,9 +258,9 @@ impl HcContact {
 
     /// The force maximum inside the step the solver just took.
     #[inline(never)]
-    fn peak_in_step<F>(
+    fn peak_in_step<F, P: Spring>(
         &self,
-        equations: &Regularized,
+        equations: &Regularized<P>,
         step: &Dop853Step<3>,
         solver: &mut Dop853<3, F>,
     ) -> f64
@@ -253,9 +275,9 @@ impl HcContact {
     /// (s, state) at the two ends of the stretch to search: where the
     /// force's rate goes from rising to falling, or the larger end force
     /// if it does not turn there.
-    fn peak_in(
+    fn peak_in<P: Spring>(
         &self,
-        equations: &Regularized,
+        equations: &Regularized<P>,
         dense: &Dense<3>,
         (s0, y0): (f64, State),
         (s1, y1): (f64, State),
@@ -294,9 +316,9 @@ fn release(step: &Dop853Step<3>, dense: &Dense<3>) -> (f64, State) {
 
 /// The regularized equations of motion (module docs) with the constants
 /// divided through by the mass once: they are evaluated a dozen times a
-/// step, and the steps are latency-bound.
+/// step, and the steps are latency-bound. `spring(δ, u)` is δⁿ.
 #[derive(Clone, Copy)]
-struct Regularized {
+struct Regularized<P> {
     /// m/s², (F − k g)/m: the net drive at the surface.
     drive: f64,
     /// 1/s, c/m.
@@ -307,21 +329,15 @@ struct Regularized {
     surface: f64,
     chi: f64,
     exponent: f64,
-    power: Power,
+    spring: P,
 }
 
-/// δⁿ = u²ⁿ as a smooth function of u through 0, so that the integrator
-/// sees no kink where u changes sign at release: u³ for Hertz (odd), u²
-/// for the linear spring, |u|²ⁿ otherwise.
-#[derive(Clone, Copy)]
-enum Power {
-    Hertz,
-    Linear,
-    Other(f64),
-}
+/// δⁿ from δ = u² and u.
+trait Spring: Fn(f64, f64) -> f64 + Copy {}
+impl<P: Fn(f64, f64) -> f64 + Copy> Spring for P {}
 
-impl Regularized {
-    fn of(c: &HcContact) -> Self {
+impl<P: Spring> Regularized<P> {
+    fn of(c: &HcContact, spring: P) -> Self {
         let inv_mass = 1.0 / c.mass;
         Regularized {
             drive: (c.force - c.stiffness * c.gap) * inv_mass,
@@ -330,11 +346,7 @@ impl Regularized {
             surface: c.surface_stiffness * inv_mass,
             chi: c.chi,
             exponent: c.exponent,
-            power: match c.exponent {
-                1.5 => Power::Hertz,
-                1.0 => Power::Linear,
-                n => Power::Other(n),
-            },
+            spring,
         }
     }
 
@@ -350,11 +362,7 @@ impl Regularized {
     fn acceleration(&self, y: &State) -> f64 {
         let (u, v) = (y[0], y[1]);
         let d = u * u;
-        let spring = match self.power {
-            Power::Hertz => d * u,
-            Power::Linear => d,
-            Power::Other(n) => d.powf(n),
-        };
+        let spring = (self.spring)(d, u);
         // The clamp Fc ≥ 0 acts only on the rate factor, so that the
         // continuation past release (u < 0) stays smooth.
         let rate_factor = 1.0 + self.chi * v;
