@@ -223,6 +223,7 @@ pub struct Dense<const N: usize> {
 
 impl<const N: usize> Dense<N> {
     /// The interpolated state at `t` ∈ [t0, t1].
+    #[inline]
     pub fn at(&self, t: f64) -> SVector<f64, N> {
         let h = self.t1 - self.t0;
         let th = if h > 0.0 { (t - self.t0) / h } else { 0.0 };
@@ -391,7 +392,9 @@ where
             let (mut sum3, mut sum5) = (0.0, 0.0);
             for i in 0..N {
                 let scale = self.tol.atol[i] + self.tol.rtol * y[i].abs().max(y1[i].abs());
-                let (r3, r5) = (err3[i] / scale, err5[i] / scale);
+                // One division per component, not two.
+                let inv = 1.0 / scale;
+                let (r3, r5) = (err3[i] * inv, err5[i] * inv);
                 sum3 += r3 * r3;
                 sum5 += r5 * r5;
             }

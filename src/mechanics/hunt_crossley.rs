@@ -301,15 +301,16 @@ fn release(step: &Dop853Step<3>, dense: &Dense<3>) -> (f64, State) {
     let (u0, u1) = (step.y0[0], step.y1[0]);
     let mut s = step.t0 + (step.t1 - step.t0) * u0 / (u0 - u1);
     let mut y = dense.at(s);
-    // A few iterations reach rounding: u is nearly linear in s there.
-    for _ in 0..4 {
-        let next = (s - y[0] / (0.5 * y[1])).clamp(step.t0, step.t1);
-        let done = (next - s).abs() <= 1e-14 * (step.t1 - step.t0);
-        s = next;
-        y = dense.at(s);
-        if done {
+    // u is nearly linear in s there, so Newton converges in two or three
+    // steps. At u = 0, dt/ds = u and dv/ds = u·a vanish: an error ε in s
+    // moves t and v only by O(ε²), so 1e-8 of the step is exact for them.
+    for _ in 0..6 {
+        let newton = -y[0] / (0.5 * y[1]);
+        if newton.abs() <= 1e-8 * (step.t1 - step.t0) {
             break;
         }
+        s = (s + newton).clamp(step.t0, step.t1);
+        y = dense.at(s);
     }
     (s, y)
 }
@@ -379,9 +380,10 @@ impl<P: Spring> Regularized<P> {
     }
 }
 
-/// The first trial step as a fraction of the contact's scale in s; the
-/// controller adjusts it within a step or two.
-const H0: f64 = 0.1;
+/// The first trial step as a fraction of the contact's scale in s: for
+/// the benchmark relays its error is ~1e-2 of the tolerance, so it is
+/// never rejected, and the controller grows the next up to 6 times.
+const H0: f64 = 0.25;
 
 #[cfg(test)]
 mod tests {
