@@ -103,11 +103,6 @@ impl HcContact {
         }
     }
 
-    /// The contact force at the integrated state (u, v, t).
-    fn force_of(&self, y: &State) -> f64 {
-        self.force_at(y[0] * y[0], y[1])
-    }
-
     fn energy_margin(&self, y: &State) -> f64 {
         // E − U(g), with x = g + δ: the spring and drive terms expand to
         // (k g − F) δ + ½ k δ², avoiding cancellation of large ½kx² terms.
@@ -206,7 +201,7 @@ impl HcContact {
                     min_force,
                 });
             }
-            peak_force = peak_force.max(self.force_of(&step.y1));
+            peak_force = peak_force.max(equations.force(&step.y1));
             // Stuck is declared only once moving out again (past the
             // deepest penetration, so the force peak has been seen).
             let moving_out = step.y1[1] < 0.0;
@@ -284,14 +279,14 @@ impl HcContact {
     ) -> f64 {
         let rate = |y: &State| equations.scaled_force_rate(y);
         let (rate0, rate1) = (rate(&y0), rate(&y1));
-        let ends = self.force_of(&y0).max(self.force_of(&y1));
+        let ends = equations.force(&y0).max(equations.force(&y1));
         if !(rate0 > 0.0 && rate1 < 0.0) {
             return ends;
         }
         // The force is flat at its maximum: placing it to 1e-7 of the step
         // gives the force to rounding.
         let s = root::illinois(|s| rate(&dense.at(s)), (s0, rate0), (s1, rate1), 1e-7);
-        ends.max(self.force_of(&dense.at(s)))
+        ends.max(equations.force(&dense.at(s)))
     }
 }
 
@@ -326,8 +321,9 @@ struct Regularized<P> {
     damping: f64,
     /// 1/s², k/m.
     stiffness: f64,
-    /// ks/m.
+    /// ks/m, and ks (N/mⁿ).
     surface: f64,
+    surface_stiffness: f64,
     chi: f64,
     exponent: f64,
     spring: P,
@@ -345,6 +341,7 @@ impl<P: Spring> Regularized<P> {
             damping: c.damping * inv_mass,
             stiffness: c.stiffness * inv_mass,
             surface: c.surface_stiffness * inv_mass,
+            surface_stiffness: c.surface_stiffness,
             chi: c.chi,
             exponent: c.exponent,
             spring,
@@ -370,6 +367,16 @@ impl<P: Spring> Regularized<P> {
         let rate_factor = if rate_factor > 0.0 { rate_factor } else { 0.0 };
         // Grouped so that the slow product is subtracted last.
         (self.drive - self.damping * v - self.stiffness * d) - self.surface * spring * rate_factor
+    }
+
+    /// The contact force (N) at the state: `force_at` without its square
+    /// root, since u = √δ is at hand.
+    fn force(&self, y: &State) -> f64 {
+        let (u, v) = (y[0], y[1]);
+        if u <= 0.0 {
+            return 0.0;
+        }
+        (self.surface_stiffness * (self.spring)(u * u, u) * (1.0 + self.chi * v)).max(0.0)
     }
 
     /// The force's rate of change dFc/dt divided by the positive ks δⁿ⁻¹:

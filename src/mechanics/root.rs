@@ -44,8 +44,10 @@ pub fn bisect(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64, tol: f64) -> Opt
 /// for smooth functions known only by value (an interpolated trajectory).
 /// `f_lo` and `f_hi` are the values at the ends, of opposite signs (if
 /// not, the end nearer zero is returned). Converges superlinearly and
-/// never leaves the bracket; stops once the bracket is narrower than `tol`
-/// times its original width, returning the last point evaluated.
+/// never leaves the bracket; stops once the bracket, or the last step, is
+/// narrower than `tol` times the original width (a step that small, in
+/// superlinear convergence, leaves less than that to the root), returning
+/// the last point evaluated.
 pub fn illinois(
     f: impl Fn(f64) -> f64,
     (mut lo, mut f_lo): (f64, f64),
@@ -66,8 +68,9 @@ pub fn illinois(
     // an end kept twice in a row is what stops plain regula falsi from
     // creeping up on the root from one side.
     let mut kept = 0;
-    let mut t = lo;
+    let mut t = f64::NAN;
     for _ in 0..200 {
+        let before = t;
         t = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
         if !(t > lo && t < hi) {
             t = 0.5 * (lo + hi);
@@ -89,7 +92,7 @@ pub fn illinois(
             }
             kept = -1;
         }
-        if hi - lo <= width {
+        if hi - lo <= width || (t - before).abs() <= width {
             break;
         }
     }
