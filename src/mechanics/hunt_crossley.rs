@@ -124,13 +124,9 @@ impl HcContact {
         // of the integration per law, so that the right-hand side,
         // evaluated a dozen times a step, has no branch on n.
         match self.exponent {
-            1.5 => self.integrate(Regularized::of(self, |d, u| d * u), v_hit, budget),
-            1.0 => self.integrate(Regularized::of(self, |d, _| d), v_hit, budget),
-            n => self.integrate(
-                Regularized::of(self, move |d: f64, _| d.powf(n)),
-                v_hit,
-                budget,
-            ),
+            1.5 => self.integrate(Regularized::of(self, Hertz), v_hit, budget),
+            1.0 => self.integrate(Regularized::of(self, Linear), v_hit, budget),
+            n => self.integrate(Regularized::of(self, Power(n)), v_hit, budget),
         }
     }
 
@@ -312,7 +308,7 @@ fn release(step: &Dop853Step<3>, dense: &Dense<3>) -> (f64, State) {
 
 /// The regularized equations of motion (module docs) with the constants
 /// divided through by the mass once: they are evaluated a dozen times a
-/// step, and the steps are latency-bound. `spring(δ, u)` is δⁿ.
+/// step, and the steps are latency-bound.
 #[derive(Clone, Copy)]
 struct Regularized<P> {
     /// m/s², (F − k g)/m: the net drive at the surface.
@@ -329,9 +325,51 @@ struct Regularized<P> {
     spring: P,
 }
 
-/// δⁿ from δ = u² and u.
-trait Spring: Fn(f64, f64) -> f64 + Copy {}
-impl<P: Fn(f64, f64) -> f64 + Copy> Spring for P {}
+/// A surface spring law δⁿ, as a function of δ = u² and u.
+trait Spring: Copy {
+    /// δⁿ.
+    fn power(self, d: f64, u: f64) -> f64;
+    /// u·δⁿ, which the right-hand side needs: for Hertz δ², one product
+    /// fewer on the chain of dependent operations than u·(δ·u).
+    fn power_times_u(self, d: f64, u: f64) -> f64;
+}
+
+/// n = 3/2: δⁿ = u³.
+#[derive(Clone, Copy)]
+struct Hertz;
+/// n = 1: δⁿ = u².
+#[derive(Clone, Copy)]
+struct Linear;
+/// Any other n: |u|²ⁿ.
+#[derive(Clone, Copy)]
+struct Power(f64);
+
+impl Spring for Hertz {
+    fn power(self, d: f64, u: f64) -> f64 {
+        d * u
+    }
+    fn power_times_u(self, d: f64, _u: f64) -> f64 {
+        d * d
+    }
+}
+
+impl Spring for Linear {
+    fn power(self, d: f64, _u: f64) -> f64 {
+        d
+    }
+    fn power_times_u(self, d: f64, u: f64) -> f64 {
+        d * u
+    }
+}
+
+impl Spring for Power {
+    fn power(self, d: f64, _u: f64) -> f64 {
+        d.powf(self.0)
+    }
+    fn power_times_u(self, d: f64, u: f64) -> f64 {
+        u * d.powf(self.0)
+    }
+}
 
 impl<P: Spring> Regularized<P> {
     fn of(c: &HcContact, spring: P) -> Self {
@@ -348,11 +386,23 @@ impl<P: Spring> Regularized<P> {
         }
     }
 
-    /// d(u, v, t)/ds.
+    /// d(u, v, t)/ds: (v/2, u·δ̈, u), with u·δ̈ expanded so that its
+    /// slowest term, u·δⁿ, is one product shorter.
     #[inline]
     fn rate(&self, y: &State) -> State {
-        let u = y[0];
-        State::new(0.5 * y[1], u * self.acceleration(y), u)
+        let (u, v) = (y[0], y[1]);
+        let d = u * u;
+        let linear = u * (self.drive - self.damping * v - self.stiffness * d);
+        let surface = self.surface * self.spring.power_times_u(d, u) * self.rate_factor(v);
+        State::new(0.5 * v, linear - surface, u)
+    }
+
+    /// The clamp Fc ≥ 0 acts only on the rate factor 1 + χ δ̇, so that
+    /// the continuation past release (u < 0) stays smooth.
+    #[inline]
+    fn rate_factor(&self, v: f64) -> f64 {
+        let rate_factor = 1.0 + self.chi * v;
+        if rate_factor > 0.0 { rate_factor } else { 0.0 }
     }
 
     /// δ̈ (m/s²) at the state (u, v, t).
@@ -360,13 +410,9 @@ impl<P: Spring> Regularized<P> {
     fn acceleration(&self, y: &State) -> f64 {
         let (u, v) = (y[0], y[1]);
         let d = u * u;
-        let spring = (self.spring)(d, u);
-        // The clamp Fc ≥ 0 acts only on the rate factor, so that the
-        // continuation past release (u < 0) stays smooth.
-        let rate_factor = 1.0 + self.chi * v;
-        let rate_factor = if rate_factor > 0.0 { rate_factor } else { 0.0 };
-        // Grouped so that the slow product is subtracted last.
-        (self.drive - self.damping * v - self.stiffness * d) - self.surface * spring * rate_factor
+        let spring = self.spring.power(d, u);
+        (self.drive - self.damping * v - self.stiffness * d)
+            - self.surface * spring * self.rate_factor(v)
     }
 
     /// The contact force (N) at the state: `force_at` without its square
@@ -376,7 +422,7 @@ impl<P: Spring> Regularized<P> {
         if u <= 0.0 {
             return 0.0;
         }
-        (self.surface_stiffness * (self.spring)(u * u, u) * (1.0 + self.chi * v)).max(0.0)
+        (self.surface_stiffness * self.spring.power(u * u, u) * (1.0 + self.chi * v)).max(0.0)
     }
 
     /// The force's rate of change dFc/dt divided by the positive ks δⁿ⁻¹:
