@@ -150,10 +150,14 @@ impl HcContact {
         let rtol = 1e-9;
         let tol = Tolerance {
             rtol,
+            // (The solver controls u and v only; t's entry goes unread.)
             atol: State::new(rtol * u_scale, rtol * v_hit, rtol * t_scale),
         };
         let h0 = H0 * s_scale;
-        let mut solver = Dop853::new(rhs, 0.0, State::new(0.0, v_hit, 0.0), h0, tol);
+        // t is a quadrature of u (dt/ds = u, read by no equation): only u
+        // and v set the step size.
+        let mut solver =
+            Dop853::new(rhs, 0.0, State::new(0.0, v_hit, 0.0), h0, tol).controlling_first::<2>();
         let sticks_possible = self.stiffness * self.gap < self.force;
         // Sticking is tested with a small margin so that rounding can never
         // call a contact stuck that will still release.
@@ -231,7 +235,7 @@ impl HcContact {
         &self,
         equations: &Regularized<P>,
         step: &Dop853Step<3>,
-        solver: &mut Dop853<3, F>,
+        solver: &mut Dop853<3, F, 2>,
         find_peak: bool,
     ) -> (State, f64)
     where
@@ -253,7 +257,7 @@ impl HcContact {
         &self,
         equations: &Regularized<P>,
         step: &Dop853Step<3>,
-        solver: &mut Dop853<3, F>,
+        solver: &mut Dop853<3, F, 2>,
     ) -> f64
     where
         F: Fn(f64, &State) -> State,
