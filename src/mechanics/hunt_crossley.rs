@@ -11,15 +11,19 @@
 //! u = √δ and a fictitious time s with dt = u ds (a Sundman transform):
 //!
 //! ```text
-//! du/ds = v/2,   dv/ds = u·a(u², v),   dt/ds = u,
-//! a = (F − c v − k (g + u²) − ks·uⁿ'·max(0, 1 + χ v)) / m,   uⁿ' = δⁿ
+//! du/ds = v/2,   dv/ds = u·a,   dt/ds = u,
+//! a = (F − c v − k (g + u²) − ks·δⁿ·max(0, 1 + χ v)) / m,   δ = u²
 //! ```
 //!
-//! which is polynomial in (u, v) for n = 1 and 3/2: smooth through the
-//! touch (u = 0 at s = 0) and the release, where u crosses 0 as a simple
-//! root (du/ds = v/2 < 0). δ = u² keeps the tiny penetration's relative
-//! precision. At u = 0, dv/ds = dt/ds = 0, so the release velocity and
-//! time hardly depend on where exactly in s the root is placed.
+//! which is polynomial in (u, v) for n = 1 and 3/2 (δ^1.5 = u³): smooth
+//! through the touch (u = 0 at s = 0) and the release, where u crosses 0
+//! as a simple root (du/ds = v/2 < 0). δ = u² keeps the tiny penetration's
+//! relative precision. At u = 0, dv/ds = dt/ds = 0, so the release
+//! velocity and time hardly depend on where exactly in s the root is
+//! placed. The step size is set by u and v; t, a quadrature of u, follows.
+//!
+//! The force peak is located on the dense output of the step in which the
+//! force's rate (known from the state) turns negative.
 //!
 //! Two events end a contact:
 //! - release: u returns to 0 moving out, located on the step's dense

@@ -21,6 +21,15 @@
 //! That is what lets events be bracketed exactly: between two consecutive
 //! velocity zeros the position is monotonic, so a level is crossed at most
 //! once there.
+//!
+//! Speed (a whole sequence takes microseconds): the constants of each
+//! equation are worked out once ([`Mode`]); a crossing between extrema of
+//! an under-damped piece is solved in the phase from the first extremum,
+//! where the motion is one exact formula and Halley's iterates advance by
+//! addition theorems rather than fresh `exp`/`sin_cos` calls
+//! ([`LinearPiece::crossing`]); any combination of y and ẏ (a
+//! Kelvin–Voigt force) is y itself shifted in time and scaled
+//! ([`Mode::combination_shift`]), so its extrema need no trigonometry.
 
 use super::root;
 

@@ -11,7 +11,8 @@
 //!   Kelvin–Voigt surface), solved in closed form in every damping regime
 //!   ([`linear`]); impacts and releases are roots of that closed form,
 //!   bracketed between consecutive extrema and polished by safeguarded
-//!   Newton iteration ([`root`]);
+//!   Halley iteration, in the exact phase form of a half swing when
+//!   under-damped;
 //! - a nonlinear contact (Hunt–Crossley), integrated by an adaptive
 //!   8th-order Runge–Kutta method with dense output and event location
 //!   ([`dop853`]), in variables that keep the motion smooth through touch
