@@ -24,7 +24,7 @@
 //! skipped flight `T`: that is the reported accumulation time.
 
 use super::hunt_crossley::{HcContact, HcEnd};
-use super::linear::LinearPiece;
+use super::linear::{LinearPiece, Mode, Shift, Zeros};
 use super::{Mechanics, MechanicsError, Settings, Surface};
 use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome};
 
@@ -166,25 +166,33 @@ struct Engine<'a> {
     settings: &'a Settings,
     /// N, drive net of preload.
     f_net: f64,
+    /// Free flight's equation, and the surface's response to an impact.
+    flight: Mode,
+    law: Law,
     impacts: Vec<Impact>,
     intervals: Vec<Interval>,
 }
 
+/// Room for a typical sequence (a few dozen contacts) without regrowing.
+const TYPICAL_CONTACTS: usize = 32;
+
 impl<'a> Engine<'a> {
     fn new(m: &'a Mechanics, surface: &'a Surface, settings: &'a Settings) -> Self {
+        let f_net = m.force - m.preload;
         Engine {
             m,
             surface,
             settings,
-            f_net: m.force - m.preload,
-            impacts: Vec::new(),
-            intervals: Vec::new(),
+            f_net,
+            flight: Mode::new(m.mass, m.damping, m.stiffness, f_net),
+            law: Law::new(m, surface),
+            impacts: Vec::with_capacity(TYPICAL_CONTACTS),
+            intervals: Vec::with_capacity(2 * TYPICAL_CONTACTS + 1),
         }
     }
 
     fn flight(&self, x0: f64, v0: f64) -> LinearPiece {
-        let m = self.m;
-        LinearPiece::new(m.mass, m.damping, m.stiffness, self.f_net, x0, v0)
+        LinearPiece::start(&self.flight, x0, v0)
     }
 
     fn run(mut self) -> Result<Chatter, MechanicsError> {
@@ -293,7 +301,7 @@ impl<'a> Engine<'a> {
     /// fields of the last impact.
     fn contact(&mut self, t_hit: f64, v_hit: f64) -> Result<ContactEnd, MechanicsError> {
         let budget = self.settings.t_end - t_hit;
-        let r = impact_response(self.m, self.surface, v_hit, budget)?;
+        let r = self.law.respond(self.m, v_hit, budget)?;
         let last = self.impacts.last_mut().expect("the impact was pushed");
         last.peak_force = r.peak_force;
         last.min_force = r.min_force;
@@ -419,70 +427,53 @@ pub fn impact_response(
     v_hit: f64,
     budget: f64,
 ) -> Result<ImpactResponse, MechanicsError> {
-    let g = m.gap;
-    let f_net = m.force - m.preload;
-    match *surface {
-        Surface::Rigid { restitution } => {
-            let v_out = -restitution * v_hit;
-            let x_eq = f_net / m.stiffness;
-            if v_out == 0.0 && x_eq >= g {
-                // Held against the surface by the static overtravel force.
-                let static_force = m.stiffness * (x_eq - g);
-                return Ok(ImpactResponse {
-                    end: ResponseEnd::Stuck,
-                    peak_force: Some(static_force),
-                    min_force: Some(static_force),
-                });
-            }
-            Ok(ImpactResponse {
-                end: ResponseEnd::Released {
-                    contact_time: 0.0,
-                    velocity: v_out,
-                },
-                peak_force: None,
-                min_force: None,
-            })
-        }
-        Surface::KelvinVoigt { stiffness, damping } => {
-            let piece = LinearPiece::new(
-                m.mass,
-                m.damping + damping,
-                m.stiffness + stiffness,
-                f_net + stiffness * g,
-                g,
-                v_hit,
-            );
-            let release = piece.crossing(g, false);
-            let budget = budget.max(0.0);
-            // Where the force is last looked at: (time, x, ẋ).
-            let until = match release {
-                Some(c) if c.time <= budget => Some((c.time, g, c.velocity)),
-                _ if budget.is_finite() => {
-                    let (x, v) = piece.state(budget);
-                    Some((budget, x, v))
+    Law::new(m, surface).respond(m, v_hit, budget)
+}
+
+/// A surface law with what depends only on the relay worked out once, so
+/// that a sequence of contacts does not redo it.
+enum Law {
+    Rigid {
+        restitution: f64,
+    },
+    KelvinVoigt {
+        /// The in-contact equation.
+        contact: Mode,
+        /// N/m and N·s/m, the surface's s0 and r0.
+        stiffness: f64,
+        damping: f64,
+        /// The varying part of the force, s0·y + r0·ẏ, as shifted
+        /// position (under-damped contact only).
+        force_shift: Option<Shift>,
+    },
+    HuntCrossley(HcContact),
+}
+
+impl Law {
+    fn new(m: &Mechanics, surface: &Surface) -> Law {
+        let g = m.gap;
+        let f_net = m.force - m.preload;
+        match *surface {
+            Surface::Rigid { restitution } => Law::Rigid { restitution },
+            Surface::KelvinVoigt { stiffness, damping } => {
+                let contact = Mode::new(
+                    m.mass,
+                    m.damping + damping,
+                    m.stiffness + stiffness,
+                    f_net + stiffness * g,
+                );
+                Law::KelvinVoigt {
+                    contact,
+                    stiffness,
+                    damping,
+                    force_shift: contact.combination_shift(stiffness, damping),
                 }
-                _ => None,
-            };
-            let (peak, min) = kv_force_extremes(&piece, g, stiffness, damping, until);
-            Ok(ImpactResponse {
-                end: match release {
-                    None => ResponseEnd::Stuck,
-                    Some(c) if c.time > budget => ResponseEnd::Horizon,
-                    Some(c) => ResponseEnd::Released {
-                        contact_time: c.time,
-                        velocity: c.velocity,
-                    },
-                },
-                peak_force: Some(peak),
-                min_force: Some(min),
-            })
-        }
-        Surface::HuntCrossley {
-            stiffness,
-            exponent,
-            chi,
-        } => {
-            let hc = HcContact {
+            }
+            Surface::HuntCrossley {
+                stiffness,
+                exponent,
+                chi,
+            } => Law::HuntCrossley(HcContact {
                 mass: m.mass,
                 damping: m.damping,
                 stiffness: m.stiffness,
@@ -491,20 +482,102 @@ pub fn impact_response(
                 surface_stiffness: stiffness,
                 exponent,
                 chi,
-            };
-            let out = hc.run(v_hit, budget)?;
-            Ok(ImpactResponse {
-                end: match out.end {
-                    HcEnd::Released { after, velocity } => ResponseEnd::Released {
-                        contact_time: after,
-                        velocity,
+            }),
+        }
+    }
+
+    /// See [`impact_response`].
+    fn respond(
+        &self,
+        m: &Mechanics,
+        v_hit: f64,
+        budget: f64,
+    ) -> Result<ImpactResponse, MechanicsError> {
+        let g = m.gap;
+        match *self {
+            Law::Rigid { restitution } => {
+                let v_out = -restitution * v_hit;
+                let x_eq = (m.force - m.preload) / m.stiffness;
+                if v_out == 0.0 && x_eq >= g {
+                    // Held against the surface by the static overtravel force.
+                    let static_force = m.stiffness * (x_eq - g);
+                    return Ok(ImpactResponse {
+                        end: ResponseEnd::Stuck,
+                        peak_force: Some(static_force),
+                        min_force: Some(static_force),
+                    });
+                }
+                Ok(ImpactResponse {
+                    end: ResponseEnd::Released {
+                        contact_time: 0.0,
+                        velocity: v_out,
                     },
-                    HcEnd::Stuck { .. } => ResponseEnd::Stuck,
-                    HcEnd::Horizon => ResponseEnd::Horizon,
-                },
-                peak_force: Some(out.peak_force),
-                min_force: Some(out.min_force),
-            })
+                    peak_force: None,
+                    min_force: None,
+                })
+            }
+            Law::KelvinVoigt {
+                ref contact,
+                stiffness,
+                damping,
+                force_shift,
+            } => {
+                let piece = LinearPiece::start(contact, g, v_hit);
+                let release = piece.crossing(g, false);
+                let budget = budget.max(0.0);
+                // Where the force is last looked at: (time, x, ẋ).
+                let until = match release {
+                    Some(c) if c.time <= budget => Some((c.time, g, c.velocity)),
+                    _ if budget.is_finite() => {
+                        let (x, v) = piece.state(budget);
+                        Some((budget, x, v))
+                    }
+                    _ => None,
+                };
+                // The force's extrema: from the deepest point, where the
+                // release crossing turned, when the force is shifted
+                // position; else from the closed-form zeros of its rate.
+                let turn = release.and_then(|c| c.turned_at);
+                let extrema = match (force_shift, turn) {
+                    (Some(shift), Some((t, x))) => {
+                        piece.combination_extrema(shift, (t, x - piece.x_eq))
+                    }
+                    _ => {
+                        let rate = piece
+                            .combo(-damping * piece.omega2, stiffness - 2.0 * piece.a * damping);
+                        piece.zeros(rate, piece.combo(stiffness, damping))
+                    }
+                };
+                let (peak, min) =
+                    kv_force_extremes(&piece, g, (stiffness, damping), extrema, until);
+                Ok(ImpactResponse {
+                    end: match release {
+                        None => ResponseEnd::Stuck,
+                        Some(c) if c.time > budget => ResponseEnd::Horizon,
+                        Some(c) => ResponseEnd::Released {
+                            contact_time: c.time,
+                            velocity: c.velocity,
+                        },
+                    },
+                    peak_force: Some(peak),
+                    min_force: Some(min),
+                })
+            }
+            Law::HuntCrossley(ref hc) => {
+                let out = hc.run(v_hit, budget)?;
+                Ok(ImpactResponse {
+                    end: match out.end {
+                        HcEnd::Released { after, velocity } => ResponseEnd::Released {
+                            contact_time: after,
+                            velocity,
+                        },
+                        HcEnd::Stuck { .. } => ResponseEnd::Stuck,
+                        HcEnd::Horizon => ResponseEnd::Horizon,
+                    },
+                    peak_force: Some(out.peak_force),
+                    min_force: Some(out.min_force),
+                })
+            }
         }
     }
 }
@@ -519,8 +592,9 @@ pub fn critical_impact_speed(
     surface: &Surface,
     rel_tol: f64,
 ) -> Result<f64, MechanicsError> {
+    let law = Law::new(m, surface);
     let releases = |v: f64| -> Result<bool, MechanicsError> {
-        let r = impact_response(m, surface, v, f64::INFINITY)?;
+        let r = law.respond(m, v, f64::INFINITY)?;
         Ok(matches!(r.end, ResponseEnd::Released { .. }))
     };
     let x_eq = (m.force - m.preload) / m.stiffness;
@@ -572,41 +646,37 @@ fn bounces(intervals: &[Interval]) -> usize {
 /// contact piece from local time 0 to `until` = (time, x, ẋ), the end
 /// state the caller already has (`None` for a contact that sticks: the
 /// force tends to its static value). The force is a constant plus a
-/// combination of y and ẏ, so its extrema are the closed-form zeros of its
-/// rate `s0 ẏ + r0 ÿ = (s0 − 2a r0) ẏ − r0 ωn² y`.
+/// combination of y and ẏ; `extrema` are that combination's extrema
+/// (local time, value) in order, from its closed-form rate zeros or as
+/// shifted position ([`Mode::combination_shift`]).
 fn kv_force_extremes(
     piece: &LinearPiece,
     g: f64,
-    s0: f64,
-    r0: f64,
+    (s0, r0): (f64, f64),
+    extrema: Zeros,
     until: Option<(f64, f64, f64)>,
 ) -> (f64, f64) {
     let force = |x: f64, v: f64| s0 * (x - g) + r0 * v;
-    let rate = piece.combo(-r0 * piece.omega2, s0 - 2.0 * piece.a * r0);
     let mut peak = force(piece.x0, piece.v0);
     let mut min = peak;
     let mut consider = |f: f64| {
         peak = peak.max(f);
         min = min.min(f);
     };
+    let at_rest = s0 * (piece.x_eq - g);
     let t_until = match until {
         Some((t, x, v)) => {
             consider(force(x, v));
             t
         }
         None => {
-            consider(s0 * (piece.x_eq - g));
+            consider(at_rest);
             f64::INFINITY
         }
     };
     // The force's own extrema decay like the motion: the first two (one
     // maximum, one minimum) bound every later one.
-    let at_rest = s0 * (piece.x_eq - g);
-    for (_, varying) in piece
-        .zeros(rate, piece.combo(s0, r0))
-        .take(2)
-        .take_while(|&(z, _)| z < t_until)
-    {
+    for (_, varying) in extrema.take(2).take_while(|&(z, _)| z < t_until) {
         consider(at_rest + varying);
     }
     (peak, min)

@@ -1,14 +1,14 @@
 //! Adaptive Runge–Kutta integration with dense output, for the pieces of
-//! motion that have no closed form (the Hunt–Crossley contact; later, a
-//! force that varies in time).
+//! motion that have no closed form (later, a force that varies in time).
+//! The Hunt–Crossley contact, which needs tight tolerances, uses the
+//! higher-order [`super::dop853`] instead; [`Tolerance`] serves both.
 //!
 //! The method is Dormand–Prince 5(4) with its 4th-order continuous
 //! extension (Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.5–6). It is
 //! written here rather than taken from a crate because the engine needs to
 //! drive it one step at a time and locate events on each step's dense
 //! output, and because the states are tiny (2–3 components): a
-//! stack-allocated `SVector` step is a few dozen flops, which is what keeps
-//! a whole Hunt–Crossley sequence in tens of microseconds.
+//! stack-allocated `SVector` step is a few dozen flops.
 //!
 //! The caller owns the loop ([`Dopri5::step`] returns one accepted
 //! [`Step`]), checks its events on the step, and stops when it likes; so

@@ -11,15 +11,18 @@
 //!   Kelvin–Voigt surface), solved in closed form in every damping regime
 //!   ([`linear`]); impacts and releases are roots of that closed form,
 //!   bracketed between consecutive extrema and polished by safeguarded
-//!   Newton iteration ([`root`]);
+//!   Halley iteration, in the exact phase form of a half swing when
+//!   under-damped;
 //! - a nonlinear contact (Hunt–Crossley), integrated by an adaptive
-//!   Runge–Kutta method with dense output and event location
-//!   ([`integrate`]).
+//!   8th-order Runge–Kutta method with dense output and event location
+//!   ([`dop853`]), in variables that keep the motion smooth through touch
+//!   and release ([`hunt_crossley`]).
 //!
 //! Sign conventions: `x` is the displacement toward the fixed contact
 //! (m), velocities are positive toward it, and contact forces are the
 //! force the fixed contact puts on the moving one, positive pushing back.
 
+pub mod dop853;
 pub mod engine;
 pub mod force;
 pub mod hunt_crossley;

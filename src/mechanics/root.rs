@@ -40,6 +40,65 @@ pub fn bisect(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64, tol: f64) -> Opt
     Some(0.5 * (lo + hi))
 }
 
+/// A root of `f` in `[lo, hi]` by the Illinois variant of regula falsi,
+/// for smooth functions known only by value (an interpolated trajectory).
+/// `f_lo` and `f_hi` are the values at the ends, of opposite signs (if
+/// not, the end nearer zero is returned). Converges superlinearly and
+/// never leaves the bracket; stops once the bracket, or the last step, is
+/// narrower than `tol` times the original width (a step that small, in
+/// superlinear convergence, leaves less than that to the root), returning
+/// the last point evaluated.
+pub fn illinois(
+    f: impl Fn(f64) -> f64,
+    (mut lo, mut f_lo): (f64, f64),
+    (mut hi, mut f_hi): (f64, f64),
+    tol: f64,
+) -> f64 {
+    if f_lo == 0.0 {
+        return lo;
+    }
+    if f_hi == 0.0 {
+        return hi;
+    }
+    if f_lo.signum() == f_hi.signum() {
+        return if f_lo.abs() < f_hi.abs() { lo } else { hi };
+    }
+    let width = tol * (hi - lo);
+    // Which end the last step kept (−1 low, 1 high): halving the value at
+    // an end kept twice in a row is what stops plain regula falsi from
+    // creeping up on the root from one side.
+    let mut kept = 0;
+    let mut t = f64::NAN;
+    for _ in 0..200 {
+        let before = t;
+        t = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
+        if !(t > lo && t < hi) {
+            t = 0.5 * (lo + hi);
+        }
+        let ft = f(t);
+        if ft == 0.0 {
+            break;
+        }
+        if ft.signum() == f_lo.signum() {
+            (lo, f_lo) = (t, ft);
+            if kept == 1 {
+                f_hi *= 0.5;
+            }
+            kept = 1;
+        } else {
+            (hi, f_hi) = (t, ft);
+            if kept == -1 {
+                f_lo *= 0.5;
+            }
+            kept = -1;
+        }
+        if hi - lo <= width || (t - before).abs() <= width {
+            break;
+        }
+    }
+    t
+}
+
 /// A function's value and first two derivatives at `t`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Jet {
@@ -172,6 +231,16 @@ mod tests {
         let f = |t: f64| (t - 1.0, 1.0, 0.0);
         let r = halley_bracketed(f, (0.0, -1.0), (1.0, 0.0), 0.5);
         assert_eq!(r, Root { t: 1.0, last: None });
+    }
+
+    #[test]
+    fn illinois_converges_on_a_lopsided_function() {
+        // Convex on the whole bracket: plain regula falsi keeps the right
+        // end forever and crawls.
+        let f = |t: f64| t.exp() - 2.0;
+        let r = illinois(f, (0.0, f(0.0)), (3.0, f(3.0)), 1e-15);
+        assert!((r - 2f64.ln()).abs() < 1e-14, "{r}");
+        assert_eq!(illinois(f, (0.0, -1.0), (1.0, -2.0), 1e-15), 0.0);
     }
 
     #[test]
