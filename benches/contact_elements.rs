@@ -265,6 +265,7 @@ fn run_netlist(ng: &Ngspice, inc: &Include, w: &Waveform, stop: f64, netlist: &s
         netlist_path: std::path::Path::new("bench.cir"),
         include_file_name: "contact.inc",
         subckt: "CONTACT",
+        coil: None,
         probes: &["v(in)"],
         chatter_end: end.min(stop),
         stop_at_least: end.min(stop),

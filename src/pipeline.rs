@@ -279,6 +279,7 @@ fn run_chatter(
         netlist_path: &netlist_path,
         include_file_name: INCLUDE_FILE,
         subckt: &circuit.subckt,
+        coil: None,
         probes: &signals,
         chatter_end: end,
         stop_at_least: end * STOP_MARGIN,

@@ -50,6 +50,10 @@ pub struct DeckRequest<'a> {
     pub include_file_name: &'a str,
     /// The contact subcircuit's name, e.g. `CONTACT`.
     pub subckt: &'a str,
+    /// For a coil-driven relay: the coil include's plain file name and the
+    /// coil subcircuit's name (e.g. `COIL`), which the netlist must
+    /// instantiate too.
+    pub coil: Option<(&'a str, &'a str)>,
     /// ngspice vector names to measure: `v(node)`, `v(a,b)`, `i(vsource)`.
     pub probes: &'a [&'a str],
     /// s, when the chatter ends: a `.tran` that stops earlier is an error.
@@ -285,6 +289,7 @@ pub fn prepare_deck(req: &DeckRequest<'_>) -> Result<Deck, NetlistError> {
 
     let cards = cards(&lines, &live);
     let mut instances = 0;
+    let mut coil_instances = 0;
     let mut has_save = false;
     let mut tran: Option<Tran> = None;
     let mut includes: Vec<(usize, PathBuf)> = Vec::new();
@@ -322,6 +327,12 @@ pub fn prepare_deck(req: &DeckRequest<'_>) -> Result<Deck, NetlistError> {
                 if instantiates(&card.text, req.subckt) {
                     instances += 1;
                 }
+                if req
+                    .coil
+                    .is_some_and(|(_, coil)| instantiates(&card.text, coil))
+                {
+                    coil_instances += 1;
+                }
             }
         }
     }
@@ -338,6 +349,22 @@ pub fn prepare_deck(req: &DeckRequest<'_>) -> Result<Deck, NetlistError> {
             return Err(NetlistError::NoContactInstance {
                 netlist,
                 subckt: req.subckt.to_owned(),
+            });
+        }
+    }
+    if let Some((_, coil)) = req.coil {
+        let mut seen = HashSet::new();
+        let mut found = coil_instances > 0;
+        for (line, path) in &includes {
+            if found {
+                break;
+            }
+            found = include_instantiates(path, coil, &netlist, *line, 1, &mut seen)?;
+        }
+        if !found {
+            return Err(NetlistError::NoCoilInstance {
+                netlist,
+                subckt: coil.to_owned(),
             });
         }
     }
@@ -387,6 +414,9 @@ pub fn prepare_deck(req: &DeckRequest<'_>) -> Result<Deck, NetlistError> {
         &format!(".include {}", quote_if_needed(req.include_file_name)),
         None,
     );
+    if let Some((coil_include, _)) = req.coil {
+        emit(&format!(".include {}", quote_if_needed(coil_include)), None);
+    }
     for (index, (line, fate)) in lines.iter().zip(&fates).enumerate().skip(1) {
         match fate {
             Fate::Keep => emit(line, Some(index + 1)),
@@ -728,6 +758,7 @@ mod tests {
             netlist_path: Path::new("/nonexistent/dir/circuit.cir"),
             include_file_name: "contact.inc",
             subckt: "CONTACT",
+            coil: None,
             probes,
             chatter_end: 5e-3,
             stop_at_least: 8e-3,
@@ -736,6 +767,26 @@ mod tests {
 
     const BASIC: &str = "My circuit\r\nV1 vdd 0 3.3\r\nR1 vdd in 10k\r\n\
         x1 in\r\n+ 0 contact ; the relay\r\n.tran 1u 10m\r\n.end\r\n";
+
+    #[test]
+    fn a_coil_driven_relay_needs_its_coil_instantiated_and_included() {
+        let coil_req = |text| DeckRequest {
+            coil: Some(("coil.inc", "COIL")),
+            ..req(text, &[])
+        };
+        let err = prepare_deck(&coil_req(BASIC)).unwrap_err();
+        assert!(matches!(err, NetlistError::NoCoilInstance { .. }), "{err}");
+        assert!(
+            err.to_string().contains("X2 coil_plus coil_minus COIL"),
+            "{err}"
+        );
+        let with_coil = BASIC.replace(".tran", "X2 drv 0 coil\r\n.tran");
+        let deck = prepare_deck(&coil_req(&with_coil)).unwrap();
+        let lines: Vec<&str> = deck.text.lines().collect();
+        assert_eq!(&lines[2..4], [".include contact.inc", ".include coil.inc"]);
+        assert_eq!(deck.source_line(4), None);
+        assert_eq!(deck.source_line(5), Some(2));
+    }
 
     #[test]
     fn basic_deck() {

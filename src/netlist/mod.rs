@@ -71,6 +71,12 @@ pub enum NetlistError {
     )]
     NoContactInstance { netlist: PathBuf, subckt: String },
     #[error(
+        "{}: no `X` line instantiates the coil subcircuit `{subckt}`: the scenario has a \
+         [coil], so the netlist's driver must drive it, e.g. `X2 coil_plus coil_minus {subckt}`",
+        netlist.display()
+    )]
+    NoCoilInstance { netlist: PathBuf, subckt: String },
+    #[error(
         "{}: line {line}: the netlist defines its own `.subckt {subckt}`, which clashes with the \
          generated contact: remove that definition (chatterspice provides it) or name the \
          contact differently in the scenario's `circuit.subckt`",
