@@ -86,3 +86,84 @@ fn a_moving_armature_changes_the_current_at_constant_flux() {
         "{after} vs {expected}"
     );
 }
+
+/// ms from the driver's turn-off (20 ms) until the coil current of
+/// `netlist` (from netlists/) falls to half its on value, with the
+/// armature held closed and the contact open.
+fn decay_time(netlist: &str) -> Option<f64> {
+    let ng = common::ngspice()?;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("netlists")
+        .join(netlist);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let open = chatterspice::waveform::Waveform::from_intervals(
+        &[chatterspice::Interval {
+            state: chatterspice::ContactState::Open,
+            start: 0.0,
+            end: 0.05,
+        }],
+        &chatterspice::waveform::ContactModel {
+            r_closed: 0.05,
+            r_open: 1e9,
+            edge_time: 1e-8,
+        },
+    )
+    .unwrap();
+    let contact = chatterspice::netlist::contact_include(
+        &open,
+        "CONTACT",
+        chatterspice::netlist::ContactElement::Pwl,
+    )
+    .unwrap();
+    let deck = chatterspice::netlist::prepare_deck(&chatterspice::netlist::DeckRequest {
+        netlist_text: &text,
+        netlist_path: &path,
+        include_file_name: "contact.inc",
+        subckt: "CONTACT",
+        coil: Some(("coil.inc", "COIL")),
+        probes: &[],
+        chatter_end: 0.0,
+        stop_at_least: 0.0,
+    })
+    .unwrap();
+    let mut req = RunRequest::new(deck.text);
+    req.includes.push(("contact.inc".into(), contact.text));
+    // Held closed: the inductance of the closed armature (x = g).
+    req.includes.push((
+        "coil.inc".into(),
+        coil_include(&COIL, "COIL", &[(0.0, 4.5e-4)]).unwrap(),
+    ));
+    let out = ng.run(&req).unwrap();
+    let plot = out.raw.plot_named("transient analysis").unwrap();
+    let t = match plot.scale() {
+        Some(Vector::Real(t)) => t,
+        _ => panic!("no time"),
+    };
+    let i = plot.real("i(v.x_coil.vi)").unwrap();
+    let on = i[t.partition_point(|&x| x < 19.9e-3)];
+    // Closed, L = 1.13 H: τ = L/R = 16 ms, so after 19.8 ms on the current
+    // has reached 1 − e^(−1.24) of V/R.
+    let expected = 5.0 / 70.0 * (1.0 - (-19.8e-3 / (1.131 / 70.0f64)).exp());
+    assert!((on / expected - 1.0).abs() < 0.05, "on current {on} vs {expected}");
+    let k = (0..t.len())
+        .find(|&k| t[k] > 20e-3 && i[k] < 0.5 * on)
+        .expect("the current decays");
+    Some((t[k] - 20e-3) * 1e3)
+}
+
+#[test]
+fn a_zener_clamp_lets_the_coil_current_die_much_faster_than_a_plain_diode() {
+    let (Some(diode), Some(zener)) = (
+        decay_time("relay_driver_diode.cir"),
+        decay_time("relay_driver_zener.cir"),
+    ) else {
+        return;
+    };
+    // A plain diode: the coil's own L/R (L ≈ 0.5 H closed, R = 70 Ω plus
+    // the diode): about ln(10)·τ ≈ 15 ms. The zener clamp: ≪ 1 ms.
+    assert!(diode > 3.0 * zener, "diode {diode} ms, zener {zener} ms");
+    assert!(
+        diode > 5.0 && zener < 2.0,
+        "diode {diode} ms, zener {zener} ms"
+    );
+}
