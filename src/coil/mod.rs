@@ -36,6 +36,15 @@
 //! force extrema) bracketed on one step and polished by bisection on the
 //! step's interpolant.
 
+pub mod direct;
+pub mod forced;
+mod sequence;
+
+pub use direct::{
+    CoilEvents, CoilRun, CoilState, EnergyBalance, PullInDip, Source, simulate_direct,
+};
+pub use forced::simulate_forced;
+
 use thiserror::Error;
 
 use crate::mechanics::MechanicsError;
