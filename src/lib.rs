@@ -12,6 +12,7 @@
 pub mod analysis;
 pub mod chatter;
 pub mod check;
+pub mod coil;
 pub mod mechanics;
 pub mod netlist;
 pub mod pipeline;

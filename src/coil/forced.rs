@@ -1,0 +1,179 @@
+//! The mechanics under a drive force that varies in time and position.
+//!
+//! This is the mechanical half of the waveform-relaxation coupling with
+//! ngspice: the circuit gives the coil current `i(t)`, the coil turns it
+//! into `F_m(i(t), x)` ([`super::Coil::force`]), and this integrates the
+//! armature under it, with the same events, surface laws and endings as
+//! the step-force engine (see `sequence` for the numerics and the sticking
+//! argument). With a constant force it reproduces
+//! [`crate::mechanics::simulate`].
+
+use super::CoilError;
+use super::sequence::{self, Drive};
+use crate::chatter::Chatter;
+use crate::mechanics::{self, Mechanics, Settings, Surface};
+
+/// Simulate one closing under `force(t, x)` (s, m → N, toward closing),
+/// which replaces `mechanics.force`; the preload still holds the armature
+/// on its rest stop at x = 0 until the force beats it.
+///
+/// The force must be finite and should be smooth between the instants the
+/// caller knows of: the integrator samples it adaptively. A contact is
+/// declared stuck on the understanding that the drive does not weaken
+/// afterwards (a closing drive); at `t_end` the force is frozen at its last
+/// value to tell whether the sequence would go on (`end_of_time`) or has
+/// ended open. `mechanics.initial_position` must lie in `[0, gap)`: the
+/// rest stop is at 0.
+pub fn simulate_forced(
+    mechanics: &Mechanics,
+    surface: &Surface,
+    settings: &Settings,
+    force: impl Fn(f64, f64) -> f64,
+) -> Result<Chatter, CoilError> {
+    mechanics::validate(
+        &Mechanics {
+            force: 0.0,
+            ..*mechanics
+        },
+        surface,
+        settings,
+    )?;
+    if mechanics.initial_position < 0.0 {
+        return Err(CoilError::InvalidParameter {
+            name: "mechanics.initial_position",
+            value: mechanics.initial_position,
+            requirement: "a position in m at or above the rest stop at 0 (and below the gap)",
+        });
+    }
+    let scale = [
+        mechanics.preload,
+        mechanics.stiffness * mechanics.gap,
+        force(0.0, mechanics.initial_position).abs(),
+    ]
+    .into_iter()
+    .fold(0.0, f64::max);
+    let drive = Forced {
+        force,
+        // The impulse ∫F dt over the suspension's time scale.
+        impulse_scale: scale * (mechanics.mass / mechanics.stiffness).sqrt(),
+        time_scale: (mechanics.mass / mechanics.stiffness).sqrt(),
+    };
+    Ok(sequence::run(mechanics, surface, settings, &drive, 0.0)?.chatter)
+}
+
+/// A drive given as a function. Its state `e` is the impulse `∫F dt`:
+/// integrating it makes the step-size control follow the force while the
+/// armature is held and nothing else moves.
+struct Forced<F> {
+    force: F,
+    impulse_scale: f64,
+    time_scale: f64,
+}
+
+/// Gauss–Legendre nodes and weights on [−1, 1], 3 points: exact for a
+/// force polynomial of degree 5 in x over a penetration of a few µm.
+const GL3: [(f64, f64); 3] = [
+    (-0.774_596_669_241_483_4, 5.0 / 9.0),
+    (0.0, 8.0 / 9.0),
+    (0.774_596_669_241_483_4, 5.0 / 9.0),
+];
+
+impl<F: Fn(f64, f64) -> f64> Drive for Forced<F> {
+    fn force(&self, t: f64, x: f64, _e: f64) -> f64 {
+        (self.force)(t, x)
+    }
+
+    fn rate(&self, t: f64, x: f64, _e: f64) -> f64 {
+        (self.force)(t, x)
+    }
+
+    fn frozen_work(&self, t: f64, _e: f64, from: f64, to: f64) -> f64 {
+        let (mid, half) = (0.5 * (from + to), 0.5 * (to - from));
+        half * GL3
+            .iter()
+            .map(|&(z, w)| w * (self.force)(t, mid + half * z))
+            .sum::<f64>()
+    }
+
+    fn e_scale(&self) -> f64 {
+        self.impulse_scale
+    }
+
+    fn time_scale(&self) -> f64 {
+        self.time_scale
+    }
+
+    fn pole(&self) -> f64 {
+        f64::INFINITY
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::chatter::Outcome;
+
+    fn relay() -> Mechanics {
+        Mechanics {
+            mass: 1.0,
+            stiffness: 1.0,
+            damping: 0.1,
+            force: 1.0,
+            gap: 0.9,
+            initial_position: 0.0,
+            initial_velocity: 0.0,
+            preload: 0.0,
+        }
+    }
+
+    #[test]
+    fn a_drive_below_the_preload_never_lifts() {
+        let m = Mechanics {
+            preload: 2.0,
+            ..relay()
+        };
+        let s = Surface::Rigid { restitution: 0.5 };
+        let settings = Settings {
+            t_end: 10.0,
+            ..Settings::default()
+        };
+        let c = simulate_forced(&m, &s, &settings, |_, _| 1.0).unwrap();
+        assert_eq!(c.outcome, Outcome::NeverCloses);
+        assert_eq!(c.shortfall, Some(0.9));
+    }
+
+    #[test]
+    fn a_late_drive_lifts_where_it_beats_the_preload() {
+        // The force ramps from 0 to 1.5 N over [3, 3.001] s: it beats the
+        // 0.5 N preload at 3 + 1e-3/3, between whatever steps the held
+        // phase took; the flight then runs as from t = 0 under a step,
+        // shifted by that time, up to the last 2/3 ms of the ramp.
+        let m = Mechanics {
+            preload: 0.5,
+            ..relay()
+        };
+        let s = Surface::KelvinVoigt {
+            stiffness: 100.0,
+            damping: 0.5,
+        };
+        let settings = Settings {
+            t_end: 20.0,
+            ..Settings::default()
+        };
+        let ramp = |t: f64, _x: f64| 1.5 * ((t - 3.0) / 1e-3).clamp(0.0, 1.0);
+        let late = simulate_forced(&m, &s, &settings, ramp).unwrap();
+        let now = simulate_forced(&m, &s, &settings, |_, _| 1.5).unwrap();
+        let shift = late.impacts[0].impact_time - now.impacts[0].impact_time;
+        assert!(shift > 3.0 + 1e-3 / 3.0 && shift < 3.001, "{shift}");
+    }
+
+    #[test]
+    fn a_non_finite_drive_is_an_error() {
+        let s = Surface::Rigid { restitution: 0.5 };
+        let err = simulate_forced(&relay(), &s, &Settings::default(), |_, _| f64::NAN);
+        assert!(
+            matches!(err, Err(CoilError::DriveNotFinite { .. })),
+            "{err:?}"
+        );
+    }
+}

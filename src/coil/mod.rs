@@ -1,0 +1,262 @@
+//! The coil drives the contact: the relay's magnetic pull and its two-way
+//! coupling with the armature (model.md §7, issue 6).
+//!
+//! The step force of [`crate::mechanics`] is really the pull of a coil.
+//! The magnetic circuit is the standard single-air-gap model (as in
+//! Modelica.Magnetic.FluxTubes): the armature at `x` (m, toward the fixed
+//! contact) leaves an air gap `g_a − x` in series with the iron path,
+//! counted as an equivalent air gap `l_eq = l_fe/μr`. With
+//! `k = μ0 N² A` (H·m) and `a = g_a + l_eq`:
+//!
+//! ```text
+//! L(x)  = k / (a − x)            inductance, ψ = L(x) i (flux linkage)
+//! v     = R i + dψ/dt = R i + L(x) di/dt + i L'(x) ẋ
+//! F_m   = ½ i² L'(x) = ψ² / (2k) force toward closing
+//! ```
+//!
+//! The last line is why the solvers here integrate the flux ψ rather than
+//! the current: at constant flux the pull does not depend on the position
+//! (the field in the gap is ψ/(N A) wherever the armature is), so the
+//! coupled equations `ψ̇ = V − R ψ (a − x)/k`,
+//! `m ẍ + r ẋ + s x + p + Fc = ψ²/(2k)` have no singularity, and the
+//! back-EMF `i L'(x) ẋ` — which makes the well-known dip of the current
+//! while the armature pulls in — needs no term of its own.
+//!
+//! - [`direct`]: a coil switched onto an ideal voltage source, solved as
+//!   one ODE in (ψ, x, ẋ) with no circuit simulator: the independent
+//!   cross-check of the coupled ngspice runs, and the reference case of
+//!   model.md §7.
+//! - [`forced`]: the mechanics under a drive force that varies in time and
+//!   position, `F(t, x)`: what the waveform-relaxation coupling with
+//!   ngspice feeds with `F_m(i(t), x)`.
+//!
+//! Both share one event-driven integrator (`sequence`): Dormand–Prince
+//! 5(4) with dense output ([`crate::mechanics::integrate`]), every event
+//! (lift-off, impact, release, landing on the rest stop, turning points,
+//! force extrema) bracketed on one step and polished by bisection on the
+//! step's interpolant.
+
+pub mod direct;
+pub mod forced;
+mod sequence;
+
+pub use direct::{
+    CoilEvents, CoilRun, CoilState, EnergyBalance, PullInDip, Source, simulate_direct,
+};
+pub use forced::simulate_forced;
+
+use thiserror::Error;
+
+use crate::mechanics::MechanicsError;
+use crate::scenario::CoilSection;
+
+/// H/m, the vacuum permeability (CODATA 2018; 4π·10⁻⁷ to 6e-10).
+pub const MU0: f64 = 1.256_637_062_12e-6;
+
+/// The relay coil and its magnetic circuit (model.md §7). SI units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Coil {
+    /// Ω, the coil's DC resistance `R_c`.
+    pub resistance: f64,
+    /// Number of turns `N`.
+    pub turns: f64,
+    /// m², pole face area `A`.
+    pub pole_area: f64,
+    /// m, armature air gap at rest `g_a` (larger than the contact travel,
+    /// so a residual gap remains when the contacts close).
+    pub air_gap: f64,
+    /// m, the iron path as an equivalent air gap `l_eq = l_fe/μr`.
+    pub iron_gap: f64,
+}
+
+impl From<&CoilSection> for Coil {
+    fn from(c: &CoilSection) -> Self {
+        Coil {
+            resistance: c.resistance,
+            turns: f64::from(c.turns),
+            pole_area: c.pole_area,
+            air_gap: c.air_gap,
+            iron_gap: c.iron_gap,
+        }
+    }
+}
+
+impl Coil {
+    /// H·m, `k = μ0 N² A`: the inductance is `k` over the total
+    /// equivalent gap.
+    pub fn permeance_length(&self) -> f64 {
+        MU0 * self.turns * self.turns * self.pole_area
+    }
+
+    /// m, the total equivalent gap `g_a − x + l_eq` with the armature at
+    /// `x`.
+    pub fn total_gap(&self, x: f64) -> f64 {
+        self.air_gap + self.iron_gap - x
+    }
+
+    /// H, `L(x) = μ0 N² A / (g_a − x + l_eq)`.
+    pub fn inductance(&self, x: f64) -> f64 {
+        self.permeance_length() / self.total_gap(x)
+    }
+
+    /// H/m, `L'(x) = μ0 N² A / (g_a − x + l_eq)²`.
+    pub fn d_inductance(&self, x: f64) -> f64 {
+        let gap = self.total_gap(x);
+        self.permeance_length() / (gap * gap)
+    }
+
+    /// N, the pull toward closing at current `i` (A) and position `x` (m):
+    /// `½ i² L'(x)`.
+    pub fn force(&self, i: f64, x: f64) -> f64 {
+        0.5 * i * i * self.d_inductance(x)
+    }
+
+    /// N, the same pull from the flux linkage ψ (Wb): `ψ²/(2 μ0 N² A)`,
+    /// independent of the position.
+    pub fn force_from_flux(&self, flux: f64) -> f64 {
+        0.5 * flux * flux / self.permeance_length()
+    }
+
+    /// A, the current that carries flux linkage `flux` (Wb) at `x` (m).
+    pub fn current(&self, flux: f64, x: f64) -> f64 {
+        flux / self.inductance(x)
+    }
+
+    /// Check every parameter; `gap` is the contact travel `mechanics.gap`
+    /// (m), which the air gap must exceed.
+    pub fn validate(&self, gap: f64) -> Result<(), CoilError> {
+        check(
+            "coil.resistance",
+            self.resistance,
+            self.resistance > 0.0,
+            "must be > 0: the coil's DC resistance, in Ω",
+        )?;
+        check(
+            "coil.turns",
+            self.turns,
+            self.turns >= 1.0,
+            "must be at least 1: the number of turns of the coil",
+        )?;
+        check(
+            "coil.pole_area",
+            self.pole_area,
+            self.pole_area > 0.0,
+            "must be > 0: the pole face area, in m²",
+        )?;
+        check(
+            "coil.air_gap",
+            self.air_gap,
+            self.air_gap > gap,
+            "must exceed `mechanics.gap`: a residual air gap must remain when the contacts close",
+        )?;
+        check(
+            "coil.iron_gap",
+            self.iron_gap,
+            self.iron_gap >= 0.0,
+            "must be ≥ 0: the iron path as an equivalent air gap, in m",
+        )
+    }
+}
+
+/// What the coupled solvers can fail on. Parameter errors name the key to
+/// change; run-time errors carry the time and state.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum CoilError {
+    #[error("`{name}` = {value} is not valid: {requirement}")]
+    InvalidParameter {
+        name: &'static str,
+        value: f64,
+        requirement: &'static str,
+    },
+    #[error(transparent)]
+    Mechanics(#[from] MechanicsError),
+    #[error(
+        "the armature reached the pole face (x = {position} m ≥ `coil.air_gap` = {pole} m) \
+         at t = {time} s: the contact cannot hold the magnetic pull; stiffen \
+         `surface.stiffness`, lower the drive, or end the run earlier with `simulation.t_end`"
+    )]
+    ArmatureAtPole { time: f64, position: f64, pole: f64 },
+    #[error(
+        "the drive force is {value} N at t = {time} s, x = {position} m: \
+         the force function must return a finite force for every time and position"
+    )]
+    DriveNotFinite {
+        time: f64,
+        position: f64,
+        value: f64,
+    },
+}
+
+fn check(
+    name: &'static str,
+    value: f64,
+    ok: bool,
+    requirement: &'static str,
+) -> Result<(), CoilError> {
+    if value.is_finite() && ok {
+        Ok(())
+    } else {
+        Err(CoilError::InvalidParameter {
+            name,
+            value,
+            requirement,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn reference() -> Coil {
+        Coil {
+            resistance: 70.0,
+            turns: 3000.0,
+            pole_area: 2e-5,
+            air_gap: 0.6e-3,
+            iron_gap: 0.05e-3,
+        }
+    }
+
+    #[test]
+    fn inductance_derivative_and_force_agree() {
+        let c = reference();
+        // L(0) = μ0·9e6·2e-5 / 0.65e-3 ≈ 0.348 H: a small relay coil.
+        assert!((c.inductance(0.0) - 0.347_991_8).abs() < 1e-7);
+        for x in [0.0, 1e-4, 4.5e-4] {
+            let h = 1e-9;
+            let fd = (c.inductance(x + h) - c.inductance(x - h)) / (2.0 * h);
+            assert!((fd / c.d_inductance(x) - 1.0).abs() < 1e-7, "{x}");
+            // The pull from the current and from the flux is one force.
+            let i = 0.03;
+            let psi = c.inductance(x) * i;
+            let f = c.force(i, x);
+            assert!((c.force_from_flux(psi) / f - 1.0).abs() < 1e-14);
+            assert!((c.current(psi, x) - i).abs() < 1e-16);
+        }
+    }
+
+    #[test]
+    fn validation_names_the_key() {
+        let bad = Coil {
+            turns: 0.0,
+            ..reference()
+        };
+        match bad.validate(4.5e-4) {
+            Err(CoilError::InvalidParameter { name, .. }) => assert_eq!(name, "coil.turns"),
+            other => panic!("{other:?}"),
+        }
+        let shallow = Coil {
+            air_gap: 4e-4,
+            ..reference()
+        };
+        let err = shallow.validate(4.5e-4).unwrap_err();
+        assert!(err.to_string().contains("coil.air_gap"), "{err}");
+        assert!(reference().validate(4.5e-4).is_ok());
+        let nan = Coil {
+            iron_gap: f64::NAN,
+            ..reference()
+        };
+        assert!(nan.validate(4.5e-4).is_err());
+    }
+}
