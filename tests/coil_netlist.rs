@@ -7,7 +7,8 @@
 
 mod common;
 
-use chatterspice::netlist::coil::{MU0, coil_include};
+use chatterspice::coil::MU0;
+use chatterspice::netlist::coil::coil_include;
 use chatterspice::rawfile::Vector;
 use chatterspice::scenario::CoilSection;
 use chatterspice::spice::{RunRequest, Runner};
@@ -144,7 +145,10 @@ fn decay_time(netlist: &str) -> Option<f64> {
     // Closed, L = 1.13 H: τ = L/R = 16 ms, so after 19.8 ms on the current
     // has reached 1 − e^(−1.24) of V/R.
     let expected = 5.0 / 70.0 * (1.0 - (-19.8e-3 / (1.131 / 70.0f64)).exp());
-    assert!((on / expected - 1.0).abs() < 0.05, "on current {on} vs {expected}");
+    assert!(
+        (on / expected - 1.0).abs() < 0.05,
+        "on current {on} vs {expected}"
+    );
     let k = (0..t.len())
         .find(|&k| t[k] > 20e-3 && i[k] < 0.5 * on)
         .expect("the current decays");

@@ -24,11 +24,9 @@
 use super::NetlistError;
 use super::check_subckt_name;
 use super::contact::{comment, line, pairs};
+use crate::coil::MU0;
 use crate::scenario::CoilSection;
 use crate::waveform::format_time;
-
-/// H/m, the magnetic constant (CODATA 2018).
-pub const MU0: f64 = 1.256_637_062_12e-6;
 
 /// The include for `coil` as subcircuit `subckt`, its armature following
 /// `trajectory`: (time in s, position x in m) with strictly increasing
