@@ -30,6 +30,19 @@ pub fn simulate_forced(
     settings: &Settings,
     force: impl Fn(f64, f64) -> f64,
 ) -> Result<Chatter, CoilError> {
+    simulate_forced_path(mechanics, surface, settings, force).map(|(chatter, _)| chatter)
+}
+
+/// [`simulate_forced`], with the armature's path: (s, m) at every
+/// accepted integration step and event, from t = 0 to where the run
+/// stopped (the sticking decision, or `t_end`), strictly increasing in
+/// time.
+pub fn simulate_forced_path(
+    mechanics: &Mechanics,
+    surface: &Surface,
+    settings: &Settings,
+    force: impl Fn(f64, f64) -> f64,
+) -> Result<(Chatter, Vec<(f64, f64)>), CoilError> {
     mechanics::validate(
         &Mechanics {
             force: 0.0,
@@ -58,7 +71,18 @@ pub fn simulate_forced(
         impulse_scale: scale * (mechanics.mass / mechanics.stiffness).sqrt(),
         time_scale: (mechanics.mass / mechanics.stiffness).sqrt(),
     };
-    Ok(sequence::run(mechanics, surface, settings, &drive, 0.0)?.chatter)
+    let run = sequence::run(mechanics, surface, settings, &drive, 0.0)?;
+    let gap = mechanics.gap;
+    let mut path: Vec<(f64, f64)> = Vec::with_capacity(run.steps.len() + 1);
+    if let Some(first) = run.steps.first() {
+        path.push((first.t0(), gap + first.y0()[0]));
+    }
+    for piece in &run.steps {
+        if path.last().is_none_or(|&(t, _)| piece.t1 > t) {
+            path.push((piece.t1, gap + piece.y1[0]));
+        }
+    }
+    Ok((run.chatter, path))
 }
 
 /// A drive given as a function. Its state `e` is the impulse `∫F dt`:

@@ -36,14 +36,16 @@
 //! force extrema) bracketed on one step and polished by bisection on the
 //! step's interpolant.
 
+pub mod coupled;
 pub mod direct;
 pub mod forced;
 mod sequence;
 
+pub use coupled::{Coupled, CouplingError, CouplingOptions, run_coupled};
 pub use direct::{
     CoilEvents, CoilRun, CoilState, EnergyBalance, PullInDip, Source, simulate_direct,
 };
-pub use forced::simulate_forced;
+pub use forced::{simulate_forced, simulate_forced_path};
 
 use thiserror::Error;
 

@@ -554,6 +554,24 @@ fn replace(fates: &mut [Fate], card: &Card, text: String) {
     }
 }
 
+/// The instance names (lowercased, as ngspice names them in vectors, e.g.
+/// `x2`) of the `X` cards of `netlist_text` that use `subckt`, in order.
+/// Only the netlist itself is read, not its includes.
+pub fn instances_of(netlist_text: &str, subckt: &str) -> Vec<String> {
+    let lines = physical_lines(netlist_text);
+    if lines.is_empty() {
+        return Vec::new();
+    }
+    let mut live = vec![true; lines.len()];
+    live[0] = false;
+    cards(&lines, &live)
+        .iter()
+        .filter(|c| instantiates(&c.text, subckt))
+        .filter_map(|c| c.text.split_whitespace().next())
+        .map(str::to_ascii_lowercase)
+        .collect()
+}
+
 /// Whether an `X` card's subcircuit is `subckt`: the last token that is
 /// not a `name=value` parameter (nor `params:`).
 fn instantiates(card: &str, subckt: &str) -> bool {
@@ -786,6 +804,14 @@ mod tests {
         assert_eq!(&lines[2..4], [".include contact.inc", ".include coil.inc"]);
         assert_eq!(deck.source_line(4), None);
         assert_eq!(deck.source_line(5), Some(2));
+    }
+
+    #[test]
+    fn instances_are_found_by_their_subcircuit() {
+        let text = "title\nX2 a b COIL\nx_relay in\n+ 0 contact\nXother a b COILS\n.end\n";
+        assert_eq!(instances_of(text, "coil"), ["x2"]);
+        assert_eq!(instances_of(text, "CONTACT"), ["x_relay"]);
+        assert!(instances_of(text, "NONE").is_empty());
     }
 
     #[test]

@@ -30,7 +30,7 @@ pub use contact::{
     ContactElement, ContactInclude, DEFAULT_POINTS_PER_SOURCE, EVENT_RAMP_ABOVE_POINTS,
     check_subckt_name, contact_include, contact_include_split,
 };
-pub use deck::{Deck, DeckRequest, DeckWarning, Tran, prepare_deck, save_names};
+pub use deck::{Deck, DeckRequest, DeckWarning, Tran, instances_of, prepare_deck, save_names};
 pub use number::parse_number;
 
 /// Errors of this stage. Netlist problems name the file and the 1-based
