@@ -24,6 +24,8 @@ use thiserror::Error;
 
 use crate::analysis::{self, AnalysisError, Comparison, ProbeAnalysis};
 use crate::chatter::{Chatter, ContactState, Interval};
+use crate::coil::coupled::Iteration;
+use crate::coil::{CouplingError, CouplingOptions, run_coupled};
 use crate::mechanics::{MechanicsError, contact_forces, simulate};
 use crate::netlist::{self, ContactElement, ContactInclude, Deck, DeckRequest, NetlistError};
 use crate::rawfile::Plot;
@@ -103,6 +105,8 @@ pub enum RunError {
     HolmNeedsForce { path: PathBuf },
     #[error(transparent)]
     Netlist(#[from] NetlistError),
+    #[error(transparent)]
+    Coupling(Box<CouplingError>),
     #[error(
         "ngspice failed on the {run} run of {}{}",
         netlist.display(),
@@ -179,15 +183,23 @@ pub struct RunResult {
     pub probes: Vec<ProbeResult>,
     /// Things worth a look that did not stop the run, in order.
     pub warnings: Vec<String>,
+    /// For a coil-driven relay: the passes of the coupling, the last one
+    /// converged.
+    pub coupling: Option<Vec<Iteration>>,
 }
 
-/// Run the whole pipeline on `scenario` with `runner`.
+/// Run the whole pipeline on `scenario` with `runner`. A scenario with a
+/// `[coil]` runs the coil in the circuit, coupled to the mechanics
+/// ([`run_coupled`]); there is no ideal-contact run then.
 pub fn run(
     scenario: &Scenario,
     runner: &dyn Runner,
     options: &RunOptions,
 ) -> Result<RunResult, RunError> {
     check_circuit(scenario)?;
+    if scenario.coil.is_some() {
+        return run_coil(scenario, runner, options);
+    }
     let mechanics = scenario.mechanics()?;
     let chatter =
         simulate(&mechanics, &scenario.surface(), &scenario.settings()).map_err(|source| {
@@ -357,6 +369,7 @@ fn run_chatter(
     let mut warnings: Vec<String> = deck.warnings.iter().map(ToString::to_string).collect();
     warnings.extend(simulation.warnings.iter().cloned());
     Ok(RunResult {
+        coupling: None,
         netlist: netlist_path,
         chatter,
         waveform,
@@ -366,6 +379,81 @@ fn run_chatter(
         ideal,
         probes,
         warnings,
+    })
+}
+
+/// `run` for a coil-driven relay: the coupled run, then the probes of its
+/// last circuit run.
+fn run_coil(
+    scenario: &Scenario,
+    runner: &dyn Runner,
+    options: &RunOptions,
+) -> Result<RunResult, RunError> {
+    let coupled = run_coupled(
+        scenario,
+        runner,
+        &CouplingOptions {
+            timeout: options.timeout,
+            ..CouplingOptions::default()
+        },
+    )
+    .map_err(|e| RunError::Coupling(Box::new(e)))?;
+    let circuit = scenario
+        .circuit
+        .as_ref()
+        .expect("check_circuit found a [circuit]");
+    let model = ContactModel::from(&scenario.contact);
+    let waveform =
+        Waveform::from_chatter(&coupled.chatter, &model).map_err(|source| RunError::Waveform {
+            path: scenario.origin.clone(),
+            source,
+        })?;
+    let element = options
+        .element
+        .unwrap_or_else(|| ContactElement::for_waveform(&waveform));
+    let include = netlist::contact_include(&waveform, &circuit.subckt, element)?;
+    let closures = analysis::closures(&coupled.chatter);
+    let mut probes = Vec::with_capacity(scenario.probes.len());
+    for probe in &scenario.probes {
+        let analysis =
+            analysis::analyze(&coupled.plot, probe, &closures).map_err(|e| RunError::Probe {
+                origin: scenario.origin.clone(),
+                signal: probe.signal.clone(),
+                run: "coupled",
+                source: Box::new(e),
+            })?;
+        probes.push(ProbeResult {
+            probe: probe.clone(),
+            analysis,
+            ideal: None,
+            comparison: None,
+        });
+    }
+    let elapsed: f64 = coupled.iterations.iter().map(|i| i.ngspice_elapsed).sum();
+    let netlist_path = circuit.netlist.clone();
+    let warnings = coupled
+        .deck
+        .warnings
+        .iter()
+        .map(ToString::to_string)
+        .collect();
+    Ok(RunResult {
+        netlist: netlist_path,
+        chatter: coupled.chatter,
+        waveform,
+        include,
+        deck: coupled.deck,
+        simulation: Simulation {
+            plot: coupled.plot,
+            version: coupled.version,
+            elapsed: Duration::from_secs_f64(elapsed),
+            warnings: Vec::new(),
+            workdir: None,
+        },
+        ideal: None,
+        probes,
+        warnings,
+        coupling: Some(coupled.iterations),
     })
 }
 

@@ -351,3 +351,28 @@ fn run_takes_a_measured_chatter_sequence() {
     let first = v["probes"][0]["first_edge"].as_f64().unwrap();
     assert!((1e-3..1e-3 + 2e-8).contains(&first), "{first}");
 }
+
+#[test]
+fn run_couples_a_coil_driven_relay_in_its_transistor_driver() {
+    let _ng = ngspice_or_skip!();
+    let scenario =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenarios/relay-driver.toml");
+    let v: Value = serde_json::from_str(&stdout_of(&[
+        "run",
+        scenario.to_str().unwrap(),
+        "--format",
+        "json",
+    ]))
+    .unwrap();
+    let bounces = v["bounce"]["bounce_count"].as_u64().unwrap();
+    assert!(bounces >= 1);
+    // The contact pulls a bare pull-up: every bounce is an edge pair.
+    assert_eq!(v["probes"][0]["edges"].as_u64().unwrap(), 1 + 2 * bounces);
+    let passes = v["coupling"].as_array().unwrap();
+    assert!(passes.len() >= 2);
+    assert!(passes.last().unwrap()["change"].as_f64().unwrap() <= 1e-7);
+    // The coil current is integrated over the closures the coupling found.
+    let make = v["bounce"]["first_impact"].as_f64().unwrap();
+    let first_closure = &v["probes"][1]["current"]["per_closure"][0];
+    assert_eq!(first_closure["start"].as_f64().unwrap(), make);
+}

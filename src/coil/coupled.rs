@@ -65,7 +65,7 @@ impl Default for CouplingOptions {
 }
 
 /// One pass of the loop.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Iteration {
     pub first_impact: Option<f64>,
     pub bounces: usize,
@@ -90,6 +90,8 @@ pub struct Coupled {
     pub coil_instance: String,
     pub iterations: Vec<Iteration>,
     pub deck: Deck,
+    /// ngspice's version, e.g. `"39"`.
+    pub version: Option<String>,
 }
 
 impl Coupled {
@@ -308,6 +310,7 @@ pub fn run_coupled(
                 coil_instance: coil_instance.clone(),
                 iterations,
                 deck,
+                version: output.version,
             });
         }
     }

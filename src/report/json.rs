@@ -12,6 +12,7 @@ use serde::Serialize;
 use crate::analysis::{Comparison, ProbeAnalysis};
 use crate::chatter::Chatter;
 use crate::check::{Evidence, Verdict};
+use crate::coil::coupled::Iteration;
 use crate::mechanics::Dimensionless;
 use crate::pipeline::{RunResult, Simulation};
 
@@ -85,6 +86,9 @@ pub struct RunJson<'a> {
     contact: ContactJson<'a>,
     netlist: String,
     warnings: &'a [String],
+    /// The coupling's passes, for a coil-driven relay.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    coupling: Option<&'a [Iteration]>,
 }
 
 /// One probe: the contract's fields (flattened from the analysis), then
@@ -153,6 +157,7 @@ impl<'a> RunJson<'a> {
             },
             netlist: run.netlist.display().to_string(),
             warnings: &run.warnings,
+            coupling: run.coupling.as_deref(),
         }
     }
 }

@@ -125,7 +125,19 @@ pub fn render_run(run: &RunResult) -> String {
     if w.widened_closures() > 0 {
         let _ = write!(contact, ", {} touches widened", w.widened_closures());
     }
-    for (label, value) in [("relay", relay), ("contact", contact), ("circuit", circuit)] {
+    let mut lines = vec![("relay", relay), ("contact", contact), ("circuit", circuit)];
+    if let Some(passes) = &run.coupling {
+        let last = passes.last().map_or(f64::NAN, |p| p.change);
+        lines.push((
+            "coil",
+            format!(
+                "coupled to the circuit in {} iterations, last change {}",
+                passes.len(),
+                engineering(last, "s")
+            ),
+        ));
+    }
+    for (label, value) in lines {
         let _ = writeln!(out, "{label:<8} {value}");
     }
 
