@@ -461,7 +461,8 @@ pub enum ScenarioError {
         takes: &'static str,
     },
     #[error(
-        "{}: the coil drive ([coil], model.md §7) is not simulated yet; \
+        "{}: a coil-driven relay ([coil], model.md §7) is simulated only with its driver \
+         circuit, by `run` (the coil coupled to the netlist); for the mechanics alone \
          replace [coil] with `mechanics.force`, the closing force in N",
         path.display()
     )]
