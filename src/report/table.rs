@@ -202,8 +202,9 @@ pub fn render_run(run: &RunResult) -> String {
             None => {
                 let _ = writeln!(
                     out,
-                    "{} edges; range {} to {}",
+                    "{} edge{}; range {} to {}",
                     a.edges,
+                    if a.edges == 1 { "" } else { "s" },
                     engineering(a.min, unit),
                     engineering(a.max, unit)
                 );
