@@ -1,10 +1,10 @@
 //! The main job, `chatterspice run`: every stage of the pipeline in order.
 //!
-//! scenario → [`simulate`](crate::mechanics::simulate) (the chatter) →
-//! [`Waveform`] (the contact conductance) → [`netlist`](crate::netlist)
+//! scenario → [`simulate`] (the chatter) →
+//! [`Waveform`] (the contact conductance) → [`netlist`]
 //! (the contact include and the user's netlist with the `.include` added)
 //! → a [`Runner`] (ngspice in batch mode) → the raw file →
-//! [`analysis`](crate::analysis) of every `[[probe]]`.
+//! [`analysis`] of every `[[probe]]`.
 //!
 //! The same circuit is run a second time with an **ideal contact**: a
 //! single clean make at the first impact. The difference between the two

@@ -3,7 +3,7 @@
 //!
 //! Each iteration runs the whole circuit in ngspice with the coil's
 //! inductance following the armature path of the previous iteration
-//! ([`coil_include`](crate::netlist::coil::coil_include)) and the contact
+//! ([`coil_include`]) and the contact
 //! following its chatter, reads the coil's flux linkage ψ(t) back, and
 //! runs the mechanics under the magnetic pull it makes,
 //! F_m = ψ²/(2 μ0 N² A) ([`Coil::force_from_flux`]), which depends on the
