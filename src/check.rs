@@ -347,7 +347,8 @@ impl Evidence {
 }
 
 /// Check `scenario`: the mechanics alone when only `[limits]` are set,
-/// the whole `run` through `runner` when a probe has a limit.
+/// the whole `run` through `runner` when a probe has a limit or the relay
+/// is coil-driven.
 pub fn run(scenario: &Scenario, runner: &dyn Runner) -> Result<Verdict, CheckError> {
     run_with(scenario, runner, &RunOptions::default()).map(|(verdict, _)| verdict)
 }
@@ -364,7 +365,8 @@ pub fn run_with(
             path: scenario.origin.clone(),
         });
     }
-    if probe_limits {
+    // A coil-driven relay moves only in its driver circuit.
+    if probe_limits || scenario.coil.is_some() {
         let result = pipeline::run(scenario, runner, options).map_err(Box::new)?;
         return Ok((evaluate(scenario, &result), Evidence::Run(Box::new(result))));
     }

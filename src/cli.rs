@@ -337,7 +337,7 @@ fn run(args: &RunArgs) -> Result<()> {
 
 fn check(args: &CheckArgs) -> Result<Status> {
     let scenario = load_scenario(args.scenario.as_deref())?;
-    let needs_ngspice = scenario.probes.iter().any(|p| p.has_limits());
+    let needs_ngspice = scenario.coil.is_some() || scenario.probes.iter().any(|p| p.has_limits());
     let options = RunOptions {
         timeout: Duration::from_secs_f64(args.timeout),
         element: args.element,

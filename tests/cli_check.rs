@@ -177,3 +177,19 @@ fn the_library_check_is_usable_from_a_user_s_own_tests() {
         "{verdict}"
     );
 }
+
+#[test]
+fn a_coil_driven_relay_is_checked_through_its_driver() {
+    let _ng = ngspice_or_skip!();
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenarios/relay-driver.toml");
+    let v = check_json(&path, 0);
+    let make = v["bounce"]["first_impact"].as_f64().unwrap();
+    let margin = check_of(&v, "limits.max_first_make")["margin"]
+        .as_f64()
+        .unwrap();
+    assert!((margin - (5e-3 - make)).abs() < 1e-15, "{margin} vs {make}");
+    // The coil's pull, not a step: the first make comes after the coil
+    // current has built up, milliseconds in.
+    assert!(make > 1e-3, "{make}");
+    assert!(v["run"]["coupling"].as_array().unwrap().len() >= 2);
+}
