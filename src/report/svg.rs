@@ -700,7 +700,7 @@ fn num(x: f64) -> String {
 }
 
 /// Text for XML content and attribute values.
-fn escape(text: &str) -> String {
+pub(crate) fn escape(text: &str) -> String {
     let mut s = String::with_capacity(text.len());
     for c in text.chars() {
         match c {

@@ -15,6 +15,7 @@ use std::fmt::Write as _;
 use super::SweepError;
 use super::sample::Sampler;
 use super::summary::Collected;
+use crate::report::svg::escape;
 
 const WIDTH: f64 = 760.0;
 const LEFT: f64 = 80.0;
@@ -351,11 +352,4 @@ fn label(value: f64, ticks: &[f64]) -> String {
     } else {
         text
     }
-}
-
-fn escape(text: &str) -> String {
-    text.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
 }

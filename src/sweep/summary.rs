@@ -16,6 +16,7 @@ use std::fmt::Write as _;
 use serde::Serialize;
 
 use crate::chatter::Outcome;
+use crate::report::units::prefix;
 
 use super::sample::Sampler;
 use super::verdict::Verdict;
@@ -412,8 +413,9 @@ impl Summary {
     }
 }
 
-/// `value` with three significant digits and an SI prefix; integers
-/// (counts, no unit) as they are.
+/// `value` with three significant digits (trailing zeros kept, so that
+/// table columns line up) and an SI prefix; integers (counts, no unit) as
+/// they are.
 fn eng(value: f64, unit: &str) -> String {
     if unit.is_empty() {
         return if value.fract() == 0.0 && value.abs() < 1e15 {
@@ -426,16 +428,7 @@ fn eng(value: f64, unit: &str) -> String {
         return format!("0 {unit}");
     }
     let exponent = (3.0 * (value.abs().log10() / 3.0).floor()).clamp(-12.0, 9.0) as i32;
-    let prefix = match exponent {
-        -12 => "p",
-        -9 => "n",
-        -6 => "µ",
-        -3 => "m",
-        3 => "k",
-        6 => "M",
-        9 => "G",
-        _ => "",
-    };
+    let prefix = prefix(exponent);
     let scaled = value / 10f64.powi(exponent);
     let decimals = if scaled.abs() >= 100.0 {
         0
