@@ -22,15 +22,8 @@ fn reference() -> Scenario {
 fn the_coupled_run_agrees_with_the_direct_solver() {
     let ng = ngspice_or_skip!();
     let scenario = reference();
-    let coupled = run_coupled(&scenario, &ng, &CouplingOptions::default()).unwrap_or_else(|e| {
-        let mut msg = e.to_string();
-        let mut source = std::error::Error::source(&e);
-        while let Some(s) = source {
-            msg.push_str(&format!("\n  caused by: {s}"));
-            source = s.source();
-        }
-        panic!("{msg}")
-    });
+    let coupled = run_coupled(&scenario, &ng, &CouplingOptions::default())
+        .unwrap_or_else(|e| panic!("{}", common::chain(&e)));
 
     let m = &scenario.mechanics;
     let mechanics = Mechanics {

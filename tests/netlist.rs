@@ -7,6 +7,8 @@
 //! Tests that need ngspice skip with a note when it is missing, and fail
 //! when `REQUIRE_NGSPICE=1` (CI sets it).
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use chatterspice::chatter::{ContactState, Interval};
@@ -17,33 +19,6 @@ use chatterspice::netlist::{
 use chatterspice::rawfile::Plot;
 use chatterspice::spice::{Ngspice, RunRequest, Runner};
 use chatterspice::waveform::{ContactModel, Waveform};
-
-fn ngspice() -> Option<Ngspice> {
-    match Ngspice::find() {
-        Ok(n) => Some(n),
-        Err(e) if std::env::var("REQUIRE_NGSPICE").as_deref() == Ok("1") => {
-            panic!("REQUIRE_NGSPICE=1 but ngspice is unusable: {e}")
-        }
-        Err(e) => {
-            // The stderr handle, not eprintln!, which the harness captures.
-            use std::io::Write;
-            let _ = writeln!(
-                std::io::stderr(),
-                "note: skipping a test that needs ngspice (set REQUIRE_NGSPICE=1 to fail instead): {e}"
-            );
-            None
-        }
-    }
-}
-
-macro_rules! ngspice_or_skip {
-    () => {
-        match ngspice() {
-            Some(n) => n,
-            None => return,
-        }
-    };
-}
 
 fn data(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -32,15 +32,8 @@ fn default_relay_on(netlist: &Path, probes: &str) -> Scenario {
 }
 
 fn run(ng: &Ngspice, scenario: &Scenario) -> RunResult {
-    pipeline::run(scenario, ng, &RunOptions::default()).unwrap_or_else(|e| {
-        let mut msg = e.to_string();
-        let mut source = std::error::Error::source(&e);
-        while let Some(s) = source {
-            msg.push_str(&format!("\n  caused by: {s}"));
-            source = s.source();
-        }
-        panic!("{msg}")
-    })
+    pipeline::run(scenario, ng, &RunOptions::default())
+        .unwrap_or_else(|e| panic!("{}", common::chain(&e)))
 }
 
 /// Durations of the openings between the first impact and settling, s.

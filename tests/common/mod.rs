@@ -25,6 +25,17 @@ pub fn ngspice() -> Option<Ngspice> {
     }
 }
 
+/// An error and its causes, one per line: what a failed test should show.
+pub fn chain(e: &dyn std::error::Error) -> String {
+    let mut msg = e.to_string();
+    let mut source = e.source();
+    while let Some(s) = source {
+        msg.push_str(&format!("\n  caused by: {s}"));
+        source = s.source();
+    }
+    msg
+}
+
 /// `let ng = ngspice_or_skip!();` at the top of a test.
 #[macro_export]
 macro_rules! ngspice_or_skip {
