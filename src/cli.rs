@@ -122,15 +122,8 @@ pub struct RunArgs {
     #[arg(long, requires = "out")]
     pub force: bool,
 
-    /// Wall-clock limit of each ngspice run, in seconds.
-    #[arg(long, value_name = "S", default_value_t = 60.0, value_parser = parse_timeout)]
-    pub timeout: f64,
-
-    /// How the contact is emitted: pwl, event-ramp or switch [default:
-    /// pwl, or event-ramp for sequences of more than 2000 points]. See the
-    /// README's comparison.
-    #[arg(long, value_name = "ELEMENT", value_parser = parse_element)]
-    pub element: Option<ContactElement>,
+    #[command(flatten)]
+    pub simulator: SimulatorArgs,
 
     /// Skip the second run with an ideal contact (no comparison).
     #[arg(long)]
@@ -144,6 +137,21 @@ pub struct RunArgs {
     /// Keep ngspice's work directories and print where they are.
     #[arg(long)]
     pub keep_workdir: bool,
+}
+
+/// How ngspice is run: the options `run`, `check` and `sweep` share.
+#[derive(Debug, Args)]
+pub struct SimulatorArgs {
+    /// Wall-clock limit of each ngspice run, in seconds (a sweep records a
+    /// sample that reaches it as an error).
+    #[arg(long, value_name = "S", default_value_t = 60.0, value_parser = parse_timeout)]
+    pub timeout: f64,
+
+    /// How the contact is emitted: pwl, event-ramp or switch [default:
+    /// pwl, or event-ramp for sequences of more than 2000 points]. See the
+    /// README's comparison.
+    #[arg(long, value_name = "ELEMENT", value_parser = parse_element)]
+    pub element: Option<ContactElement>,
 
     /// The ngspice program [default: $CHATTERSPICE_NGSPICE, else ngspice
     /// on PATH].
@@ -162,18 +170,8 @@ pub struct CheckArgs {
     #[arg(long, value_enum, default_value_t = RunFormat::Table)]
     pub format: RunFormat,
 
-    /// Wall-clock limit of each ngspice run, in seconds.
-    #[arg(long, value_name = "S", default_value_t = 60.0, value_parser = parse_timeout)]
-    pub timeout: f64,
-
-    /// How the contact is emitted (see `run`).
-    #[arg(long, value_name = "ELEMENT", value_parser = parse_element)]
-    pub element: Option<ContactElement>,
-
-    /// The ngspice program [default: $CHATTERSPICE_NGSPICE, else ngspice
-    /// on PATH].
-    #[arg(long, value_name = "PROGRAM")]
-    pub ngspice: Option<PathBuf>,
+    #[command(flatten)]
+    pub simulator: SimulatorArgs,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -286,11 +284,11 @@ fn run(args: &RunArgs) -> Result<()> {
         refuse_existing_bundle(dir, args.force)?;
     }
     let scenario = load_scenario(args.scenario.as_deref())?;
-    let ngspice = Ngspice::locate(args.ngspice.as_deref())?;
+    let ngspice = Ngspice::locate(args.simulator.ngspice.as_deref())?;
     let options = RunOptions {
-        timeout: Duration::from_secs_f64(args.timeout),
+        timeout: Duration::from_secs_f64(args.simulator.timeout),
         keep_workdir: args.keep_workdir,
-        element: args.element,
+        element: args.simulator.element,
         compare_ideal: !args.no_ideal,
     };
     let mut result = match &args.measured {
@@ -339,12 +337,12 @@ fn check(args: &CheckArgs) -> Result<Status> {
     let scenario = load_scenario(args.scenario.as_deref())?;
     let needs_ngspice = scenario.coil.is_some() || scenario.probes.iter().any(|p| p.has_limits());
     let options = RunOptions {
-        timeout: Duration::from_secs_f64(args.timeout),
-        element: args.element,
+        timeout: Duration::from_secs_f64(args.simulator.timeout),
+        element: args.simulator.element,
         ..RunOptions::default()
     };
     let (verdict, evidence) = if needs_ngspice {
-        let ngspice = Ngspice::locate(args.ngspice.as_deref())?;
+        let ngspice = Ngspice::locate(args.simulator.ngspice.as_deref())?;
         check::run_with(&scenario, &ngspice, &options)?
     } else {
         // The relay's limits alone: no circuit, no ngspice needed.
@@ -551,20 +549,8 @@ pub struct SweepArgs {
     #[arg(long)]
     pub force: bool,
 
-    /// Wall-clock limit of each ngspice run, in seconds; a sample that
-    /// reaches it is recorded as an error.
-    #[arg(long, value_name = "S", default_value_t = 60.0, value_parser = parse_timeout)]
-    pub timeout: f64,
-
-    /// How the contact is emitted: pwl, event-ramp or switch [default:
-    /// pwl, or event-ramp for sequences of more than 2000 points].
-    #[arg(long, value_name = "ELEMENT", value_parser = parse_element)]
-    pub element: Option<ContactElement>,
-
-    /// The ngspice program [default: $CHATTERSPICE_NGSPICE, else ngspice
-    /// on PATH].
-    #[arg(long, value_name = "PROGRAM")]
-    pub ngspice: Option<PathBuf>,
+    #[command(flatten)]
+    pub simulator: SimulatorArgs,
 }
 
 #[derive(Debug, Args)]
@@ -640,7 +626,7 @@ fn sweep(args: &SweepArgs) -> Result<Status> {
     let ngspice = if args.mechanics_only {
         None
     } else {
-        Some(Ngspice::locate(args.ngspice.as_deref())?)
+        Some(Ngspice::locate(args.simulator.ngspice.as_deref())?)
     };
     let mut options = SweepOptions::new(match &ngspice {
         Some(n) => Mode::Circuit(n),
@@ -650,8 +636,8 @@ fn sweep(args: &SweepArgs) -> Result<Status> {
         options.jobs = jobs;
     }
     options.shard = args.shard.unwrap_or(Shard::WHOLE);
-    options.run.timeout = Duration::from_secs_f64(args.timeout);
-    options.run.element = args.element;
+    options.run.timeout = Duration::from_secs_f64(args.simulator.timeout);
+    options.run.element = args.simulator.element;
 
     std::fs::create_dir_all(&dir)
         .with_context(|| format!("{}: cannot create the output directory", dir.display()))?;
