@@ -473,16 +473,7 @@ impl Law {
                 stiffness,
                 exponent,
                 chi,
-            } => Law::HuntCrossley(HcContact {
-                mass: m.mass,
-                damping: m.damping,
-                stiffness: m.stiffness,
-                force: f_net,
-                gap: g,
-                surface_stiffness: stiffness,
-                exponent,
-                chi,
-            }),
+            } => Law::HuntCrossley(HcContact::new(m, stiffness, exponent, chi)),
         }
     }
 

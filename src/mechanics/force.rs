@@ -99,16 +99,7 @@ fn replay(
             exponent,
             chi,
         } => {
-            let hc = HcContact {
-                mass: m.mass,
-                damping: m.damping,
-                stiffness: m.stiffness,
-                force: f_net,
-                gap: g,
-                surface_stiffness: stiffness,
-                exponent,
-                chi,
-            };
+            let hc = HcContact::new(m, stiffness, exponent, chi);
             hunt_crossley_forces(&hc, v_hit, local)
         }
     }

@@ -37,7 +37,7 @@
 
 use nalgebra::Vector3;
 
-use super::MechanicsError;
+use super::{Mechanics, MechanicsError};
 use super::dop853::{Dense, Dop853, Dop853Step};
 use super::integrate::Tolerance;
 use super::root;
@@ -86,6 +86,21 @@ pub struct HcOutcome {
 type State = Vector3<f64>;
 
 impl HcContact {
+    /// The contact of relay `m` (its drive net of preload) on a
+    /// Hunt–Crossley surface of stiffness k (N/mⁿ), exponent n and χ (s/m).
+    pub fn new(m: &Mechanics, stiffness: f64, exponent: f64, chi: f64) -> HcContact {
+        HcContact {
+            mass: m.mass,
+            damping: m.damping,
+            stiffness: m.stiffness,
+            force: m.force - m.preload,
+            gap: m.gap,
+            surface_stiffness: stiffness,
+            exponent,
+            chi,
+        }
+    }
+
     /// Contact force at penetration δ and rate δ̇.
     pub fn force_at(&self, delta: f64, delta_dot: f64) -> f64 {
         if delta <= 0.0 {
