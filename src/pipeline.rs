@@ -331,40 +331,12 @@ fn run_chatter(
         .map(|result| simulation_of("ideal", result, &netlist_path, &deck))
         .transpose()?;
 
-    let closures = analysis::closures(&chatter);
-    // The ideal contact's one closure: from the first impact on.
-    let ideal_closures: Vec<(f64, f64)> = chatter
-        .first_impact
-        .map(|t| (t, chatter.t_end.max(t)))
-        .into_iter()
-        .collect();
-    let mut probes = Vec::with_capacity(scenario.probes.len());
-    for probe in &scenario.probes {
-        let probe_error = |run, source| RunError::Probe {
-            origin: origin.clone(),
-            signal: probe.signal.clone(),
-            run,
-            source: Box::new(source),
-        };
-        let analysis = analysis::analyze(&simulation.plot, probe, &closures)
-            .map_err(|e| probe_error("bounced", e))?;
-        let ideal_analysis = ideal
-            .as_ref()
-            .map(|sim| analysis::analyze(&sim.plot, probe, &ideal_closures))
-            .transpose()
-            .map_err(|e| probe_error("ideal", e))?;
-        let comparison = ideal_analysis
-            .as_ref()
-            .map(|ideal| analysis::compare(&analysis, ideal))
-            .transpose()
-            .map_err(|e| probe_error("ideal", e))?;
-        probes.push(ProbeResult {
-            probe: probe.clone(),
-            analysis,
-            ideal: ideal_analysis,
-            comparison,
-        });
-    }
+    let probes = probe_results(
+        scenario,
+        &chatter,
+        ("bounced", &simulation.plot),
+        ideal.as_ref().map(|sim| &sim.plot),
+    )?;
 
     let mut warnings: Vec<String> = deck.warnings.iter().map(ToString::to_string).collect();
     warnings.extend(simulation.warnings.iter().cloned());
@@ -380,6 +352,51 @@ fn run_chatter(
         probes,
         warnings,
     })
+}
+
+/// Every probe of `scenario` analysed in `plot` (named `run` in errors)
+/// and, with an ideal-contact run, in its plot too and compared. Currents
+/// are integrated over the chatter's closures, and over the ideal
+/// contact's one closure (from the first impact on) in its run.
+fn probe_results(
+    scenario: &Scenario,
+    chatter: &Chatter,
+    (run, plot): (&'static str, &Plot),
+    ideal_plot: Option<&Plot>,
+) -> Result<Vec<ProbeResult>, RunError> {
+    let closures = analysis::closures(chatter);
+    let ideal_closures: Vec<(f64, f64)> = chatter
+        .first_impact
+        .map(|t| (t, chatter.t_end.max(t)))
+        .into_iter()
+        .collect();
+    let mut probes = Vec::with_capacity(scenario.probes.len());
+    for probe in &scenario.probes {
+        let probe_error = |run, source| RunError::Probe {
+            origin: scenario.origin.clone(),
+            signal: probe.signal.clone(),
+            run,
+            source: Box::new(source),
+        };
+        let analysis =
+            analysis::analyze(plot, probe, &closures).map_err(|e| probe_error(run, e))?;
+        let ideal = ideal_plot
+            .map(|p| analysis::analyze(p, probe, &ideal_closures))
+            .transpose()
+            .map_err(|e| probe_error("ideal", e))?;
+        let comparison = ideal
+            .as_ref()
+            .map(|ideal| analysis::compare(&analysis, ideal))
+            .transpose()
+            .map_err(|e| probe_error("ideal", e))?;
+        probes.push(ProbeResult {
+            probe: probe.clone(),
+            analysis,
+            ideal,
+            comparison,
+        });
+    }
+    Ok(probes)
 }
 
 /// `run` for a coil-driven relay: the coupled run, then the probes of its
@@ -412,23 +429,7 @@ fn run_coil(
         .element
         .unwrap_or_else(|| ContactElement::for_waveform(&waveform));
     let include = netlist::contact_include(&waveform, &circuit.subckt, element)?;
-    let closures = analysis::closures(&coupled.chatter);
-    let mut probes = Vec::with_capacity(scenario.probes.len());
-    for probe in &scenario.probes {
-        let analysis =
-            analysis::analyze(&coupled.plot, probe, &closures).map_err(|e| RunError::Probe {
-                origin: scenario.origin.clone(),
-                signal: probe.signal.clone(),
-                run: "coupled",
-                source: Box::new(e),
-            })?;
-        probes.push(ProbeResult {
-            probe: probe.clone(),
-            analysis,
-            ideal: None,
-            comparison: None,
-        });
-    }
+    let probes = probe_results(scenario, &coupled.chatter, ("coupled", &coupled.plot), None)?;
     let elapsed: f64 = coupled.iterations.iter().map(|i| i.ngspice_elapsed).sum();
     let netlist_path = circuit.netlist.clone();
     let warnings = coupled

@@ -37,10 +37,10 @@
 
 use nalgebra::Vector3;
 
-use super::{Mechanics, MechanicsError};
 use super::dop853::{Dense, Dop853, Dop853Step};
 use super::integrate::Tolerance;
 use super::root;
+use super::{Mechanics, MechanicsError};
 
 /// Everything the contact integration needs (SI units).
 #[derive(Debug, Clone, Copy, PartialEq)]
