@@ -577,10 +577,7 @@ fn simulation_of(
             .join(", ")
     };
     let plot = raw
-        .plots
-        .iter()
-        .rev()
-        .find(|p| p.name.to_ascii_lowercase().starts_with("transient"))
+        .last_transient()
         .cloned()
         .ok_or_else(|| RunError::NoTransient {
             run,

@@ -271,17 +271,15 @@ pub fn run_coupled(
                 source: Box::new(source),
             })?;
         let ngspice_elapsed = started.elapsed().as_secs_f64();
-        let plot = output
-            .raw
-            .plots
-            .iter()
-            .rev()
-            .find(|p| p.name.to_ascii_lowercase().starts_with("transient"))
-            .cloned()
-            .ok_or_else(|| CouplingError::MissingVector {
-                iteration,
-                vector: psi.clone(),
-            })?;
+        let plot =
+            output
+                .raw
+                .last_transient()
+                .cloned()
+                .ok_or_else(|| CouplingError::MissingVector {
+                    iteration,
+                    vector: psi.clone(),
+                })?;
         let flux = series(&plot, &psi).ok_or_else(|| CouplingError::MissingVector {
             iteration,
             vector: psi.clone(),

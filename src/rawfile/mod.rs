@@ -297,6 +297,15 @@ impl RawFile {
         Ok(RawFile { plots, warnings })
     }
 
+    /// The last transient-analysis plot (ngspice names it "Transient
+    /// Analysis"; a deck with `.op` first has the operating point before it).
+    pub fn last_transient(&self) -> Option<&Plot> {
+        self.plots
+            .iter()
+            .rev()
+            .find(|p| p.name.to_ascii_lowercase().starts_with("transient"))
+    }
+
     /// The first plot whose name is `name`, ignoring case
     /// (e.g. `"transient analysis"`).
     pub fn plot_named(&self, name: &str) -> Option<&Plot> {
