@@ -115,7 +115,6 @@ fn the_iterations_are_reported_and_shrink() {
     let ng = ngspice_or_skip!();
     let coupled = run_coupled(&reference(), &ng, &CouplingOptions::default()).unwrap();
     let changes: Vec<f64> = coupled.iterations.iter().map(|i| i.change).collect();
-    eprintln!("iterations: {:?}", coupled.iterations);
     assert!(changes.len() >= 2);
     // Once the events are the same in number, each pass moves them less.
     let finite: Vec<f64> = changes.iter().copied().filter(|c| c.is_finite()).collect();
