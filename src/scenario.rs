@@ -336,6 +336,7 @@ struct Document {
     mechanics: MechanicsSection,
     coil: Option<CoilSection>,
     surface: SurfaceSection,
+    back_stop: Option<SurfaceSection>,
     #[serde(default)]
     contact: ContactSection,
     #[serde(default)]
@@ -355,6 +356,10 @@ pub struct Scenario {
     pub mechanics: MechanicsSection,
     pub coil: Option<CoilSection>,
     pub surface: SurfaceSection,
+    /// `[back_stop]`: the rest stop's own surface law, where the armature
+    /// lands on release (the normally-closed contact). Only with `[coil]`:
+    /// a step force never releases.
+    pub back_stop: Option<SurfaceSection>,
     pub contact: ContactSection,
     pub simulation: SimulationSection,
     pub circuit: Option<CircuitSection>,
@@ -367,6 +372,8 @@ pub struct Scenario {
     /// Computed once during validation: converting a Hunt–Crossley
     /// restitution into χ is a root solve that can fail.
     resolved_surface: Surface,
+    /// `[back_stop]`'s law, resolved as `resolved_surface`.
+    resolved_back_stop: Option<Surface>,
     /// The built-in scenario carries its netlist's text, used when the
     /// file is not on disk (an installed binary).
     embedded_netlist: Option<&'static str>,
@@ -552,7 +559,7 @@ impl Scenario {
             origin,
             index: &index,
         };
-        let resolved_surface = check.all(&document)?;
+        let (resolved_surface, resolved_back_stop) = check.all(&document)?;
 
         let base = origin.parent().unwrap_or(Path::new(""));
         let circuit = document.circuit.map(|c| CircuitSection {
@@ -564,6 +571,7 @@ impl Scenario {
             mechanics: document.mechanics,
             coil: document.coil,
             surface: document.surface,
+            back_stop: document.back_stop,
             contact: document.contact,
             simulation: document.simulation,
             circuit,
@@ -571,6 +579,7 @@ impl Scenario {
             limits: document.limits,
             sweep: document.sweep,
             resolved_surface,
+            resolved_back_stop,
             embedded_netlist: None,
         }
         .with_checked_sweep(&check)
@@ -631,6 +640,12 @@ impl Scenario {
     /// to χ.
     pub fn surface(&self) -> Surface {
         self.resolved_surface
+    }
+
+    /// The back stop's law (`[back_stop]`), resolved like
+    /// [`Scenario::surface`]; `None`: the armature lands inelastically.
+    pub fn back_stop(&self) -> Option<Surface> {
+        self.resolved_back_stop
     }
 
     /// The engine settings from `[simulation]`.
@@ -908,11 +923,13 @@ impl Check<'_> {
         Ok(())
     }
 
-    /// Everything; returns the resolved surface law.
-    fn all(&self, d: &Document) -> Result<Surface, ScenarioError> {
+    /// Everything; returns the resolved surface laws of the contact and
+    /// of the back stop.
+    fn all(&self, d: &Document) -> Result<(Surface, Option<Surface>), ScenarioError> {
         self.mechanics(&d.mechanics)?;
         self.drive(&d.mechanics, d.coil.as_ref())?;
-        let surface = self.surface(&d.surface)?;
+        let surface = self.surface("surface", &d.surface)?;
+        let back_stop = self.back_stop(d.back_stop.as_ref(), d.coil.is_some())?;
         self.contact(&d.contact)?;
         self.simulation(&d.simulation)?;
         if let Some(circuit) = &d.circuit {
@@ -924,7 +941,27 @@ impl Check<'_> {
         if let Some(limits) = &d.limits {
             self.limits(limits)?;
         }
-        Ok(surface)
+        Ok((surface, back_stop))
+    }
+
+    /// `[back_stop]`, which only a coil-driven relay reaches (on release).
+    fn back_stop(
+        &self,
+        s: Option<&SurfaceSection>,
+        coil: bool,
+    ) -> Result<Option<Surface>, ScenarioError> {
+        let Some(s) = s else { return Ok(None) };
+        if !coil {
+            return Err(ScenarioError::Conflict {
+                at: self.at("back_stop"),
+                key: "back_stop".to_owned(),
+                other: "mechanics.force".to_owned(),
+                advice: "the armature comes back to its rest stop only on release, and a \
+                         step force never releases: give a [coil] (the release follows its \
+                         driver) or remove [back_stop]",
+            });
+        }
+        self.surface("back_stop", s).map(Some)
     }
 
     fn mechanics(&self, m: &MechanicsSection) -> Result<(), ScenarioError> {
@@ -1034,7 +1071,7 @@ impl Check<'_> {
         )
     }
 
-    fn surface(&self, s: &SurfaceSection) -> Result<Surface, ScenarioError> {
+    fn surface(&self, section: &str, s: &SurfaceSection) -> Result<Surface, ScenarioError> {
         let law = s.law;
         let given = [
             ("stiffness", s.stiffness),
@@ -1046,7 +1083,7 @@ impl Check<'_> {
         ];
         for (name, value) in given {
             if value.is_some() && !law.keys().contains(&name) {
-                let key = format!("surface.{name}");
+                let key = format!("{section}.{name}");
                 return Err(ScenarioError::NotForLaw {
                     at: self.at(&key),
                     key,
@@ -1060,7 +1097,7 @@ impl Check<'_> {
                 .iter()
                 .find(|(n, _)| *n == name)
                 .and_then(|(_, v)| *v)
-                .ok_or_else(|| self.missing(&format!("surface.{name}"), help))
+                .ok_or_else(|| self.missing(&format!("{section}.{name}"), help))
         };
         match law {
             SurfaceLaw::Rigid => {
@@ -1069,7 +1106,7 @@ impl Check<'_> {
                     "law \"rigid\" needs the restitution e in [0, 1]",
                 )?;
                 self.number(
-                    "surface.restitution",
+                    &format!("{section}.restitution"),
                     e,
                     (0.0..=1.0).contains(&e),
                     "must lie in [0, 1]: 0 is a dead impact, 1 a perfectly elastic one",
@@ -1082,7 +1119,7 @@ impl Check<'_> {
                     "law \"kelvin-voigt\" needs the surface stiffness s0 in N/m",
                 )?;
                 self.number(
-                    "surface.stiffness",
+                    &format!("{section}.stiffness"),
                     stiffness,
                     stiffness > 0.0,
                     "must be > 0: the surface stiffness s0, in N/m",
@@ -1092,26 +1129,26 @@ impl Check<'_> {
                     "law \"kelvin-voigt\" needs the surface damping r0 in N·s/m (0 is allowed)",
                 )?;
                 self.number(
-                    "surface.damping",
+                    &format!("{section}.damping"),
                     damping,
                     damping >= 0.0,
                     "must be ≥ 0: the surface damping r0, in N·s/m",
                 )?;
                 Ok(Surface::KelvinVoigt { stiffness, damping })
             }
-            SurfaceLaw::HuntCrossley => self.hunt_crossley(s),
+            SurfaceLaw::HuntCrossley => self.hunt_crossley(section, s),
         }
     }
 
-    fn hunt_crossley(&self, s: &SurfaceSection) -> Result<Surface, ScenarioError> {
+    fn hunt_crossley(&self, section: &str, s: &SurfaceSection) -> Result<Surface, ScenarioError> {
         let stiffness = s.stiffness.ok_or_else(|| {
             self.missing(
-                "surface.stiffness",
+                &format!("{section}.stiffness"),
                 "law \"hunt-crossley\" needs the surface stiffness k in N/mⁿ",
             )
         })?;
         self.number(
-            "surface.stiffness",
+            &format!("{section}.stiffness"),
             stiffness,
             stiffness > 0.0,
             "must be > 0: the surface stiffness k, in N/mⁿ",
@@ -1119,7 +1156,7 @@ impl Check<'_> {
         // n = 1 is the paper's linear surface spring (model.md §2c).
         let exponent = s.exponent.unwrap_or(1.0);
         self.number(
-            "surface.exponent",
+            &format!("{section}.exponent"),
             exponent,
             exponent > 0.0,
             "must be > 0: 1 for a linear spring, 1.5 for Hertz contact",
@@ -1127,7 +1164,7 @@ impl Check<'_> {
         let chi = match (s.chi, s.restitution, s.reference_velocity) {
             (Some(chi), None, None) => {
                 self.number(
-                    "surface.chi",
+                    &format!("{section}.chi"),
                     chi,
                     chi >= 0.0,
                     "must be ≥ 0: χ = λ/k in s/m (0 is a lossless surface)",
@@ -1136,33 +1173,33 @@ impl Check<'_> {
             }
             (Some(_), restitution, _) => {
                 let other = if restitution.is_some() {
-                    "surface.restitution"
+                    format!("{section}.restitution")
                 } else {
-                    "surface.reference_velocity"
+                    format!("{section}.reference_velocity")
                 };
                 return Err(ScenarioError::Conflict {
-                    at: self.at("surface.chi"),
-                    key: "surface.chi".to_owned(),
-                    other: other.to_owned(),
+                    at: self.at(&format!("{section}.chi")),
+                    key: format!("{section}.chi"),
+                    other,
                     advice: "give χ directly, or as `restitution` at `reference_velocity`, not both",
                 });
             }
             (None, Some(e), Some(v)) => {
                 self.number(
-                    "surface.restitution",
+                    &format!("{section}.restitution"),
                     e,
                     e > 0.0 && e <= 1.0,
                     "must lie in (0, 1]: the restitution at `reference_velocity`",
                 )?;
                 self.number(
-                    "surface.reference_velocity",
+                    &format!("{section}.reference_velocity"),
                     v,
                     v > 0.0,
                     "must be > 0: the impact speed, in m/s, at which `restitution` holds",
                 )?;
                 hunt_crossley_chi(e, v).ok_or_else(|| {
                     self.invalid(
-                        "surface.restitution",
+                        &format!("{section}.restitution"),
                         e,
                         format!(
                             "cannot be reached at `reference_velocity` = {v:?} m/s; \
@@ -1173,19 +1210,19 @@ impl Check<'_> {
             }
             (None, Some(_), None) => {
                 return Err(self.missing(
-                    "surface.reference_velocity",
+                    &format!("{section}.reference_velocity"),
                     "a Hunt–Crossley `restitution` holds at one impact speed; give it in m/s",
                 ));
             }
             (None, None, Some(_)) => {
                 return Err(self.missing(
-                    "surface.restitution",
+                    &format!("{section}.restitution"),
                     "`reference_velocity` needs the restitution e in (0, 1] that holds at it",
                 ));
             }
             (None, None, None) => {
                 return Err(self.missing(
-                    "surface.chi",
+                    &format!("{section}.chi"),
                     "law \"hunt-crossley\" needs `chi` in s/m, or `restitution` with \
                      `reference_velocity` in m/s",
                 ));
@@ -1664,8 +1701,9 @@ impl Scenario {
             None => self.revalidate(probes),
         };
         match result {
-            Ok(surface) => {
+            Ok((surface, back_stop)) => {
                 self.resolved_surface = surface;
+                self.resolved_back_stop = back_stop;
                 Ok(())
             }
             Err(e) => {
@@ -1685,7 +1723,7 @@ impl Scenario {
 
     /// The loader's physics rules on the scenario as it now is; the
     /// probes only when asked (their keys are formatted, which allocates).
-    fn revalidate(&self, probes: bool) -> Result<Surface, ScenarioError> {
+    fn revalidate(&self, probes: bool) -> Result<(Surface, Option<Surface>), ScenarioError> {
         let index = KeyIndex {
             text: "",
             document_span: 0..0,
@@ -1697,7 +1735,8 @@ impl Scenario {
         };
         check.mechanics(&self.mechanics)?;
         check.drive(&self.mechanics, self.coil.as_ref())?;
-        let surface = check.surface(&self.surface)?;
+        let surface = check.surface("surface", &self.surface)?;
+        let back_stop = check.back_stop(self.back_stop.as_ref(), self.coil.is_some())?;
         check.contact(&self.contact)?;
         check.simulation(&self.simulation)?;
         if probes {
@@ -1705,7 +1744,7 @@ impl Scenario {
                 check.probe(i, probe)?;
             }
         }
-        Ok(surface)
+        Ok((surface, back_stop))
     }
 
     fn unknown_number(&self, key: &str, within: &'static str) -> ScenarioError {

@@ -9,6 +9,7 @@
 //! [`crate::mechanics::simulate`].
 
 use super::CoilError;
+use super::cycle::{self, Cycle, Stops};
 use super::sequence::{self, Drive};
 use crate::chatter::Chatter;
 use crate::mechanics::{self, Mechanics, Settings, Surface};
@@ -58,19 +59,7 @@ pub fn simulate_forced_path(
             requirement: "a position in m at or above the rest stop at 0 (and below the gap)",
         });
     }
-    let scale = [
-        mechanics.preload,
-        mechanics.stiffness * mechanics.gap,
-        force(0.0, mechanics.initial_position).abs(),
-    ]
-    .into_iter()
-    .fold(0.0, f64::max);
-    let drive = Forced {
-        force,
-        // The impulse ∫F dt over the suspension's time scale.
-        impulse_scale: scale * (mechanics.mass / mechanics.stiffness).sqrt(),
-        time_scale: (mechanics.mass / mechanics.stiffness).sqrt(),
-    };
+    let drive = Forced::new(mechanics, force);
     let run = sequence::run(mechanics, surface, settings, &drive, 0.0)?;
     let gap = mechanics.gap;
     let mut path: Vec<(f64, f64)> = Vec::with_capacity(run.steps.len() + 1);
@@ -83,6 +72,37 @@ pub fn simulate_forced_path(
         }
     }
     Ok((run.chatter, path))
+}
+
+/// The whole cycle under `force(t, x)` (s, m → N, toward closing): the
+/// closing, the contact held, its release when the force falls, and the
+/// armature's return onto its rest stop (`stops.back`, the normally-closed
+/// contact), for every pulse of the force up to `settings.t_end`. See
+/// [`super::cycle`]. Unlike [`simulate_forced`], nothing is assumed of
+/// the force after the contact sticks.
+pub fn simulate_cycle(
+    mechanics: &Mechanics,
+    stops: &Stops,
+    settings: &Settings,
+    force: impl Fn(f64, f64) -> f64,
+) -> Result<Cycle, CoilError> {
+    let unforced = Mechanics {
+        force: 0.0,
+        ..*mechanics
+    };
+    mechanics::validate(&unforced, &stops.make, settings)?;
+    if let Some(back) = &stops.back {
+        mechanics::validate(&unforced, back, settings)?;
+    }
+    if mechanics.initial_position < 0.0 {
+        return Err(CoilError::InvalidParameter {
+            name: "mechanics.initial_position",
+            value: mechanics.initial_position,
+            requirement: "a position in m at or above the rest stop at 0 (and below the gap)",
+        });
+    }
+    let drive = Forced::new(mechanics, force);
+    cycle::run(mechanics, stops, settings, &drive, 0.0)
 }
 
 /// A drive given as a function. Its state `e` is the impulse `∫F dt`:
@@ -101,6 +121,25 @@ const GL3: [(f64, f64); 3] = [
     (0.0, 8.0 / 9.0),
     (0.774_596_669_241_483_4, 5.0 / 9.0),
 ];
+
+impl<F: Fn(f64, f64) -> f64> Forced<F> {
+    fn new(mechanics: &Mechanics, force: F) -> Self {
+        let scale = [
+            mechanics.preload,
+            mechanics.stiffness * mechanics.gap,
+            force(0.0, mechanics.initial_position).abs(),
+        ]
+        .into_iter()
+        .fold(0.0, f64::max);
+        let time_scale = (mechanics.mass / mechanics.stiffness).sqrt();
+        Forced {
+            force,
+            // The impulse ∫F dt over the suspension's time scale.
+            impulse_scale: scale * time_scale,
+            time_scale,
+        }
+    }
+}
 
 impl<F: Fn(f64, f64) -> f64> Drive for Forced<F> {
     fn force(&self, t: f64, x: f64, _e: f64) -> f64 {

@@ -37,15 +37,17 @@
 //! step's interpolant.
 
 pub mod coupled;
+pub mod cycle;
 pub mod direct;
 pub mod forced;
 mod sequence;
 
 pub use coupled::{Coupled, CouplingError, CouplingOptions, run_coupled};
+pub use cycle::{Cycle, Stops, Stroke};
 pub use direct::{
     CoilEvents, CoilRun, CoilState, EnergyBalance, PullInDip, Source, simulate_direct,
 };
-pub use forced::{simulate_forced, simulate_forced_path};
+pub use forced::{simulate_cycle, simulate_forced, simulate_forced_path};
 
 use thiserror::Error;
 

@@ -515,23 +515,23 @@ pub(crate) fn first_true(cond: impl Fn(f64) -> bool, mut lo: f64, mut hi: f64) -
 }
 
 /// A step split at the velocity zero it may contain.
-struct Parts {
+pub(crate) struct Parts {
     bounds: [(f64, f64); 2],
     n: usize,
     /// (time, state) of the turning point, if any.
-    turn: Option<(f64, State)>,
+    pub turn: Option<(f64, State)>,
 }
 
 impl Parts {
     /// The one or two time spans on which x is monotonic, in order.
-    fn spans(&self) -> &[(f64, f64)] {
+    pub fn spans(&self) -> &[(f64, f64)] {
         &self.bounds[..self.n]
     }
 }
 
 /// The step split at the velocity zero it may contain: up to two parts,
 /// each with x monotonic, and the turning point if any.
-fn monotone_parts(step: &Step<3>) -> Parts {
+pub(crate) fn monotone_parts(step: &Step<3>) -> Parts {
     let (v0, v1) = (step.y0[1], step.y1[1]);
     if (v0 > 0.0 && v1 < 0.0) || (v0 < 0.0 && v1 > 0.0) {
         let up = v0 > 0.0;
@@ -559,7 +559,7 @@ fn monotone_parts(step: &Step<3>) -> Parts {
 }
 
 /// The state on `step` at `t`, exact at its ends.
-fn state_on(step: &Step<3>, t: f64) -> State {
+pub(crate) fn state_on(step: &Step<3>, t: f64) -> State {
     if t == step.t0 {
         step.y0
     } else if t == step.t1 {

@@ -1,0 +1,1071 @@
+//! The whole operating cycle of a relay under a drive that rises and
+//! falls: pull-in and make-side chatter, the contact held closed, the
+//! release when the drive weakens, the return stroke and the bounce of
+//! the armature on its rest stop (the normally-closed contact), and so on
+//! for as many pulses as the drive gives (model.md §7, issue 6).
+//!
+//! [`super::sequence`] simulates one closing and ends when the contact has
+//! stuck, on the understanding that the drive does not weaken afterwards.
+//! Here nothing ends before `t_end`: a stuck contact stays in its contact
+//! phase and releases by the same rule that ends every contact (the
+//! moving contact back at the surface, moving out), so the break of the
+//! normally-open (NO) contact is found where the pull no longer holds it.
+//!
+//! The state is the one of `sequence`, `(u = x − g, v, e)`, and so are the
+//! numerics: Dormand–Prince 5(4) with dense output, each step split at its
+//! velocity zero, every crossing bracketed on a monotonic part and
+//! polished by bisection on the interpolant. The phases:
+//!
+//! - **held** on the rest stop at x = 0 by the preload, while the drive
+//!   does not beat it; it lifts off when `F(t, 0) > p`;
+//! - **flight**, ending at a touch of the NO contact (x = g, moving up) or
+//!   of the rest stop (x = 0, moving down);
+//! - **make contact**, the NO surface law (Kelvin–Voigt, Hunt–Crossley),
+//!   until the release (x back at g, moving out);
+//! - **pressed** against a rigid NO surface while the drive holds it
+//!   there, `F(t, g) ≥ p + s g`; it breaks when it no longer does;
+//! - **back contact**, the rest stop's own surface law (the back stop),
+//!   with penetration `−x`, until x is back at 0 moving up.
+//!
+//! Without a back-stop law the landing is inelastic: the armature is held
+//! on the rest stop at once. A rigid surface with restitution below 1
+//! makes an endless sequence of ever shorter bounces; as in the engine, an
+//! opening shorter than `min_open_time` or smaller than `min_gap` is not
+//! resolved: the contact is taken as closed since the previous touch, held
+//! (pressed, or on the rest stop). A held armature sits at exactly x = 0
+//! (or g): the static penetration of a deformable stop under the preload,
+//! `p/s_b`, is neglected there.
+//!
+//! Contact forces (peak and minimum per contact) are taken at the events,
+//! at the ends of the steps and at the zeros of the force's rate inside
+//! them, bisected on the interpolant, as the closing engine does.
+
+use super::CoilError;
+use super::sequence::{Drive, RTOL, State, first_true, monotone_parts, state_on, surface_force};
+use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome};
+use crate::mechanics::integrate::{Dopri5, Step, Tolerance};
+use crate::mechanics::{Mechanics, Settings, Surface};
+
+/// One stroke of the armature: from leaving the rest stop (lift-off) to
+/// leaving it again, or to the end of the run. All times in s from t = 0.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Stroke {
+    /// The armature leaves the rest stop: the normally-closed contact
+    /// opens.
+    pub lift_off: f64,
+    /// The first touch of the NO contact; `None` if this stroke never
+    /// reached it.
+    pub first_make: Option<f64>,
+    /// The start of the NO contact's last closed interval in this stroke:
+    /// closed for good from here until the break. `None` when the stroke
+    /// never made, or ended at `t_end` in a flight after a release (still
+    /// bouncing).
+    pub last_make: Option<f64>,
+    /// NO openings between the first and the last make.
+    pub bounces: usize,
+    /// The last release of the NO contact, after which the armature went
+    /// back to its rest stop; `None` if it did not within the run.
+    pub break_time: Option<f64>,
+    /// The first touch of the rest stop after the break: the NC contact
+    /// makes. `None` if the armature did not come back within the run.
+    pub back_make: Option<f64>,
+    /// The start of the NC contact's last closed interval in this stroke.
+    pub back_last_make: Option<f64>,
+    /// NC openings between the first and the last back make.
+    pub back_bounces: usize,
+}
+
+impl Stroke {
+    /// s, from the first make to the last: the make-side bounce time.
+    pub fn bounce_time(&self) -> Option<f64> {
+        Some(self.last_make? - self.first_make?)
+    }
+
+    /// s, from the first back make to the last: the NC (break-side)
+    /// bounce time.
+    pub fn back_bounce_time(&self) -> Option<f64> {
+        Some(self.back_last_make? - self.back_make?)
+    }
+}
+
+/// A simulated cycle.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cycle {
+    /// The normally-open contact over the whole run. Its summary fields
+    /// (`outcome`, `first_impact`, `settle_time`, `bounce_count`) are those
+    /// of the first stroke's closing, the contract of a chatter sequence;
+    /// `impacts` and `intervals` cover every stroke, release included.
+    pub make: Chatter,
+    /// The rest stop as the normally-closed contact, closed while the
+    /// armature is on it; its impacts are the landings.
+    pub back: Chatter,
+    pub strokes: Vec<Stroke>,
+    /// (s, m): the armature's path, at every accepted step and event.
+    pub path: Vec<(f64, f64)>,
+}
+
+/// How the armature meets the two stops.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Stops {
+    /// The fixed NO contact at x = g.
+    pub make: Surface,
+    /// The rest stop at x = 0; `None`: inelastic, held at once.
+    pub back: Option<Surface>,
+}
+
+/// Simulate from t = 0 to `settings.t_end` under `drive`, from the
+/// drive's state `e0`. Parameters must have been validated.
+pub(crate) fn run<D: Drive>(
+    m: &Mechanics,
+    stops: &Stops,
+    settings: &Settings,
+    drive: &D,
+    e0: f64,
+) -> Result<Cycle, CoilError> {
+    let omega = (m.stiffness / m.mass).sqrt();
+    let tol = Tolerance {
+        rtol: RTOL,
+        atol: State::new(RTOL * m.gap, RTOL * m.gap * omega, RTOL * drive.e_scale()),
+    };
+    let x0 = m.initial_position;
+    let f0 = drive.force(0.0, x0, e0);
+    if !f0.is_finite() {
+        return Err(CoilError::DriveNotFinite {
+            time: 0.0,
+            position: x0,
+            value: f0,
+        });
+    }
+    let held = x0 == 0.0 && m.initial_velocity <= 0.0;
+    let back_state = if held {
+        ContactState::Closed
+    } else {
+        ContactState::Open
+    };
+    let mut sim = Sim {
+        model: Model {
+            m: *m,
+            stops: *stops,
+            settings: *settings,
+            drive,
+            tol,
+        },
+        rec: Record {
+            make: Track::new(ContactState::Open),
+            back: Track::new(back_state),
+            log: Vec::new(),
+            path: vec![(0.0, x0)],
+            reach: x0,
+        },
+    };
+    let y0 = State::new(x0 - m.gap, if held { 0.0 } else { m.initial_velocity }, e0);
+    sim.simulate(if held { Phase::Held } else { Phase::Flight }, y0)?;
+    Ok(sim.finish())
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Phase {
+    Held,
+    Flight,
+    Make,
+    Pressed,
+    Back,
+}
+
+/// What ended a phase.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Event {
+    Lift,
+    TouchMake,
+    TouchBack,
+    ReleaseMake,
+    ReleaseBack,
+    Break,
+    Horizon,
+}
+
+/// One contact's record: its intervals and impacts.
+struct Track {
+    intervals: Vec<Interval>,
+    impacts: Vec<Impact>,
+    state: ContactState,
+    since: f64,
+    /// The last release: (s, smallest distance reached since, in m, from
+    /// this contact's surface). Cleared at the next touch.
+    released: Option<(f64, f64)>,
+}
+
+impl Track {
+    fn new(state: ContactState) -> Self {
+        Track {
+            intervals: Vec::new(),
+            impacts: Vec::new(),
+            state,
+            since: 0.0,
+            released: None,
+        }
+    }
+
+    fn change(&mut self, t: f64, to: ContactState) {
+        if self.state != to {
+            self.intervals.push(Interval {
+                state: self.state,
+                start: self.since,
+                end: t,
+            });
+            self.state = to;
+            self.since = t;
+        }
+    }
+
+    /// A touch at `t` at `speed` (> 0): the contact closes.
+    fn touch(&mut self, t: f64, speed: f64) {
+        if let (Some((_, farthest)), Some(last)) = (self.released.take(), self.impacts.last_mut()) {
+            last.max_gap_after = Some(farthest);
+        }
+        self.change(t, ContactState::Closed);
+        self.impacts.push(Impact {
+            impact_time: t,
+            impact_velocity: speed,
+            release_time: None,
+            release_velocity: None,
+            restitution: None,
+            contact_time: None,
+            peak_force: None,
+            min_force: None,
+            max_gap_after: None,
+        });
+    }
+
+    /// The contact opens at `t`, separating at `speed` (> 0).
+    fn release(&mut self, t: f64, speed: f64) {
+        self.change(t, ContactState::Open);
+        if let Some(last) = self.impacts.last_mut() {
+            last.release_time = Some(t);
+            last.release_velocity = Some(-speed);
+            last.restitution = Some(speed / last.impact_velocity);
+            last.contact_time = Some(t - last.impact_time);
+        }
+        self.released = Some((t, 0.0));
+    }
+
+    /// The opening since the last release is below resolution: the
+    /// contact is taken as closed since the last touch.
+    fn unresolve(&mut self) {
+        self.released = None;
+        let Some(closed) = self.intervals.pop() else {
+            return;
+        };
+        debug_assert_eq!(closed.state, ContactState::Closed);
+        self.state = ContactState::Closed;
+        self.since = closed.start;
+        if let Some(last) = self.impacts.last_mut() {
+            last.release_time = None;
+            last.release_velocity = None;
+            last.restitution = None;
+            last.contact_time = None;
+        }
+    }
+
+    /// The force on the contact now in its last impact's record.
+    fn see_force(&mut self, f: f64) {
+        if let Some(last) = self.impacts.last_mut() {
+            last.peak_force = Some(last.peak_force.map_or(f, |p| p.max(f)));
+            last.min_force = Some(last.min_force.map_or(f, |p| p.min(f)));
+        }
+    }
+
+    /// Note how far from the surface the armature got.
+    fn see_distance(&mut self, d: f64) {
+        if let Some((_, farthest)) = &mut self.released {
+            *farthest = farthest.max(d);
+        }
+    }
+
+    fn finish(mut self, t_end: f64) -> (Vec<Interval>, Vec<Impact>) {
+        self.intervals.push(Interval {
+            state: self.state,
+            start: self.since.min(t_end),
+            end: t_end,
+        });
+        (self.intervals, self.impacts)
+    }
+}
+
+/// The relay, its stops and the drive: everything the right-hand side
+/// needs.
+struct Model<'a, D> {
+    m: Mechanics,
+    stops: Stops,
+    settings: Settings,
+    drive: &'a D,
+    tol: Tolerance<3>,
+}
+
+/// What the run has produced so far.
+struct Record {
+    make: Track,
+    back: Track,
+    /// Every touch, release and lift-off, in order.
+    log: Vec<(f64, Event)>,
+    path: Vec<(f64, f64)>,
+    /// m, the largest x reached.
+    reach: f64,
+}
+
+impl Record {
+    /// The armature passed through `x`; the gap is `g`.
+    fn see_position(&mut self, x: f64, g: f64) {
+        self.reach = self.reach.max(x);
+        self.make.see_distance(g - x);
+        self.back.see_distance(x);
+    }
+}
+
+struct Sim<'a, D> {
+    model: Model<'a, D>,
+    rec: Record,
+}
+
+impl<D: Drive> Model<'_, D> {
+    fn g(&self) -> f64 {
+        self.m.gap
+    }
+
+    /// N, the drive at (t, x, e) less the spring at x and the preload:
+    /// > 0 pushes toward closing.
+    fn net(&self, t: f64, x: f64, e: f64) -> f64 {
+        self.drive.force(t, x, e) - self.m.preload - self.m.stiffness * x
+    }
+
+    /// N, the NO contact's force at u (> 0 in it) and rate v.
+    fn make_force(&self, y: &State) -> f64 {
+        surface_force(&self.stops.make, y[0], y[1])
+    }
+
+    /// N, the back stop's force at x = g + u (< 0 in it), pushing +x.
+    fn back_force(&self, y: &State) -> f64 {
+        match self.stops.back {
+            Some(s) => surface_force(&s, -(self.g() + y[0]), -y[1]),
+            None => 0.0,
+        }
+    }
+
+    fn rhs(&self, phase: Phase, t: f64, y: &State) -> State {
+        let g = self.g();
+        match phase {
+            Phase::Held => State::new(0.0, 0.0, self.drive.rate(t, 0.0, y[2])),
+            Phase::Pressed => State::new(0.0, 0.0, self.drive.rate(t, g, y[2])),
+            Phase::Flight | Phase::Make | Phase::Back => {
+                let x = g + y[0];
+                let contact = match phase {
+                    Phase::Make => -self.make_force(y),
+                    Phase::Back => self.back_force(y),
+                    _ => 0.0,
+                };
+                let a = (self.net(t, x, y[2]) - self.m.damping * y[1] + contact) / self.m.mass;
+                State::new(y[1], a, self.drive.rate(t, x, y[2]))
+            }
+        }
+    }
+
+    /// N/s, the rate of the contact force of `phase` (make or back)
+    /// along the motion at (t, y).
+    fn force_rate(&self, phase: Phase, t: f64, y: &State) -> f64 {
+        let a = self.rhs(phase, t, y)[1];
+        // Penetration, its rate and acceleration into the surface.
+        let (surface, d, dd, ddd) = match phase {
+            Phase::Make => (Some(self.stops.make), y[0], y[1], a),
+            _ => (self.stops.back, -(self.g() + y[0]), -y[1], -a),
+        };
+        match surface {
+            Some(Surface::KelvinVoigt { stiffness, damping }) => stiffness * dd + damping * ddd,
+            Some(Surface::HuntCrossley {
+                stiffness,
+                exponent,
+                chi,
+            }) if d > 0.0 && 1.0 + chi * dd > 0.0 => {
+                stiffness
+                    * (exponent * d.powf(exponent - 1.0) * dd * (1.0 + chi * dd)
+                        + d.powf(exponent) * chi * ddd)
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// Whether a held phase still holds at (t, y): the preload keeps the
+    /// armature on the rest stop, or the drive keeps it pressed on the NO
+    /// contact.
+    fn holds(&self, phase: Phase, t: f64, y: &State) -> bool {
+        match phase {
+            Phase::Held => self.drive.force(t, 0.0, y[2]) <= self.m.preload,
+            _ => self.net(t, self.g(), y[2]) >= 0.0,
+        }
+    }
+
+    /// s, the time scale of a phase, for the first trial step.
+    fn scale(&self, phase: Phase, speed: f64) -> f64 {
+        let m = &self.m;
+        let free = (m.mass / m.stiffness).sqrt();
+        let surface = match phase {
+            Phase::Held | Phase::Pressed => return self.drive.time_scale(),
+            Phase::Flight => return free,
+            Phase::Make => Some(self.stops.make),
+            Phase::Back => self.stops.back,
+        };
+        match surface {
+            Some(Surface::KelvinVoigt { stiffness, .. }) => {
+                (m.mass / (m.stiffness + stiffness)).sqrt()
+            }
+            Some(Surface::HuntCrossley {
+                stiffness,
+                exponent,
+                ..
+            }) if speed > 0.0 => {
+                // The depth at which the surface alone stops the impact,
+                // crossed at the impact speed.
+                let depth = ((exponent + 1.0) * m.mass * speed * speed / (2.0 * stiffness))
+                    .powf(1.0 / (exponent + 1.0));
+                (depth / speed).min(free)
+            }
+            _ => free,
+        }
+    }
+
+    fn solver(
+        &self,
+        phase: Phase,
+        t: f64,
+        y: State,
+    ) -> Dopri5<3, impl Fn(f64, &State) -> State + '_> {
+        let h0 = 1e-2 * self.scale(phase, y[1].abs());
+        Dopri5::new(
+            move |t, y: &State| self.rhs(phase, t, y),
+            t,
+            y,
+            h0,
+            self.tol,
+        )
+    }
+
+    /// Whether the opening since `track`'s last release, touched again at
+    /// `t`, is below resolution.
+    fn unresolved(&self, track: &Track, t: f64) -> bool {
+        let Some((released, farthest)) = track.released else {
+            return false;
+        };
+        let s = &self.settings;
+        let min_gap = s.min_gap.max(1e3 * f64::EPSILON * self.g());
+        let min_open = s.min_open_time.max(1e3 * f64::EPSILON * t);
+        t - released < min_open || farthest < min_gap
+    }
+}
+
+impl<D: Drive> Sim<'_, D> {
+    /// Run the phases from `phase` at (0, y) to `t_end`.
+    fn simulate(&mut self, mut phase: Phase, mut y: State) -> Result<(), CoilError> {
+        let g = self.model.g();
+        let mut t = 0.0;
+        loop {
+            let (event, te, mut ye) = self.phase(phase, t, y)?;
+            let rec = &mut self.rec;
+            if rec.path.last().is_none_or(|&(tp, _)| te > tp) {
+                rec.path.push((te, g + ye[0]));
+            }
+            phase = match event {
+                Event::Horizon => return Ok(()),
+                Event::Lift => {
+                    rec.log.push((te, Event::Lift));
+                    rec.back.change(te, ContactState::Open);
+                    rec.back.released = Some((te, 0.0));
+                    Phase::Flight
+                }
+                Event::ReleaseMake | Event::Break => {
+                    rec.log.push((te, Event::ReleaseMake));
+                    rec.make.release(te, (-ye[1]).max(0.0));
+                    Phase::Flight
+                }
+                Event::ReleaseBack => {
+                    rec.log.push((te, Event::ReleaseBack));
+                    rec.back.release(te, ye[1].max(0.0));
+                    Phase::Flight
+                }
+                Event::TouchMake => self.touch_make(te, &mut ye),
+                Event::TouchBack => self.touch_back(te, &mut ye),
+            };
+            (t, y) = (te, ye);
+        }
+    }
+
+    /// The NO contact touched at `t` with state `y` (u = 0): the phase
+    /// that follows; `y` becomes the state after the touch.
+    fn touch_make(&mut self, t: f64, y: &mut State) -> Phase {
+        let (model, rec) = (&self.model, &mut self.rec);
+        let speed = y[1];
+        if model.unresolved(&rec.make, t) {
+            rec.make.unresolve();
+            return match model.stops.make {
+                Surface::Rigid { .. } => self.press(t, y),
+                _ => Phase::Make,
+            };
+        }
+        rec.log.push((t, Event::TouchMake));
+        rec.make.touch(t, speed);
+        match model.stops.make {
+            Surface::Rigid { restitution } => {
+                let out = restitution * speed;
+                if out == 0.0 {
+                    return self.press(t, y);
+                }
+                y[1] = -out;
+                rec.log.push((t, Event::ReleaseMake));
+                rec.make.release(t, out);
+                Phase::Flight
+            }
+            _ => {
+                rec.make.see_force(model.make_force(y));
+                Phase::Make
+            }
+        }
+    }
+
+    /// Held against a rigid NO contact from `t`, if the drive holds it.
+    fn press(&mut self, t: f64, y: &mut State) -> Phase {
+        y[1] = 0.0;
+        let held_by = self.model.net(t, self.model.g(), y[2]);
+        if held_by >= 0.0 {
+            self.rec.make.see_force(held_by);
+            Phase::Pressed
+        } else {
+            self.rec.log.push((t, Event::ReleaseMake));
+            self.rec.make.release(t, 0.0);
+            Phase::Flight
+        }
+    }
+
+    /// The rest stop touched at `t` with state `y` (x = 0).
+    fn touch_back(&mut self, t: f64, y: &mut State) -> Phase {
+        let (model, rec) = (&self.model, &mut self.rec);
+        let speed = -y[1];
+        let deformable = matches!(
+            model.stops.back,
+            Some(Surface::KelvinVoigt { .. } | Surface::HuntCrossley { .. })
+        );
+        if model.unresolved(&rec.back, t) {
+            rec.back.unresolve();
+            return if deformable { Phase::Back } else { rest(y) };
+        }
+        rec.log.push((t, Event::TouchBack));
+        rec.back.touch(t, speed);
+        match model.stops.back {
+            None => rest(y),
+            Some(Surface::Rigid { restitution }) => {
+                let out = restitution * speed;
+                if out == 0.0 {
+                    return rest(y);
+                }
+                y[1] = out;
+                rec.log.push((t, Event::ReleaseBack));
+                rec.back.release(t, out);
+                Phase::Flight
+            }
+            Some(_) => {
+                rec.back.see_force(model.back_force(y));
+                Phase::Back
+            }
+        }
+    }
+
+    /// Integrate `phase` from (t0, y0) to its event: (event, time, state
+    /// at the event, with the position set exactly to its level).
+    fn phase(
+        &mut self,
+        phase: Phase,
+        t0: f64,
+        y0: State,
+    ) -> Result<(Event, f64, State), CoilError> {
+        let (model, rec) = (&self.model, &mut self.rec);
+        let g = model.g();
+        let t_end = model.settings.t_end;
+        if t0 >= t_end {
+            return Ok((Event::Horizon, t0, y0));
+        }
+        let held = matches!(phase, Phase::Held | Phase::Pressed);
+        let (level, ends) = if phase == Phase::Held {
+            (-g, Event::Lift)
+        } else {
+            (0.0, Event::Break)
+        };
+        if held && !model.holds(phase, t0, &y0) {
+            return Ok((ends, t0, y0));
+        }
+        let mut solver = model.solver(phase, t0, y0);
+        loop {
+            let step = solver.step(t_end)?;
+            let found = if held {
+                if model.holds(phase, step.t1, &step.y1) {
+                    if phase == Phase::Pressed {
+                        rec.make.see_force(model.net(step.t1, g, step.y1[2]));
+                    }
+                    None
+                } else {
+                    let te = first_true(|t| !model.holds(phase, t, &step.at(t)), step.t0, step.t1);
+                    let mut ye = state_on(&step, te);
+                    (ye[0], ye[1]) = (level, 0.0);
+                    Some((ends, te, ye))
+                }
+            } else {
+                moving_event(model, rec, phase, &step)?
+            };
+            if let Some(found) = found {
+                return Ok(found);
+            }
+            if !held {
+                rec.path.push((step.t1, g + step.y1[0]));
+            }
+            if step.t1 >= t_end {
+                return Ok((Event::Horizon, step.t1, step.y1));
+            }
+        }
+    }
+
+    fn finish(self) -> Cycle {
+        let t_end = self.model.settings.t_end;
+        let g = self.model.g();
+        let rec = self.rec;
+        let lift_offs = lift_offs(&rec.log);
+        let (make_intervals, make_impacts) = rec.make.finish(t_end);
+        let (back_intervals, back_impacts) = rec.back.finish(t_end);
+        let strokes = strokes(&lift_offs, &make_impacts, &back_impacts);
+        let make = summary(
+            make_intervals,
+            make_impacts,
+            strokes.first(),
+            g - rec.reach,
+            t_end,
+        );
+        let ends_closed = back_intervals
+            .last()
+            .filter(|i| i.state == ContactState::Closed)
+            .map(|i| i.start);
+        let back = Chatter {
+            outcome: if ends_closed.is_some() {
+                Outcome::Stuck
+            } else {
+                Outcome::EndsOpen
+            },
+            first_impact: back_impacts.first().map(|i| i.impact_time),
+            settle_time: ends_closed,
+            bounce_count: strokes.iter().map(|s| s.back_bounces).sum(),
+            impacts: back_impacts,
+            intervals: back_intervals,
+            shortfall: None,
+            accumulation_time: None,
+            t_end,
+        };
+        Cycle {
+            make,
+            back,
+            strokes,
+            path: rec.path,
+        }
+    }
+}
+
+/// Held on the rest stop.
+fn rest(y: &mut State) -> Phase {
+    y[1] = 0.0;
+    Phase::Held
+}
+
+/// The first event of a moving phase inside `step`, with the bookkeeping
+/// of the step (reach, distances, contact forces).
+fn moving_event<D: Drive>(
+    model: &Model<'_, D>,
+    rec: &mut Record,
+    phase: Phase,
+    step: &Step<3>,
+) -> Result<Option<(Event, f64, State)>, CoilError> {
+    let g = model.g();
+    let parts = monotone_parts(step);
+    // A crossing of `level` (in u) in the given direction on a monotonic
+    // part [a, b].
+    let crossing = |a: f64, b: f64, level: f64, up: bool| -> Option<(f64, State)> {
+        let (ua, ub) = (state_on(step, a)[0], state_on(step, b)[0]);
+        let crosses = if up {
+            ua < level && ub >= level
+        } else {
+            ua > level && ub <= level
+        };
+        crosses.then(|| {
+            let te = first_true(
+                |t| {
+                    let u = step.at(t)[0];
+                    if up { u >= level } else { u <= level }
+                },
+                a,
+                b,
+            );
+            let mut ye = state_on(step, te);
+            ye[0] = level;
+            (te, ye)
+        })
+    };
+    let mut found = None;
+    for &(a, b) in parts.spans() {
+        found = match phase {
+            Phase::Flight => crossing(a, b, 0.0, true)
+                .map(|(t, y)| (Event::TouchMake, t, y))
+                .or_else(|| crossing(a, b, -g, false).map(|(t, y)| (Event::TouchBack, t, y))),
+            Phase::Make => crossing(a, b, 0.0, false).map(|(t, y)| (Event::ReleaseMake, t, y)),
+            Phase::Back => crossing(a, b, -g, true).map(|(t, y)| (Event::ReleaseBack, t, y)),
+            Phase::Held | Phase::Pressed => None,
+        };
+        if found.is_some() {
+            break;
+        }
+    }
+    let (t_last, y_last) = match found {
+        Some((_, te, ye)) => (te, ye),
+        None => (step.t1, step.y1),
+    };
+    // The turning point counts only if it comes before the event.
+    let turn = parts.turn.filter(|&(tz, _)| tz <= t_last);
+    if let Some((_, yz)) = turn {
+        rec.see_position(g + yz[0], g);
+    }
+    rec.see_position(g + y_last[0], g);
+    let track_force = |rec: &mut Record, side: Phase| {
+        // The force at the end, and at its extremum inside the step: a
+        // zero of its rate, bisected on the interpolant.
+        let rate = |t: f64| {
+            let y = state_on(step, t);
+            model.force_rate(side, t, &y)
+        };
+        let (r0, r1) = (rate(step.t0), rate(t_last));
+        let mut seen = vec![y_last];
+        if (r0 > 0.0 && r1 < 0.0) || (r0 < 0.0 && r1 > 0.0) {
+            let rising = r0 > 0.0;
+            let tz = first_true(
+                |t| {
+                    let r = rate(t);
+                    if rising { r <= 0.0 } else { r >= 0.0 }
+                },
+                step.t0,
+                t_last,
+            );
+            seen.push(state_on(step, tz));
+        }
+        for y in seen {
+            match side {
+                Phase::Make => rec.make.see_force(model.make_force(&y)),
+                _ => rec.back.see_force(model.back_force(&y)),
+            }
+        }
+    };
+    match phase {
+        Phase::Make => {
+            let pole = model.drive.pole();
+            if g + y_last[0] >= pole {
+                let tp = first_true(|t| g + step.at(t)[0] >= pole, step.t0, t_last);
+                return Err(CoilError::ArmatureAtPole {
+                    time: tp,
+                    position: g + state_on(step, tp)[0],
+                    pole,
+                });
+            }
+            track_force(rec, Phase::Make);
+        }
+        Phase::Back => track_force(rec, Phase::Back),
+        _ => {}
+    }
+    Ok(found)
+}
+
+/// s, the lift-offs in an event log: every departure from a held rest,
+/// and every release from the back stop after which the armature next
+/// touches the NO contact (the others are NC bounces).
+fn lift_offs(log: &[(f64, Event)]) -> Vec<f64> {
+    let mut out = Vec::new();
+    for (k, &(t, event)) in log.iter().enumerate() {
+        let lifts = match event {
+            Event::Lift => true,
+            Event::ReleaseBack => log[k + 1..]
+                .iter()
+                .find(|(_, e)| matches!(e, Event::TouchMake | Event::TouchBack))
+                .is_some_and(|(_, e)| *e == Event::TouchMake),
+            _ => false,
+        };
+        if lifts {
+            out.push(t);
+        }
+    }
+    out
+}
+
+/// The NO contact's chatter, summarised by its first stroke.
+fn summary(
+    intervals: Vec<Interval>,
+    impacts: Vec<Impact>,
+    first: Option<&Stroke>,
+    shortfall: f64,
+    t_end: f64,
+) -> Chatter {
+    let first_impact = impacts.first().map(|i| i.impact_time);
+    let (outcome, settle_time, bounce_count) = match first {
+        Some(s) if s.first_make.is_some() => match s.last_make {
+            Some(last) => (Outcome::Stuck, Some(last), s.bounces),
+            None => (Outcome::EndOfTime, None, s.bounces),
+        },
+        _ => (Outcome::NeverCloses, None, 0),
+    };
+    Chatter {
+        outcome,
+        first_impact,
+        settle_time,
+        bounce_count,
+        impacts,
+        intervals,
+        shortfall: (outcome == Outcome::NeverCloses).then_some(shortfall.max(0.0)),
+        accumulation_time: None,
+        t_end,
+    }
+}
+
+/// Cut the run into strokes at the lift-offs.
+fn strokes(lift_offs: &[f64], make: &[Impact], back: &[Impact]) -> Vec<Stroke> {
+    let mut out = Vec::with_capacity(lift_offs.len());
+    for (k, &lift_off) in lift_offs.iter().enumerate() {
+        let until = lift_offs.get(k + 1).copied().unwrap_or(f64::INFINITY);
+        let within = |i: &&Impact| i.impact_time >= lift_off && i.impact_time < until;
+        let makes: Vec<&Impact> = make.iter().filter(within).collect();
+        let last = makes.last();
+        // The break: the last release, when the armature reached the rest
+        // stop after it.
+        let landing = back
+            .iter()
+            .filter(within)
+            .find(|b| last.is_none_or(|m| m.release_time.is_some_and(|r| b.impact_time > r)));
+        let ended_in_flight = last.is_some_and(|m| m.release_time.is_some()) && landing.is_none();
+        let backs: Vec<&Impact> = match landing {
+            Some(first) => back
+                .iter()
+                .filter(within)
+                .filter(|b| b.impact_time >= first.impact_time)
+                .collect(),
+            None => Vec::new(),
+        };
+        out.push(Stroke {
+            lift_off,
+            first_make: makes.first().map(|i| i.impact_time),
+            last_make: if ended_in_flight {
+                None
+            } else {
+                last.map(|i| i.impact_time)
+            },
+            bounces: makes.len().saturating_sub(1),
+            break_time: landing.and(last.and_then(|m| m.release_time)),
+            back_make: backs.first().map(|i| i.impact_time),
+            back_last_make: backs
+                .last()
+                .filter(|b| b.release_time.is_none_or(|r| r >= until))
+                .map(|i| i.impact_time),
+            back_bounces: backs.len().saturating_sub(1),
+        });
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::coil::{simulate_cycle, simulate_forced};
+
+    /// A small relay, undamped so that the strokes have closed forms.
+    fn relay() -> Mechanics {
+        Mechanics {
+            mass: 2e-4,
+            stiffness: 800.0,
+            damping: 0.0,
+            force: 0.0,
+            gap: 4.5e-4,
+            initial_position: 0.0,
+            initial_velocity: 0.0,
+            preload: 0.1,
+        }
+    }
+
+    fn settings(t_end: f64) -> Settings {
+        Settings {
+            t_end,
+            ..Settings::default()
+        }
+    }
+
+    /// `f0` from t = 0 until `off`, nothing after.
+    fn pulse(f0: f64, off: f64) -> impl Fn(f64, f64) -> f64 {
+        move |t, _| if t < off { f0 } else { 0.0 }
+    }
+
+    #[test]
+    fn a_drive_that_stays_on_closes_as_the_closing_engine_does() {
+        let m = Mechanics {
+            damping: 0.04,
+            ..relay()
+        };
+        let surface = Surface::KelvinVoigt {
+            stiffness: 8e4,
+            damping: 0.37536,
+        };
+        let stops = Stops {
+            make: surface,
+            back: None,
+        };
+        let closing = simulate_forced(&m, &surface, &settings(0.02), |_, _| 0.5).unwrap();
+        let cycle = simulate_cycle(&m, &stops, &settings(0.02), |_, _| 0.5).unwrap();
+        assert_eq!(cycle.make.impacts.len(), closing.impacts.len());
+        for (a, b) in cycle.make.impacts.iter().zip(&closing.impacts) {
+            assert!((a.impact_time - b.impact_time).abs() < 1e-12, "{a:?} {b:?}");
+            let peak = (a.peak_force.unwrap() / b.peak_force.unwrap() - 1.0).abs();
+            assert!(peak < 1e-4, "{peak}");
+        }
+        assert_eq!(cycle.make.settle_time, closing.settle_time);
+        assert_eq!(cycle.make.bounce_count, closing.bounce_count);
+        let [stroke] = cycle.strokes.as_slice() else {
+            panic!("{:?}", cycle.strokes)
+        };
+        assert_eq!(stroke.lift_off, 0.0);
+        assert_eq!(stroke.break_time, None);
+        assert_eq!(
+            stroke.bounce_time(),
+            closing
+                .settle_time
+                .map(|s| s - closing.first_impact.unwrap())
+        );
+    }
+
+    #[test]
+    fn release_and_back_stop_bounce_follow_the_closed_forms() {
+        // Rigid stops, no damping: the armature is pressed on the NO
+        // contact until the force drops at `off`, leaves it at rest from
+        // x = g, and swings about −p/s onto the rest stop, where each
+        // bounce at speed w flies 2/ω·atan(w s/(ω p)).
+        let m = relay();
+        let (e, off) = (0.5, 8e-3);
+        let stops = Stops {
+            make: Surface::Rigid { restitution: e },
+            back: Some(Surface::Rigid { restitution: e }),
+        };
+        let cycle = simulate_cycle(&m, &stops, &settings(0.02), pulse(0.5, off)).unwrap();
+        let [stroke] = cycle.strokes.as_slice() else {
+            panic!("{:?}", cycle.strokes)
+        };
+        let omega = (m.stiffness / m.mass).sqrt();
+        let x_p = m.preload / m.stiffness;
+        // The closing: from rest about x_eq = (f − p)/s.
+        let x_eq = (0.5 - m.preload) / m.stiffness;
+        let first_make = (1.0 - m.gap / x_eq).acos() / omega;
+        assert!((stroke.first_make.unwrap() / first_make - 1.0).abs() < 1e-9);
+        let break_time = stroke.break_time.unwrap();
+        assert!((break_time - off).abs() < 1e-12, "{break_time}");
+        let swing = (x_p / (m.gap + x_p)).acos() / omega;
+        let back_make = stroke.back_make.unwrap();
+        assert!(
+            ((back_make - off) / swing - 1.0).abs() < 1e-9,
+            "{back_make}"
+        );
+        let speed = omega * ((m.gap + x_p).powi(2) - x_p * x_p).sqrt();
+        let first = cycle
+            .back
+            .impacts
+            .iter()
+            .find(|i| i.impact_time == back_make)
+            .unwrap();
+        assert!((first.impact_velocity / speed - 1.0).abs() < 1e-9);
+        assert_eq!(first.restitution, Some(e));
+        // The bounces on the rest stop sum to the NC bounce time.
+        let expected: f64 = (1..=stroke.back_bounces as i32)
+            .map(|k| 2.0 / omega * (e.powi(k) * speed / (omega * x_p)).atan())
+            .sum();
+        let bounce = stroke.back_bounce_time().unwrap();
+        assert!(
+            (bounce / expected - 1.0).abs() < 1e-9,
+            "{bounce} {expected}"
+        );
+        assert!(stroke.back_bounces >= 10, "{stroke:?}");
+        // At the end it rests on the stop: the NC contact is closed.
+        assert_eq!(
+            cycle.back.intervals.last().unwrap().state,
+            ContactState::Closed
+        );
+        assert_eq!(
+            cycle.make.intervals.last().unwrap().state,
+            ContactState::Open
+        );
+    }
+
+    #[test]
+    fn every_pulse_is_a_stroke_with_a_deformable_back_stop() {
+        let m = Mechanics {
+            damping: 0.2,
+            ..relay()
+        };
+        let stops = Stops {
+            make: Surface::KelvinVoigt {
+                stiffness: 8e4,
+                damping: 1.5,
+            },
+            back: Some(Surface::KelvinVoigt {
+                stiffness: 4e4,
+                damping: 1.0,
+            }),
+        };
+        let pulses = [(0.0, 10e-3), (20e-3, 30e-3)];
+        let force = |t: f64, _x: f64| {
+            if pulses.iter().any(|&(on, off)| (on..off).contains(&t)) {
+                0.6
+            } else {
+                0.0
+            }
+        };
+        let cycle = simulate_cycle(&m, &stops, &settings(0.04), force).unwrap();
+        assert_eq!(cycle.strokes.len(), 2, "{:?}", cycle.strokes);
+        for (stroke, (on, off)) in cycle.strokes.iter().zip(pulses) {
+            let (first, last) = (stroke.first_make.unwrap(), stroke.last_make.unwrap());
+            let (brk, back) = (stroke.break_time.unwrap(), stroke.back_make.unwrap());
+            assert!(
+                on <= stroke.lift_off && stroke.lift_off < first,
+                "{stroke:?}"
+            );
+            assert!(
+                first <= last && last < off && off < brk && brk < back,
+                "{stroke:?}"
+            );
+            assert!(stroke.bounces > 0 && stroke.back_bounces > 0, "{stroke:?}");
+            assert!(stroke.back_last_make.unwrap() >= back);
+        }
+        // The second stroke starts from the rest where the first left it:
+        // the same closing, shifted by the lift-off.
+        let [a, b] = [&cycle.strokes[0], &cycle.strokes[1]];
+        // The same closing, shifted by the pulse; the second starts out of
+        // the back stop's static dent (p/s_b = 2.5 µm), a little later.
+        let late = (b.first_make.unwrap() - 20e-3) - a.first_make.unwrap();
+        assert!(late > 0.0 && late < 1e-4, "{late}");
+        assert_eq!(a.bounces, b.bounces);
+        // The path moves forward in time and stays between the stops, up
+        // to the surfaces' dent: at most v·√(m/s0), 0.1 mm on the soft
+        // back stop hit at ~1 m/s.
+        assert!(cycle.path.windows(2).all(|w| w[1].0 > w[0].0));
+        assert!(
+            cycle
+                .path
+                .iter()
+                .all(|&(_, x)| (-1e-4..m.gap + 1e-4).contains(&x))
+        );
+        // Intervals tile the run.
+        for chatter in [&cycle.make, &cycle.back] {
+            assert!(chatter.intervals.windows(2).all(|w| w[0].end == w[1].start));
+            assert_eq!(chatter.intervals.last().unwrap().end, 0.04);
+        }
+    }
+}
