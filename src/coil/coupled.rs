@@ -24,7 +24,9 @@ use std::time::{Duration, Instant};
 
 use thiserror::Error;
 
-use super::forced::simulate_forced_path;
+use super::cycle::Stops;
+use super::forced::simulate_cycle;
+use super::timing::{Operation, Switching, operations};
 use super::{Coil, CoilError};
 use crate::chatter::{Chatter, ContactState, Interval};
 use crate::mechanics::Mechanics;
@@ -79,7 +81,15 @@ pub struct Iteration {
 /// A converged coupled run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Coupled {
+    /// The normally-open contact over the whole run (see
+    /// [`super::Cycle::make`]).
     pub chatter: Chatter,
+    /// The rest stop as the normally-closed contact.
+    pub back: Chatter,
+    /// The coil switching found in the circuit.
+    pub switching: Switching,
+    /// Each stroke with its timing.
+    pub operations: Vec<Operation>,
     /// (s, m): the armature's path.
     pub path: Vec<(f64, f64)>,
     /// The circuit's last run (with the final path and chatter, up to the
@@ -97,8 +107,29 @@ pub struct Coupled {
 impl Coupled {
     /// (s, A): the coil current of the last circuit run.
     pub fn current(&self) -> Vec<(f64, f64)> {
-        series(&self.plot, &format!("i(v.{}.vi)", self.coil_instance)).unwrap_or_default()
+        series(&self.plot, &current_vector(&self.coil_instance)).unwrap_or_default()
     }
+
+    /// (s, V): the voltage across the coil in the last circuit run.
+    pub fn voltage(&self) -> Vec<(f64, f64)> {
+        series(&self.plot, &voltage_vector(&self.coil_instance)).unwrap_or_default()
+    }
+}
+
+/// The coil instance's current vector, e.g. `i(v.x2.vi)`.
+pub fn current_vector(instance: &str) -> String {
+    format!("i(v.{instance}.vi)")
+}
+
+/// The vector of the voltage across coil instance `instance`, e.g.
+/// `v(x2.vt)`.
+pub fn voltage_vector(instance: &str) -> String {
+    format!("v({instance}.vt)")
+}
+
+/// The coil's flux-linkage vector, e.g. `v(x2.psi)`.
+pub fn flux_vector(instance: &str) -> String {
+    format!("v({instance}.psi)")
 }
 
 /// Why a coupled run failed.
@@ -217,14 +248,22 @@ pub fn run_coupled(
         iteration: 0,
         source,
     })?;
-    let surface = scenario.surface();
+    let stops = Stops {
+        make: scenario.surface(),
+        back: scenario.back_stop(),
+    };
     let settings = scenario.settings();
     let model = ContactModel::from(&scenario.contact);
-    let signals: Vec<&str> = scenario.probes.iter().map(|p| p.signal.as_str()).collect();
-    let psi = format!("v({coil_instance}.psi)");
+    let psi = flux_vector(coil_instance);
+    let volts = voltage_vector(coil_instance);
+    let current = current_vector(coil_instance);
+    // The coil's own vectors too, in case the netlist `.save`s only some.
+    let mut signals: Vec<&str> = scenario.probes.iter().map(|p| p.signal.as_str()).collect();
+    signals.extend([psi.as_str(), volts.as_str(), current.as_str()]);
 
     // Iteration 0: the armature at rest, the contact open.
     let mut chatter = open_chatter(settings.t_end);
+    let mut back = open_chatter(settings.t_end);
     let mut path = vec![(0.0, m.initial_position)];
     let mut iterations: Vec<Iteration> = Vec::new();
     for iteration in 1..=options.max_iterations {
@@ -285,24 +324,37 @@ pub fn run_coupled(
             vector: psi.clone(),
         })?;
         let pull = |t: f64, _x: f64| coil.force_from_flux(interpolate(&flux, t));
-        let (next, next_path) = simulate_forced_path(&mechanics, &surface, &settings, pull)
-            .map_err(|source| CouplingError::Coil {
-                path: origin.clone(),
-                iteration,
-                source,
+        let cycle =
+            simulate_cycle(&mechanics, &stops, &settings, pull).map_err(|source| {
+                CouplingError::Coil {
+                    path: origin.clone(),
+                    iteration,
+                    source,
+                }
             })?;
-        let change = event_change(&chatter, &next);
+        let change = event_change(&chatter, &cycle.make).max(event_change(&back, &cycle.back));
         iterations.push(Iteration {
-            first_impact: next.first_impact,
-            bounces: next.bounce_count,
+            first_impact: cycle.make.first_impact,
+            bounces: cycle.make.bounce_count,
             change,
             ngspice_elapsed,
         });
-        chatter = next;
-        path = next_path;
+        (chatter, back, path) = (cycle.make, cycle.back, cycle.path);
         if change <= options.tolerance && iteration > 1 {
+            let switching = match (plot.scale(), plot.real(&volts)) {
+                (Some(Vector::Real(time)), Some(v)) => Switching::from_voltage(time, v),
+                _ => {
+                    return Err(CouplingError::MissingVector {
+                        iteration,
+                        vector: volts,
+                    });
+                }
+            };
             return Ok(Coupled {
+                operations: operations(&cycle.strokes, &switching),
+                switching,
                 chatter,
+                back,
                 path,
                 plot,
                 coil_instance: coil_instance.clone(),

@@ -41,9 +41,11 @@ pub mod cycle;
 pub mod direct;
 pub mod forced;
 mod sequence;
+pub mod timing;
 
 pub use coupled::{Coupled, CouplingError, CouplingOptions, run_coupled};
 pub use cycle::{Cycle, Stops, Stroke};
+pub use timing::{Operation, Switching, operations};
 pub use direct::{
     CoilEvents, CoilRun, CoilState, EnergyBalance, PullInDip, Source, simulate_direct,
 };

@@ -19,7 +19,9 @@
 //! ngspice's voltage tolerance. Every corner is a breakpoint.
 //!
 //! The coil current is measured by a zero-volt source `VI` in series:
-//! `i(v.<instance>.vi)` in the raw file (e.g. `i(v.x2.vi)`).
+//! `i(v.<instance>.vi)` in the raw file (e.g. `i(v.x2.vi)`); the voltage
+//! across the coil is repeated on node `vt`, `v(<instance>.vt)`, which
+//! tells when the driver switched the coil on and off.
 
 use super::NetlistError;
 use super::check_subckt_name;
@@ -75,6 +77,8 @@ pub fn coil_include(
         &format!("R_C a n1 {}", format_time(coil.resistance)),
     );
     line(&mut out, "VI n1 n2 0");
+    comment(&mut out, "the voltage across the coil, for its switching instants");
+    line(&mut out, "E_VT vt 0 a b 1");
     comment(
         &mut out,
         "flux linkage: V(psi) = integral of the inductive voltage",

@@ -1,0 +1,177 @@
+//! Relay timing as datasheets state it, from the strokes of a simulated
+//! cycle and the instants the driver switched the coil on and off.
+//!
+//! - **operate time**: coil on → the NO contact closed for good (its last
+//!   make), bounce included; **first make**: coil on → its first touch;
+//! - **bounce time**: first make → last make;
+//! - **release time**: coil off → the NO contact breaks for good;
+//! - **NC make** and **NC bounce time**: coil off → the armature's first
+//!   touch of its rest stop (the normally-closed contact), and from there
+//!   to its last.
+//!
+//! The coil counts as on while the voltage across it exceeds half the
+//! largest it reaches: a driver that saturates puts nearly the supply
+//! across it, and at turn-off the suppression makes it negative.
+
+use serde::Serialize;
+
+use super::cycle::Stroke;
+
+/// The instants the coil was switched, in s.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct Switching {
+    /// Rising edges (0 when energised from the start).
+    pub on: Vec<f64>,
+    /// Falling edges.
+    pub off: Vec<f64>,
+}
+
+impl Switching {
+    /// The edges of the coil voltage `volts` sampled at `time`: crossings
+    /// of half its largest value, interpolated. Nothing when the coil
+    /// never sees a positive voltage.
+    pub fn from_voltage(time: &[f64], volts: &[f64]) -> Switching {
+        let peak = volts.iter().copied().fold(0.0, f64::max);
+        let mut out = Switching::default();
+        if peak <= 0.0 || time.is_empty() {
+            return out;
+        }
+        let level = 0.5 * peak;
+        let mut on = volts[0] > level;
+        if on {
+            out.on.push(time[0]);
+        }
+        for k in 1..time.len().min(volts.len()) {
+            let now = volts[k] > level;
+            if now != on {
+                let (v0, v1) = (volts[k - 1], volts[k]);
+                let frac = if v1 != v0 { (level - v0) / (v1 - v0) } else { 1.0 };
+                let t = time[k - 1] + frac.clamp(0.0, 1.0) * (time[k] - time[k - 1]);
+                if now {
+                    out.on.push(t);
+                } else {
+                    out.off.push(t);
+                }
+                on = now;
+            }
+        }
+        out
+    }
+}
+
+/// One operation of the relay: a stroke and the switching that made it.
+/// Durations are `None` when an instant they need did not happen within
+/// the run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Operation {
+    /// s, the coil switched on before this stroke.
+    pub coil_on: Option<f64>,
+    /// s, the coil switched off after it closed.
+    pub coil_off: Option<f64>,
+    #[serde(flatten)]
+    pub stroke: Stroke,
+    /// s, coil on → first make.
+    pub first_make_time: Option<f64>,
+    /// s, coil on → last make (closed for good).
+    pub operate_time: Option<f64>,
+    /// s, first make → last make.
+    pub bounce_time: Option<f64>,
+    /// s, coil off → the NO contact's break.
+    pub release_time: Option<f64>,
+    /// s, coil off → the first touch of the rest stop (NC make).
+    pub nc_make_time: Option<f64>,
+    /// s, first → last touch of the rest stop.
+    pub nc_bounce_time: Option<f64>,
+}
+
+/// Pair every stroke with the coil switching around it.
+pub fn operations(strokes: &[Stroke], switching: &Switching) -> Vec<Operation> {
+    strokes
+        .iter()
+        .enumerate()
+        .map(|(k, stroke)| {
+            let next = strokes.get(k + 1).map_or(f64::INFINITY, |s| s.lift_off);
+            // Lift-off may only lag the switch-on, by the flux build-up.
+            let coil_on = switching
+                .on
+                .iter()
+                .copied()
+                .filter(|&t| t <= stroke.lift_off)
+                .last();
+            let from = coil_on.unwrap_or(stroke.lift_off);
+            let coil_off = switching
+                .off
+                .iter()
+                .copied()
+                .find(|&t| t >= from && t < next);
+            let since = |a: Option<f64>, b: Option<f64>| Some(b? - a?);
+            Operation {
+                coil_on,
+                coil_off,
+                first_make_time: since(coil_on, stroke.first_make),
+                operate_time: since(coil_on, stroke.last_make),
+                bounce_time: stroke.bounce_time(),
+                release_time: since(coil_off, stroke.break_time),
+                nc_make_time: since(coil_off, stroke.back_make),
+                nc_bounce_time: stroke.back_bounce_time(),
+                stroke: stroke.clone(),
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_coil_switches_where_its_voltage_crosses_half_its_peak() {
+        let time = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0];
+        // Off, on at 4.8 V, flyback to −0.7 V, on again.
+        let volts = [0.0, 4.8, 4.8, -0.7, 4.8, 4.8];
+        let s = Switching::from_voltage(&time, &volts);
+        assert_eq!(s.on, vec![0.5, 3.0 + 3.1 / 5.5]);
+        assert_eq!(s.off.len(), 1);
+        assert!((s.off[0] - (2.0 + 2.4 / 5.5)).abs() < 1e-12);
+        // Never energised: no edges.
+        assert_eq!(Switching::from_voltage(&time, &[0.0; 6]), Switching::default());
+        // Energised from the start.
+        assert_eq!(Switching::from_voltage(&[0.0, 1.0], &[5.0, 5.0]).on, vec![0.0]);
+    }
+
+    #[test]
+    fn durations_run_from_the_switching_that_caused_them() {
+        let stroke = Stroke {
+            lift_off: 1.5e-3,
+            first_make: Some(4e-3),
+            last_make: Some(5e-3),
+            bounces: 3,
+            break_time: Some(21e-3),
+            back_make: Some(23e-3),
+            back_last_make: Some(26e-3),
+            back_bounces: 2,
+        };
+        let switching = Switching {
+            on: vec![0.1e-3],
+            off: vec![20e-3],
+        };
+        let [op] = operations(std::slice::from_ref(&stroke), &switching)
+            .try_into()
+            .unwrap();
+        let close = |a: Option<f64>, b: f64| (a.unwrap() - b).abs() < 1e-15;
+        assert!(close(op.first_make_time, 3.9e-3));
+        assert!(close(op.operate_time, 4.9e-3));
+        assert!(close(op.bounce_time, 1e-3));
+        assert!(close(op.release_time, 1e-3));
+        assert!(close(op.nc_make_time, 3e-3));
+        assert!(close(op.nc_bounce_time, 3e-3));
+        // Not switched off within the run: no release.
+        let on_only = Switching {
+            on: vec![0.1e-3],
+            off: vec![],
+        };
+        let op = &operations(&[stroke], &on_only)[0];
+        assert_eq!(op.release_time, None);
+        assert!(op.operate_time.is_some());
+    }
+}
