@@ -339,7 +339,8 @@ pub fn run_coupled(
             change,
             ngspice_elapsed,
         });
-        (chatter, back, path) = (cycle.make, cycle.back, cycle.path);
+        let tolerance = PATH_TOLERANCE * (coil.air_gap + coil.iron_gap);
+        (chatter, back, path) = (cycle.make, cycle.back, thin(&cycle.path, tolerance));
         if change <= options.tolerance && iteration > 1 {
             let switching = match (plot.scale(), plot.real(&volts)) {
                 (Some(Vector::Real(time)), Some(v)) => Switching::from_voltage(time, v),
@@ -370,6 +371,48 @@ pub fn run_coupled(
         change: iterations.last().map_or(f64::INFINITY, |i| i.change),
         tolerance: options.tolerance,
     })
+}
+
+/// How closely the armature path given to the circuit follows the
+/// mechanics, relative to the total air gap at rest: the coil current
+/// `ψ (g_a + l_eq − x)/(μ0 N² A)` then moves by less than 1e-4 of itself
+/// wherever the armature is (the smallest gap left, at the contact, is
+/// some tenths of the gap at rest), far below what moves an impact by
+/// the coupling's tolerance; a flight is then some hundred points, as
+/// many as ngspice's own steps over it.
+const PATH_TOLERANCE: f64 = 1e-5;
+
+/// The points of `path` (s, m) that its linear interpolation needs to
+/// stay within `tolerance` (m) of every point: the integrator's steps
+/// are far denser than the path's shape needs (thousands of them while
+/// the contact rests), and each one would be a breakpoint for ngspice.
+/// The first and last points are always kept.
+pub fn thin(path: &[(f64, f64)], tolerance: f64) -> Vec<(f64, f64)> {
+    let Some(&first) = path.first() else {
+        return Vec::new();
+    };
+    let mut out = vec![first];
+    let mut start = 0;
+    let mut end = 2;
+    while end < path.len() {
+        let (t0, x0) = path[start];
+        let (t1, x1) = path[end];
+        let fits = path[start + 1..end].iter().all(|&(t, x)| {
+            let line = x0 + (x1 - x0) * (t - t0) / (t1 - t0);
+            (x - line).abs() <= tolerance
+        });
+        if fits {
+            end += 1;
+        } else {
+            start = end - 1;
+            out.push(path[start]);
+            end = start + 2;
+        }
+    }
+    if path.len() > 1 {
+        out.push(path[path.len() - 1]);
+    }
+    out
 }
 
 /// A contact open from 0 to `t_end`: before the first iteration.
@@ -423,5 +466,39 @@ fn interpolate(samples: &[(f64, f64)], t: f64) -> f64 {
         v0 + (v1 - v0) * (t - t0) / (t1 - t0)
     } else {
         v1
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn thinning_keeps_the_shape_within_the_tolerance() {
+        // A parabola sampled finely, then a long rest.
+        let mut path: Vec<(f64, f64)> = (0..=1000)
+            .map(|k| {
+                let t = f64::from(k) * 1e-6;
+                (t, 4e-4 * (t / 1e-3).powi(2))
+            })
+            .collect();
+        path.extend((1..=1000).map(|k| (1e-3 + f64::from(k) * 1e-6, 4e-4)));
+        let tol = 1e-9;
+        let thin = thin(&path, tol);
+        // A chord of a parabola x'' = 800 m/s² is off by x''·h²/8 at its
+        // middle: 1 nm allows h = 3.2 µs, some 320 chords for the
+        // millisecond, and one for the rest.
+        assert!((300..360).contains(&thin.len()), "{}", thin.len());
+        assert_eq!(thin.first(), path.first());
+        assert_eq!(thin.last(), path.last());
+        // Every original point is within the tolerance of the thinned line.
+        for &(t, x) in &path {
+            let k = thin.partition_point(|p| p.0 <= t).clamp(1, thin.len() - 1);
+            let ((t0, x0), (t1, x1)) = (thin[k - 1], thin[k]);
+            let line = x0 + (x1 - x0) * (t - t0) / (t1 - t0);
+            assert!((x - line).abs() <= tol * (1.0 + 1e-9), "{t} {x} {line}");
+        }
+        assert_eq!(super::thin(&path[..1], tol), path[..1].to_vec());
+        assert!(super::thin(&[], tol).is_empty());
     }
 }
