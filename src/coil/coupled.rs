@@ -55,12 +55,15 @@ pub struct CouplingOptions {
 
 impl Default for CouplingOptions {
     /// 0.1 µs is far below any relay's bounce (tens of µs) and well above
-    /// the integrators' precision; ten iterations are plenty for a coil
-    /// whose back-EMF changes its current by tens of percent.
+    /// the integrators' precision. A closing converges in about five
+    /// iterations; a whole cycle takes more, as each pass settles the
+    /// events a little further along (a slow release, whose break moves
+    /// with every small change of the held current, took eleven): twenty
+    /// allows for both.
     fn default() -> Self {
         CouplingOptions {
             tolerance: 1e-7,
-            max_iterations: 10,
+            max_iterations: 20,
             timeout: RunRequest::DEFAULT_TIMEOUT,
         }
     }
@@ -324,14 +327,13 @@ pub fn run_coupled(
             vector: psi.clone(),
         })?;
         let pull = |t: f64, _x: f64| coil.force_from_flux(interpolate(&flux, t));
-        let cycle =
-            simulate_cycle(&mechanics, &stops, &settings, pull).map_err(|source| {
-                CouplingError::Coil {
-                    path: origin.clone(),
-                    iteration,
-                    source,
-                }
-            })?;
+        let cycle = simulate_cycle(&mechanics, &stops, &settings, pull).map_err(|source| {
+            CouplingError::Coil {
+                path: origin.clone(),
+                iteration,
+                source,
+            }
+        })?;
         let change = event_change(&chatter, &cycle.make).max(event_change(&back, &cycle.back));
         iterations.push(Iteration {
             first_impact: cycle.make.first_impact,
@@ -342,15 +344,19 @@ pub fn run_coupled(
         let tolerance = PATH_TOLERANCE * (coil.air_gap + coil.iron_gap);
         (chatter, back, path) = (cycle.make, cycle.back, thin(&cycle.path, tolerance));
         if change <= options.tolerance && iteration > 1 {
-            let switching = match (plot.scale(), plot.real(&volts)) {
-                (Some(Vector::Real(time)), Some(v)) => Switching::from_voltage(time, v),
-                _ => {
-                    return Err(CouplingError::MissingVector {
-                        iteration,
-                        vector: volts,
-                    });
-                }
+            let vector = |name: &str| {
+                plot.real(name).ok_or_else(|| CouplingError::MissingVector {
+                    iteration,
+                    vector: name.to_owned(),
+                })
             };
+            let Some(Vector::Real(time)) = plot.scale() else {
+                return Err(CouplingError::MissingVector {
+                    iteration,
+                    vector: "time".to_owned(),
+                });
+            };
+            let switching = Switching::from_coil(time, vector(&volts)?, vector(&current)?);
             return Ok(Coupled {
                 operations: operations(&cycle.strokes, &switching),
                 switching,

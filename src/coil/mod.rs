@@ -45,11 +45,11 @@ pub mod timing;
 
 pub use coupled::{Coupled, CouplingError, CouplingOptions, run_coupled};
 pub use cycle::{Cycle, Stops, Stroke};
-pub use timing::{Operation, Switching, operations};
 pub use direct::{
     CoilEvents, CoilRun, CoilState, EnergyBalance, PullInDip, Source, simulate_direct,
 };
 pub use forced::{simulate_cycle, simulate_forced, simulate_forced_path};
+pub use timing::{Operation, Switching, operations};
 
 use thiserror::Error;
 

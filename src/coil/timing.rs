@@ -11,7 +11,11 @@
 //!
 //! The coil counts as on while the voltage across it exceeds half the
 //! largest it reaches: a driver that saturates puts nearly the supply
-//! across it, and at turn-off the suppression makes it negative.
+//! across it, and at turn-off the suppression makes it negative. Once the
+//! suppression has let the current die, the coil rings with the circuit's
+//! junction capacitances (tens of kHz, some volts): an "on" that carries
+//! less than a tenth of the peak coil current is such ringing, not a
+//! drive, and is dropped.
 
 use serde::Serialize;
 
@@ -27,10 +31,34 @@ pub struct Switching {
 }
 
 impl Switching {
-    /// The edges of the coil voltage `volts` sampled at `time`: crossings
-    /// of half its largest value, interpolated. Nothing when the coil
-    /// never sees a positive voltage.
-    pub fn from_voltage(time: &[f64], volts: &[f64]) -> Switching {
+    /// The edges of the coil voltage `volts` sampled at `time`, the coil
+    /// carrying `current`: crossings of half the largest voltage,
+    /// interpolated, of the pulses that drive a current (see the module
+    /// docs). Nothing when the coil never sees a positive voltage.
+    pub fn from_coil(time: &[f64], volts: &[f64], current: &[f64]) -> Switching {
+        let edges = Switching::from_voltage(time, volts);
+        let peak = current.iter().copied().fold(0.0, f64::max);
+        let mut out = Switching::default();
+        for &on in &edges.on {
+            let off = edges.off.iter().copied().find(|&t| t > on);
+            let lo = time.partition_point(|&t| t < on);
+            let hi = off.map_or(time.len(), |t| time.partition_point(|&s| s <= t));
+            let drives = current[lo..hi.min(current.len())]
+                .iter()
+                .any(|&i| i >= 0.1 * peak);
+            if drives && peak > 0.0 {
+                out.on.push(on);
+                if let Some(off) = off {
+                    out.off.push(off);
+                }
+            }
+        }
+        out
+    }
+
+    /// The edges of the coil voltage alone: every crossing of half its
+    /// largest value, interpolated.
+    fn from_voltage(time: &[f64], volts: &[f64]) -> Switching {
         let peak = volts.iter().copied().fold(0.0, f64::max);
         let mut out = Switching::default();
         if peak <= 0.0 || time.is_empty() {
@@ -45,7 +73,11 @@ impl Switching {
             let now = volts[k] > level;
             if now != on {
                 let (v0, v1) = (volts[k - 1], volts[k]);
-                let frac = if v1 != v0 { (level - v0) / (v1 - v0) } else { 1.0 };
+                let frac = if v1 != v0 {
+                    (level - v0) / (v1 - v0)
+                } else {
+                    1.0
+                };
                 let t = time[k - 1] + frac.clamp(0.0, 1.0) * (time[k] - time[k - 1]);
                 if now {
                     out.on.push(t);
@@ -96,8 +128,8 @@ pub fn operations(strokes: &[Stroke], switching: &Switching) -> Vec<Operation> {
                 .on
                 .iter()
                 .copied()
-                .filter(|&t| t <= stroke.lift_off)
-                .last();
+                .rev()
+                .find(|&t| t <= stroke.lift_off);
             let from = coil_on.unwrap_or(stroke.lift_off);
             let coil_off = switching
                 .off
@@ -134,9 +166,29 @@ mod tests {
         assert_eq!(s.off.len(), 1);
         assert!((s.off[0] - (2.0 + 2.4 / 5.5)).abs() < 1e-12);
         // Never energised: no edges.
-        assert_eq!(Switching::from_voltage(&time, &[0.0; 6]), Switching::default());
+        assert_eq!(
+            Switching::from_voltage(&time, &[0.0; 6]),
+            Switching::default()
+        );
         // Energised from the start.
-        assert_eq!(Switching::from_voltage(&[0.0, 1.0], &[5.0, 5.0]).on, vec![0.0]);
+        assert_eq!(
+            Switching::from_voltage(&[0.0, 1.0], &[5.0, 5.0]).on,
+            vec![0.0]
+        );
+    }
+
+    #[test]
+    fn ringing_after_the_flyback_is_not_a_drive() {
+        let time: Vec<f64> = (0..10).map(f64::from).collect();
+        // A drive pulse 1..3, then ringing through ±5 V with no current.
+        let volts = [0.0, 5.0, 5.0, -25.0, 5.5, -4.0, 5.0, -3.0, 0.0, 0.0];
+        let current = [0.0, 0.02, 0.05, 0.01, 1e-5, -1e-5, 1e-5, 0.0, 0.0, 0.0];
+        let s = Switching::from_coil(&time, &volts, &current);
+        assert_eq!(s.on.len(), 1, "{s:?}");
+        assert_eq!(s.off.len(), 1, "{s:?}");
+        assert!(s.on[0] < 1.0 && s.off[0] > 2.0 && s.off[0] < 3.0, "{s:?}");
+        // The voltage alone sees three pulses.
+        assert_eq!(Switching::from_voltage(&time, &volts).on.len(), 3);
     }
 
     #[test]

@@ -77,7 +77,10 @@ pub fn coil_include(
         &format!("R_C a n1 {}", format_time(coil.resistance)),
     );
     line(&mut out, "VI n1 n2 0");
-    comment(&mut out, "the voltage across the coil, for its switching instants");
+    comment(
+        &mut out,
+        "the voltage across the coil, for its switching instants",
+    );
     line(&mut out, "E_VT vt 0 a b 1");
     comment(
         &mut out,
