@@ -29,6 +29,7 @@ use thiserror::Error;
 
 use crate::analysis::ProbeAnalysis;
 use crate::chatter::Chatter;
+use crate::coil::Operation;
 use crate::mechanics::{MechanicsError, simulate};
 use crate::pipeline::{self, RunError, RunOptions, RunResult};
 use crate::report::units::engineering;
@@ -173,7 +174,8 @@ pub fn quantity(value: f64, unit: &str) -> String {
 pub enum CheckError {
     #[error(
         "{}: nothing to check: add a [limits] section (max_bounce_time, max_bounces, \
-         max_operate_time, max_first_make) or limits on a [[probe]] (max_edges, \
+         max_operate_time, max_first_make; with a coil max_release_time, \
+         max_nc_bounce_time, max_nc_bounces) or limits on a [[probe]] (max_edges, \
          max_glitches, max_peak, max_value, min_value, max_last_edge)",
         path.display()
     )]
@@ -190,8 +192,13 @@ pub enum CheckError {
     Run(#[from] Box<RunError>),
 }
 
-/// The relay's limits against a chatter sequence.
-pub fn relay_checks(limits: &LimitsSection, chatter: &Chatter) -> Vec<LimitCheck> {
+/// The relay's limits against a chatter sequence and, for a coil-driven
+/// relay, its operations (the release limits hold for every one).
+pub fn relay_checks(
+    limits: &LimitsSection,
+    chatter: &Chatter,
+    operations: &[Operation],
+) -> Vec<LimitCheck> {
     let never = |what: &str| format!("the contact {what} ({})", chatter.outcome);
     let settle = chatter
         .settle_time
@@ -240,6 +247,49 @@ pub fn relay_checks(limits: &LimitsSection, chatter: &Chatter) -> Vec<LimitCheck
             Bound::Max,
             limit,
             settle,
+        ));
+    }
+    let worst = |what: &str, get: &dyn Fn(&Operation) -> Option<f64>| {
+        let values: Vec<f64> = operations.iter().filter_map(get).collect();
+        if values.is_empty() {
+            Err(format!(
+                "no {what}: the coil is not switched off after the contact closed, within \
+                 `simulation.t_end`"
+            ))
+        } else {
+            Ok(values.into_iter().fold(f64::NEG_INFINITY, f64::max))
+        }
+    };
+    if let Some(limit) = limits.max_release_time {
+        out.push(LimitCheck::new(
+            "limits.max_release_time".into(),
+            "release time".into(),
+            "s",
+            Bound::Max,
+            limit,
+            worst("release", &|op| op.release_time),
+        ));
+    }
+    if let Some(limit) = limits.max_nc_bounce_time {
+        out.push(LimitCheck::new(
+            "limits.max_nc_bounce_time".into(),
+            "NC bounce time".into(),
+            "s",
+            Bound::Max,
+            limit,
+            worst("NC bounce", &|op| op.nc_bounce_time),
+        ));
+    }
+    if let Some(limit) = limits.max_nc_bounces {
+        out.push(LimitCheck::new(
+            "limits.max_nc_bounces".into(),
+            "NC bounces".into(),
+            "",
+            Bound::Max,
+            limit as f64,
+            worst("NC bounce", &|op| {
+                op.nc_bounce_time.map(|_| op.stroke.back_bounces as f64)
+            }),
         ));
     }
     out
@@ -320,7 +370,7 @@ pub fn evaluate(scenario: &Scenario, run: &RunResult) -> Verdict {
     let mut checks = scenario
         .limits
         .as_ref()
-        .map(|l| relay_checks(l, &run.chatter))
+        .map(|l| relay_checks(l, &run.chatter, &run.operations))
         .unwrap_or_default();
     for (i, (probe, result)) in scenario.probes.iter().zip(&run.probes).enumerate() {
         checks.extend(probe_checks(i, probe, &result.analysis));
@@ -393,7 +443,7 @@ pub fn relay_only(scenario: &Scenario) -> Result<(Verdict, Evidence), CheckError
     let checks = scenario
         .limits
         .as_ref()
-        .map(|l| relay_checks(l, &chatter))
+        .map(|l| relay_checks(l, &chatter, &[]))
         .unwrap_or_default();
     Ok((Verdict::new(checks), Evidence::Mechanics(chatter)))
 }
@@ -410,9 +460,9 @@ mod tests {
             max_bounces: Some(1),
             max_bounce_time: Some(1e-3),
             max_operate_time: Some(1e-3),
-            max_first_make: None,
+            ..LimitsSection::default()
         };
-        let checks = relay_checks(&limits, &chatter);
+        let checks = relay_checks(&limits, &chatter, &[]);
         let by_key = |k: &str| checks.iter().find(|c| c.key == k).unwrap();
         let bounces = by_key("limits.max_bounces");
         assert!(!bounces.passed);
@@ -430,6 +480,54 @@ mod tests {
     }
 
     #[test]
+    fn release_limits_hold_for_the_worst_operation() {
+        use crate::coil::{Stroke, Switching, operations};
+        let stroke = |lift_off: f64, nc_bounces: usize| Stroke {
+            lift_off,
+            first_make: Some(lift_off + 2e-3),
+            last_make: Some(lift_off + 3e-3),
+            bounces: 2,
+            break_time: Some(lift_off + 12e-3),
+            back_make: Some(lift_off + 13e-3),
+            back_last_make: Some(lift_off + 13e-3 + 0.5e-3 * nc_bounces as f64),
+            back_bounces: nc_bounces,
+        };
+        // Two operations: released 2 ms and 4 ms after the coil went off.
+        let switching = Switching {
+            on: vec![0.0, 20e-3],
+            off: vec![10e-3, 28e-3],
+        };
+        let ops = operations(&[stroke(1e-3, 2), stroke(21e-3, 4)], &switching);
+        let limits = LimitsSection {
+            max_release_time: Some(3e-3),
+            max_nc_bounce_time: Some(3e-3),
+            max_nc_bounces: Some(4),
+            ..LimitsSection::default()
+        };
+        let checks = relay_checks(&limits, &fixtures::stuck(), &ops);
+        let by_key = |k: &str| checks.iter().find(|c| c.key == k).unwrap();
+        let release = by_key("limits.max_release_time");
+        assert!(!release.passed);
+        assert!(
+            (release.actual.unwrap() - 5e-3).abs() < 1e-12,
+            "{release:?}"
+        );
+        let nc = by_key("limits.max_nc_bounce_time");
+        assert!(
+            nc.passed && (nc.actual.unwrap() - 2e-3).abs() < 1e-12,
+            "{nc:?}"
+        );
+        assert_eq!(by_key("limits.max_nc_bounces").actual, Some(4.0));
+        // No release within the run: the limit fails and says why.
+        let held = relay_checks(&limits, &fixtures::stuck(), &[]);
+        assert!(
+            held.iter().all(|c| !c.passed && c.note.is_some()),
+            "{held:?}"
+        );
+        assert!(held[0].note.as_deref().unwrap().contains("switched off"));
+    }
+
+    #[test]
     fn a_relay_that_never_closes_fails_every_relay_limit_with_a_reason() {
         let chatter = fixtures::never_closes();
         let limits = LimitsSection {
@@ -437,8 +535,9 @@ mod tests {
             max_bounce_time: Some(1.0),
             max_operate_time: Some(1.0),
             max_first_make: Some(1.0),
+            ..LimitsSection::default()
         };
-        let checks = relay_checks(&limits, &chatter);
+        let checks = relay_checks(&limits, &chatter, &[]);
         assert_eq!(checks.len(), 4);
         for c in &checks {
             assert!(!c.passed, "{c:?}");

@@ -25,7 +25,7 @@ use thiserror::Error;
 use crate::analysis::{self, AnalysisError, Comparison, ProbeAnalysis};
 use crate::chatter::{Chatter, ContactState, Interval};
 use crate::coil::coupled::Iteration;
-use crate::coil::{CouplingError, CouplingOptions, run_coupled};
+use crate::coil::{CouplingError, CouplingOptions, Operation, run_coupled};
 use crate::mechanics::{MechanicsError, contact_forces, simulate};
 use crate::netlist::{self, ContactElement, ContactInclude, Deck, DeckRequest, NetlistError};
 use crate::rawfile::Plot;
@@ -186,6 +186,9 @@ pub struct RunResult {
     /// For a coil-driven relay: the passes of the coupling, the last one
     /// converged.
     pub coupling: Option<Vec<Iteration>>,
+    /// For a coil-driven relay: each operation (closing and release) with
+    /// its timing. Empty for a step force.
+    pub operations: Vec<Operation>,
 }
 
 /// Run the whole pipeline on `scenario` with `runner`. A scenario with a
@@ -342,6 +345,7 @@ fn run_chatter(
     warnings.extend(simulation.warnings.iter().cloned());
     Ok(RunResult {
         coupling: None,
+        operations: Vec::new(),
         netlist: netlist_path,
         chatter,
         waveform,
@@ -455,6 +459,7 @@ fn run_coil(
         probes,
         warnings,
         coupling: Some(coupled.iterations),
+        operations: coupled.operations,
     })
 }
 

@@ -326,6 +326,14 @@ pub struct LimitsSection {
     pub max_operate_time: Option<f64>,
     /// s, the first impact (first make).
     pub max_first_make: Option<f64>,
+    /// s, coil off → the NO contact's break, in every operation (a
+    /// coil-driven relay only).
+    pub max_release_time: Option<f64>,
+    /// s, the bounce of the armature on its rest stop (the NC contact)
+    /// after each release, first touch to last.
+    pub max_nc_bounce_time: Option<f64>,
+    /// Most NC bounces after each release.
+    pub max_nc_bounces: Option<u64>,
 }
 
 /// The file as serde sees it; [`Scenario`] adds the origin and the
@@ -940,6 +948,7 @@ impl Check<'_> {
         }
         if let Some(limits) = &d.limits {
             self.limits(limits)?;
+            self.release_limits(limits, d.coil.is_some())?;
         }
         Ok((surface, back_stop))
     }
@@ -1390,12 +1399,41 @@ impl Check<'_> {
                 l.max_first_make,
                 "the latest first impact allowed, in s",
             ),
+            (
+                "limits.max_release_time",
+                l.max_release_time,
+                "the longest release time allowed (coil off → the NO contact breaks), in s",
+            ),
+            (
+                "limits.max_nc_bounce_time",
+                l.max_nc_bounce_time,
+                "the longest NC bounce allowed after a release, in s",
+            ),
         ] {
             if let Some(v) = value {
                 self.number(key, v, v > 0.0, format!("must be > 0: {what}"))?;
             }
         }
         Ok(())
+    }
+
+    /// The release limits need a coil: a step force never releases.
+    fn release_limits(&self, l: &LimitsSection, coil: bool) -> Result<(), ScenarioError> {
+        let given = [
+            ("limits.max_release_time", l.max_release_time.is_some()),
+            ("limits.max_nc_bounce_time", l.max_nc_bounce_time.is_some()),
+            ("limits.max_nc_bounces", l.max_nc_bounces.is_some()),
+        ];
+        match given.iter().find(|(_, set)| *set) {
+            Some((key, _)) if !coil => Err(ScenarioError::Conflict {
+                at: self.at(key),
+                key: (*key).to_owned(),
+                other: "mechanics.force".to_owned(),
+                advice: "a release needs a coil that is switched off: with a step force the \
+                         contact never releases; give a [coil] or remove the limit",
+            }),
+            _ => Ok(()),
+        }
     }
 }
 

@@ -12,6 +12,7 @@ use serde::Serialize;
 use crate::analysis::{Comparison, ProbeAnalysis};
 use crate::chatter::Chatter;
 use crate::check::{Evidence, Verdict};
+use crate::coil::Operation;
 use crate::coil::coupled::Iteration;
 use crate::mechanics::Dimensionless;
 use crate::pipeline::{RunResult, Simulation};
@@ -89,6 +90,9 @@ pub struct RunJson<'a> {
     /// The coupling's passes, for a coil-driven relay.
     #[serde(skip_serializing_if = "Option::is_none")]
     coupling: Option<&'a [Iteration]>,
+    /// Each closing and release of a coil-driven relay, with its timing.
+    #[serde(skip_serializing_if = "<[_]>::is_empty")]
+    operations: &'a [Operation],
 }
 
 /// One probe: the contract's fields (flattened from the analysis), then
@@ -158,6 +162,7 @@ impl<'a> RunJson<'a> {
             netlist: run.netlist.display().to_string(),
             warnings: &run.warnings,
             coupling: run.coupling.as_deref(),
+            operations: &run.operations,
         }
     }
 }

@@ -12,6 +12,7 @@ use super::units::engineering;
 use crate::analysis::ProbeAnalysis;
 use crate::chatter::{Chatter, Impact, Outcome};
 use crate::check::{Bound, Verdict, quantity};
+use crate::coil::Operation;
 use crate::pipeline::RunResult;
 
 /// Summary and impact table, `\n`-terminated.
@@ -136,6 +137,9 @@ pub fn render_run(run: &RunResult) -> String {
                 engineering(last, "s")
             ),
         ));
+    }
+    for (k, op) in run.operations.iter().enumerate() {
+        lines.push(("", operation_line(k + 1, op)));
     }
     for (label, value) in lines {
         let _ = writeln!(out, "{label:<8} {value}");
@@ -462,4 +466,36 @@ simulated to  20.0000 ms
         assert_eq!(sig(Some(0.0), " µm"), "0 µm");
         assert_eq!(sig(None, ""), "-");
     }
+}
+
+/// One operation of a coil-driven relay: what the coil did and how the
+/// contacts answered, times from the coil's switching.
+fn operation_line(number: usize, op: &Operation) -> String {
+    let time = |t: Option<f64>| t.map_or_else(|| "-".to_owned(), |t| engineering(t, "s"));
+    let mut line = format!("operation {number}: coil on {}", time(op.coil_on));
+    let s = &op.stroke;
+    if s.first_make.is_some() {
+        let _ = write!(
+            line,
+            ", first make +{}, operate +{} ({} bounces in {})",
+            time(op.first_make_time),
+            time(op.operate_time),
+            s.bounces,
+            time(op.bounce_time)
+        );
+    } else {
+        line.push_str(", never makes");
+    }
+    if let Some(off) = op.coil_off {
+        let _ = write!(
+            line,
+            "; coil off {}, release +{}, NC make +{} ({} bounces in {})",
+            time(Some(off)),
+            time(op.release_time),
+            time(op.nc_make_time),
+            s.back_bounces,
+            time(op.nc_bounce_time)
+        );
+    }
+    line
 }
