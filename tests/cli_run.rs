@@ -366,8 +366,20 @@ fn run_couples_a_coil_driven_relay_in_its_transistor_driver() {
     .unwrap();
     let bounces = v["bounce"]["bounce_count"].as_u64().unwrap();
     assert!(bounces >= 1);
-    // The contact pulls a bare pull-up: every bounce is an edge pair.
-    assert_eq!(v["probes"][0]["edges"].as_u64().unwrap(), 1 + 2 * bounces);
+    // The contact pulls a bare pull-up: every bounce is an edge pair, and
+    // the release at the end of the drive pulse one more edge.
+    assert_eq!(v["probes"][0]["edges"].as_u64().unwrap(), 2 + 2 * bounces);
+    let op = &v["operations"][0];
+    assert_eq!(op["bounces"].as_u64(), Some(bounces));
+    let break_time = op["break_time"].as_f64().unwrap();
+    let last_edge = v["probes"][0]["last_edge"].as_f64().unwrap();
+    assert!(
+        (last_edge - break_time).abs() < 1e-6,
+        "{last_edge} {break_time}"
+    );
+    let release = op["release_time"].as_f64().unwrap();
+    let off = op["coil_off"].as_f64().unwrap();
+    assert!((off + release - break_time).abs() < 1e-12);
     let passes = v["coupling"].as_array().unwrap();
     assert!(passes.len() >= 2);
     assert!(passes.last().unwrap()["change"].as_f64().unwrap() <= 1e-7);
