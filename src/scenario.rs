@@ -1592,6 +1592,12 @@ pub const NUMBER_KEYS: &[&str] = &[
     "surface.exponent",
     "surface.chi",
     "surface.reference_velocity",
+    "back_stop.stiffness",
+    "back_stop.damping",
+    "back_stop.restitution",
+    "back_stop.exponent",
+    "back_stop.chi",
+    "back_stop.reference_velocity",
     "contact.r_closed",
     "contact.r_open",
     "contact.edge_time",
@@ -1653,6 +1659,20 @@ macro_rules! number_field {
             "surface.exponent" => Field::Optional($($r)* s.surface.exponent),
             "surface.chi" => Field::Optional($($r)* s.surface.chi),
             "surface.reference_velocity" => Field::Optional($($r)* s.surface.reference_velocity),
+            "back_stop.stiffness" | "back_stop.damping" | "back_stop.restitution"
+            | "back_stop.exponent" | "back_stop.chi" | "back_stop.reference_velocity" => {
+                match $($r)* s.back_stop {
+                    Some(b) => Field::Optional(match $key {
+                        "back_stop.stiffness" => $($r)* b.stiffness,
+                        "back_stop.damping" => $($r)* b.damping,
+                        "back_stop.restitution" => $($r)* b.restitution,
+                        "back_stop.exponent" => $($r)* b.exponent,
+                        "back_stop.chi" => $($r)* b.chi,
+                        _ => $($r)* b.reference_velocity,
+                    }),
+                    None => Field::NoSection("[back_stop]"),
+                }
+            }
             "contact.r_closed" => Field::Plain($($r)* s.contact.r_closed),
             "contact.r_open" => Field::Plain($($r)* s.contact.r_open),
             "contact.edge_time" => Field::Plain($($r)* s.contact.edge_time),
@@ -2373,6 +2393,36 @@ high = 2.31
         let err = s.mechanics().unwrap_err();
         assert!(matches!(err, ScenarioError::CoilDriveUnsupported { .. }));
         assert!(err.to_string().contains("mechanics.force"), "{err}");
+    }
+
+    #[test]
+    fn a_back_stop_has_a_surface_law_of_its_own_and_needs_a_coil() {
+        let coil = format!("{}{COIL}", edit("force = 0.5\n", ""));
+        let back = "\n[back_stop]\nlaw = \"rigid\"\nrestitution = 0.4\n";
+        let mut s = parse(&format!("{coil}{back}")).unwrap();
+        assert_eq!(s.back_stop(), Some(Surface::Rigid { restitution: 0.4 }));
+        assert_eq!(parse(&coil).unwrap().back_stop(), None);
+        // Its keys are named as its own, and settable for sweeps.
+        fails_on(
+            &format!("{coil}{}", back.replace("0.4", "1.5")),
+            "back_stop.restitution",
+        );
+        fails_on(&format!("{coil}{back}damping = 1.0\n"), "back_stop.damping");
+        s.set_number("back_stop.restitution", 0.2).unwrap();
+        assert_eq!(s.back_stop(), Some(Surface::Rigid { restitution: 0.2 }));
+        assert!(s.set_number("back_stop.restitution", 2.0).is_err());
+        assert_eq!(s.back_stop(), Some(Surface::Rigid { restitution: 0.2 }));
+        // A step force never releases: a back stop or a release limit
+        // without a coil is refused, naming what to change.
+        let err = fails_on(&format!("{VALID}{back}"), "back_stop");
+        assert!(err.to_string().contains("[coil]"), "{err}");
+        fails_on(
+            &format!("{VALID}\n[limits]\nmax_release_time = 1e-3\n"),
+            "limits.max_release_time",
+        );
+        let limits = "\n[limits]\nmax_release_time = 1e-3\nmax_nc_bounces = 3\n";
+        let s = parse(&format!("{coil}{limits}")).unwrap();
+        assert_eq!(s.limits.unwrap().max_nc_bounces, Some(3));
     }
 
     #[test]

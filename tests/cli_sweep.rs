@@ -468,3 +468,54 @@ fn an_ngspice_sweep_holds_each_sample_against_the_probe_limits() {
     }
     assert!(failing > 0, "{text}");
 }
+
+/// The coil-driven relay of examples/scenarios/relay-driver.toml with
+/// `sweep` appended, written to `dir/coil.toml`.
+fn coil_scenario(dir: &Path, sweep: &str) -> PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(root.join("examples/scenarios/relay-driver.toml"))
+        .unwrap()
+        .replace(
+            "../../netlists/relay_driver_diode.cir",
+            &root
+                .join("netlists/relay_driver_diode.cir")
+                .to_string_lossy(),
+        );
+    let path = dir.join("coil.toml");
+    std::fs::write(&path, format!("{text}\n{sweep}\n")).unwrap();
+    path
+}
+
+#[test]
+fn a_coil_driven_relay_sweeps_its_release_through_the_circuit() {
+    let _ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    let s = coil_scenario(
+        dir.path(),
+        "[sweep]\nsamples = 2\nseed = 3\n[sweep.vary]\n\"coil.resistance\" = 0.05",
+    );
+    let csv = String::from_utf8(sweep_csv(&s, dir.path(), "out", &["--jobs", "2"])).unwrap();
+    let mut rows = csv::Reader::from_reader(csv.as_bytes());
+    let header = rows.headers().unwrap().clone();
+    let column = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let (release, nc) = (column("release_time"), column("nc_bounce_time"));
+    let records: Vec<csv::StringRecord> = rows.records().map(Result::unwrap).collect();
+    assert_eq!(records.len(), 2);
+    for r in &records {
+        assert_eq!(&r[column("error")], "", "{r:?}");
+        // The plain diode releases in some 15 ms (README).
+        let t: f64 = r[release].parse().unwrap();
+        assert!((5e-3..30e-3).contains(&t), "{r:?}");
+        let b: f64 = r[nc].parse().unwrap();
+        assert!(b > 0.0, "{r:?}");
+    }
+    // The relay moves only in its circuit.
+    chatterspice()
+        .arg("sweep")
+        .arg(&s)
+        .args(["--mechanics-only", "--out"])
+        .arg(dir.path().join("mech"))
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("--mechanics-only"));
+}

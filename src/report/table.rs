@@ -399,6 +399,38 @@ fn sig(value: Option<f64>, unit: &str) -> String {
     format!("{v:.decimals$}{unit}")
 }
 
+/// One operation of a coil-driven relay: what the coil did and how the
+/// contacts answered, times from the coil's switching.
+fn operation_line(number: usize, op: &Operation) -> String {
+    let time = |t: Option<f64>| t.map_or_else(|| "-".to_owned(), |t| engineering(t, "s"));
+    let mut line = format!("operation {number}: coil on {}", time(op.coil_on));
+    let s = &op.stroke;
+    if s.first_make.is_some() {
+        let _ = write!(
+            line,
+            ", first make +{}, operate +{} ({} bounces in {})",
+            time(op.first_make_time),
+            time(op.operate_time),
+            s.bounces,
+            time(op.bounce_time)
+        );
+    } else {
+        line.push_str(", never makes");
+    }
+    if let Some(off) = op.coil_off {
+        let _ = write!(
+            line,
+            "; coil off {}, release +{}, NC make +{} ({} bounces in {})",
+            time(Some(off)),
+            time(op.release_time),
+            time(op.nc_make_time),
+            s.back_bounces,
+            time(op.nc_bounce_time)
+        );
+    }
+    line
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -466,36 +498,4 @@ simulated to  20.0000 ms
         assert_eq!(sig(Some(0.0), " µm"), "0 µm");
         assert_eq!(sig(None, ""), "-");
     }
-}
-
-/// One operation of a coil-driven relay: what the coil did and how the
-/// contacts answered, times from the coil's switching.
-fn operation_line(number: usize, op: &Operation) -> String {
-    let time = |t: Option<f64>| t.map_or_else(|| "-".to_owned(), |t| engineering(t, "s"));
-    let mut line = format!("operation {number}: coil on {}", time(op.coil_on));
-    let s = &op.stroke;
-    if s.first_make.is_some() {
-        let _ = write!(
-            line,
-            ", first make +{}, operate +{} ({} bounces in {})",
-            time(op.first_make_time),
-            time(op.operate_time),
-            s.bounces,
-            time(op.bounce_time)
-        );
-    } else {
-        line.push_str(", never makes");
-    }
-    if let Some(off) = op.coil_off {
-        let _ = write!(
-            line,
-            "; coil off {}, release +{}, NC make +{} ({} bounces in {})",
-            time(Some(off)),
-            time(op.release_time),
-            time(op.nc_make_time),
-            s.back_bounces,
-            time(op.nc_bounce_time)
-        );
-    }
-    line
 }

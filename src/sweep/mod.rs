@@ -80,6 +80,12 @@ pub enum SweepError {
         path.display()
     )]
     NeedsCircuit { path: PathBuf },
+    #[error(
+        "{}: a coil-driven relay moves only in its driver circuit: drop --mechanics-only \
+         (each sample then runs the coupled ngspice simulation)",
+        path.display()
+    )]
+    CoilNeedsCircuit { path: PathBuf },
     #[error("shard `{text}`: give K/N with 1 <= K <= N, e.g. --shard 3/8 for the third of eight")]
     Shard { text: String },
     #[error("cannot write the sweep's rows")]
@@ -169,6 +175,12 @@ pub struct Record {
     pub settle_time: Option<f64>,
     /// s, settle time − first impact (when the contact closed for good).
     pub bounce_time: Option<f64>,
+    /// s, for a coil-driven relay: the longest release time of its
+    /// operations (coil off → the NO contact breaks).
+    pub release_time: Option<f64>,
+    /// s, for a coil-driven relay: the longest bounce on the rest stop
+    /// (the NC contact) after a release.
+    pub nc_bounce_time: Option<f64>,
     /// One per `[[probe]]`, for a circuit sweep that reached ngspice's
     /// results; empty otherwise.
     pub probes: Vec<ProbeRecord>,

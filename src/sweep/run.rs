@@ -21,8 +21,10 @@ use std::num::NonZeroUsize;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc;
 
+use crate::chatter::Chatter;
+use crate::coil::Operation;
 use crate::mechanics::simulate;
-use crate::pipeline::{self, RunOptions};
+use crate::pipeline::{self, RunOptions, RunResult};
 use crate::scenario::Scenario;
 use crate::spice::Runner;
 
@@ -118,7 +120,13 @@ pub fn run(
     out: &mut dyn Write,
     progress: &dyn Progress,
 ) -> Result<Collected, SweepError> {
+    let coil = scenario.coil.is_some();
     let signals: Vec<String> = match options.mode {
+        Mode::Mechanics if coil => {
+            return Err(SweepError::CoilNeedsCircuit {
+                path: scenario.origin.clone(),
+            });
+        }
         Mode::Mechanics => Vec::new(),
         Mode::Circuit(_) => {
             if scenario.circuit.is_none() || scenario.probes.is_empty() {
@@ -133,7 +141,7 @@ pub fn run(
             scenario.probes.iter().map(|p| p.signal.clone()).collect()
         }
     };
-    let header = table::header(sampler.keys(), &signals);
+    let header = table::header(sampler.keys(), &signals, coil);
     let probes = signals.len();
     out.write_all(&header)
         .and_then(|()| out.flush())
@@ -164,7 +172,7 @@ pub fn run(
                     let records: Vec<Record> = positions
                         .map(|p| worker.evaluate(options.shard.sample(p)))
                         .collect();
-                    let rows = table::rows(&records, sampler.keys().len(), probes);
+                    let rows = table::rows(&records, sampler.keys().len(), probes, coil);
                     if tx.send((c, rows, records)).is_err() {
                         break;
                     }
@@ -236,6 +244,8 @@ impl<'a, 'r> Worker<'a, 'r> {
             first_impact: None,
             settle_time: None,
             bounce_time: None,
+            release_time: None,
+            nc_bounce_time: None,
             probes: Vec::new(),
             verdict: Verdict::Error,
             failed_limits: Vec::new(),
@@ -258,6 +268,29 @@ impl<'a, 'r> Worker<'a, 'r> {
             return record;
         }
         let scenario = &self.scenario;
+        if scenario.coil.is_some() {
+            // The relay moves only in its circuit: the coupled run gives
+            // the chatter too.
+            let Mode::Circuit(runner) = self.options.mode else {
+                record.error = Some("a coil-driven relay needs the circuit".to_owned());
+                return record;
+            };
+            match pipeline::run(scenario, runner, &self.options.run) {
+                Ok(result) => {
+                    record_chatter(&mut record, &result.chatter);
+                    let worst = |get: fn(&Operation) -> Option<f64>| {
+                        result.operations.iter().filter_map(get).reduce(f64::max)
+                    };
+                    record.release_time = worst(|op| op.release_time);
+                    record.nc_bounce_time = worst(|op| op.nc_bounce_time);
+                    record_probes(&mut record, &result);
+                    (record.verdict, record.failed_limits) =
+                        verdict(scenario, &result.chatter, Some(&result));
+                }
+                Err(e) => record.error = Some(one_line(&e)),
+            }
+            return record;
+        }
         let chatter = match scenario
             .mechanics()
             .map_err(|e| one_line(&e))
@@ -270,29 +303,14 @@ impl<'a, 'r> Worker<'a, 'r> {
                 return record;
             }
         };
-        record.outcome = Some(chatter.outcome);
-        record.bounce_count = Some(chatter.bounce_count);
-        record.first_impact = chatter.first_impact;
-        record.settle_time = chatter.settle_time;
-        record.bounce_time = chatter
-            .first_impact
-            .zip(chatter.settle_time)
-            .filter(|_| chatter.outcome.is_closed())
-            .map(|(first, settle)| settle - first);
+        record_chatter(&mut record, &chatter);
         match self.options.mode {
             Mode::Mechanics => {
                 (record.verdict, record.failed_limits) = verdict(scenario, &chatter, None);
             }
             Mode::Circuit(runner) => match pipeline::run(scenario, runner, &self.options.run) {
                 Ok(result) => {
-                    record.probes = result
-                        .probes
-                        .iter()
-                        .map(|p| ProbeRecord {
-                            edges: p.analysis.edges,
-                            peak: p.analysis.max.abs().max(p.analysis.min.abs()),
-                        })
-                        .collect();
+                    record_probes(&mut record, &result);
                     (record.verdict, record.failed_limits) =
                         verdict(scenario, &chatter, Some(&result));
                 }
@@ -301,6 +319,31 @@ impl<'a, 'r> Worker<'a, 'r> {
         }
         record
     }
+}
+
+/// The chatter's columns of a record.
+fn record_chatter(record: &mut Record, chatter: &Chatter) {
+    record.outcome = Some(chatter.outcome);
+    record.bounce_count = Some(chatter.bounce_count);
+    record.first_impact = chatter.first_impact;
+    record.settle_time = chatter.settle_time;
+    record.bounce_time = chatter
+        .first_impact
+        .zip(chatter.settle_time)
+        .filter(|_| chatter.outcome.is_closed())
+        .map(|(first, settle)| settle - first);
+}
+
+/// The probes' columns of a record.
+fn record_probes(record: &mut Record, result: &RunResult) {
+    record.probes = result
+        .probes
+        .iter()
+        .map(|p| ProbeRecord {
+            edges: p.analysis.edges,
+            peak: p.analysis.max.abs().max(p.analysis.min.abs()),
+        })
+        .collect();
 }
 
 /// An error and its causes on one line, each cause's first line only:

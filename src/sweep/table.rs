@@ -2,7 +2,10 @@
 //!
 //! Columns: `index`, each varied key (its name, e.g. `mechanics.mass`, in
 //! sorted order), `outcome`, `bounce_count`, `first_impact`,
-//! `settle_time`, `bounce_time` (s, settle − first impact), then per probe
+//! `settle_time`, `bounce_time` (s, settle − first impact); for a
+//! coil-driven relay `release_time` and `nc_bounce_time` (s, the longest
+//! of its operations: coil off → break, and the bounce on the rest stop);
+//! then per probe
 //! `<signal>.edges` and `<signal>.peak` (max |value|, V or A), then
 //! `verdict` (`pass`, `fail`, `error`; see [`super::verdict`]),
 //! `failed_limits` (the keys of the limits that failed, space-separated,
@@ -33,12 +36,19 @@ pub const OUTCOME_COLUMNS: [&str; 5] = [
     "bounce_time",
 ];
 
-/// The header line for `keys` and probe `signals`.
-pub fn header(keys: &[String], signals: &[String]) -> Vec<u8> {
+/// The columns of a coil-driven relay's release, after the outcome's.
+pub const RELEASE_COLUMNS: [&str; 2] = ["release_time", "nc_bounce_time"];
+
+/// The header line for `keys` and probe `signals`, with the release
+/// columns for a coil-driven relay.
+pub fn header(keys: &[String], signals: &[String], coil: bool) -> Vec<u8> {
     let mut w = Writer::from_writer(Vec::new());
     let mut names: Vec<String> = vec!["index".to_owned()];
     names.extend(keys.iter().cloned());
     names.extend(OUTCOME_COLUMNS.iter().map(|s| (*s).to_owned()));
+    if coil {
+        names.extend(RELEASE_COLUMNS.iter().map(|s| (*s).to_owned()));
+    }
     for s in signals {
         names.push(format!("{s}.edges"));
         names.push(format!("{s}.peak"));
@@ -54,7 +64,7 @@ pub fn header(keys: &[String], signals: &[String]) -> Vec<u8> {
 /// probes, each `\n`-terminated. A record without values or probes (a
 /// sample that failed before them) has empty cells there, so every row
 /// has the header's width.
-pub fn rows(records: &[Record], keys: usize, probes: usize) -> Vec<u8> {
+pub fn rows(records: &[Record], keys: usize, probes: usize, coil: bool) -> Vec<u8> {
     let mut w = Writer::from_writer(Vec::with_capacity(records.len() * 96));
     let mut cell = String::new();
     let mut number = |w: &mut Writer<Vec<u8>>, value: Option<f64>| {
@@ -78,6 +88,10 @@ pub fn rows(records: &[Record], keys: usize, probes: usize) -> Vec<u8> {
         number(&mut w, r.first_impact);
         number(&mut w, r.settle_time);
         number(&mut w, r.bounce_time);
+        if coil {
+            number(&mut w, r.release_time);
+            number(&mut w, r.nc_bounce_time);
+        }
         for i in 0..probes {
             let p = r.probes.get(i);
             w.write_field(p.map_or_else(String::new, |p| p.edges.to_string()))
@@ -427,6 +441,8 @@ mod tests {
             first_impact: Some(1e-3),
             settle_time: Some(2e-3),
             bounce_time: Some(1e-3),
+            release_time: None,
+            nc_bounce_time: None,
             probes: vec![ProbeRecord {
                 edges: 5,
                 peak: 3.3,
@@ -440,7 +456,7 @@ mod tests {
     #[test]
     fn rows_match_the_header_and_quote_what_needs_it() {
         let keys = vec!["mechanics.mass".to_owned(), "surface.damping".to_owned()];
-        let h = header(&keys, &["v(a,b)".to_owned()]);
+        let h = header(&keys, &["v(a,b)".to_owned()], false);
         assert_eq!(
             String::from_utf8(h).unwrap(),
             "index,mechanics.mass,surface.damping,outcome,bounce_count,first_impact,settle_time,\
@@ -453,13 +469,13 @@ mod tests {
         failed.verdict = Verdict::Error;
         failed.error = Some("ngspice failed: timeout, 60 s".to_owned());
         failed.probes = vec![];
-        let text = String::from_utf8(rows(&[record(0)], 2, 1)).unwrap();
+        let text = String::from_utf8(rows(&[record(0)], 2, 1, false)).unwrap();
         assert_eq!(
             text,
             "0,0.00015,0.25,stuck,3,0.001,0.002,0.001,5,3.3,pass,,\n"
         );
         failed.values.clear();
-        let text = String::from_utf8(rows(&[failed], 2, 1)).unwrap();
+        let text = String::from_utf8(rows(&[failed], 2, 1, false)).unwrap();
         assert_eq!(
             text,
             "1,,,,,0.001,0.002,0.001,,,error,,\"ngspice failed: timeout, 60 s\"\n"
@@ -467,7 +483,7 @@ mod tests {
     }
 
     fn csv_of(indices: &[u64]) -> Vec<u8> {
-        let mut out = header(&["k".to_owned()], &[]);
+        let mut out = header(&["k".to_owned()], &[], false);
         let records: Vec<Record> = indices
             .iter()
             .map(|&i| Record {
@@ -476,7 +492,7 @@ mod tests {
                 ..record(i)
             })
             .collect();
-        out.extend(rows(&records, 1, 0));
+        out.extend(rows(&records, 1, 0, false));
         out
     }
 
@@ -498,7 +514,7 @@ mod tests {
         let report = merge(gap, &mut Vec::new(), None, true).unwrap();
         assert_eq!(report.missing, vec![1, 2]);
 
-        let other = header(&["j".to_owned()], &[]);
+        let other = header(&["j".to_owned()], &[], false);
         let err = merge(
             vec![
                 ("a".into(), Cursor::new(csv_of(&[0]))),
