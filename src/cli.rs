@@ -15,6 +15,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::time::Duration;
 
 use chatterspice::check;
+use chatterspice::coil::CouplingOptions;
 use chatterspice::mechanics::Dimensionless;
 use chatterspice::netlist::{self, ContactElement};
 use chatterspice::pipeline::{self, RunOptions};
@@ -157,6 +158,52 @@ pub struct SimulatorArgs {
     /// on PATH].
     #[arg(long, value_name = "PROGRAM")]
     pub ngspice: Option<PathBuf>,
+
+    /// With a [coil]: the most coupling passes (ngspice run + mechanics)
+    /// before giving up with exit 2.
+    #[arg(long, value_name = "N", default_value_t = CouplingOptions::default().max_iterations,
+          value_parser = parse_iterations)]
+    pub max_iterations: usize,
+
+    /// With a [coil]: converged when no impact or release time moves more
+    /// than this between passes, in seconds.
+    #[arg(long, value_name = "S", default_value_t = CouplingOptions::default().tolerance,
+          value_parser = parse_tolerance)]
+    pub coupling_tolerance: f64,
+}
+
+impl SimulatorArgs {
+    /// The run options these arguments set; the rest default.
+    fn run_options(&self) -> RunOptions {
+        RunOptions {
+            timeout: Duration::from_secs_f64(self.timeout),
+            element: self.element,
+            coupling: CouplingOptions {
+                tolerance: self.coupling_tolerance,
+                max_iterations: self.max_iterations,
+                ..CouplingOptions::default()
+            },
+            ..RunOptions::default()
+        }
+    }
+}
+
+fn parse_iterations(text: &str) -> Result<usize, String> {
+    match text.parse::<usize>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(format!(
+            "`{text}` is not a number of passes: give a whole number ≥ 1, e.g. 20"
+        )),
+    }
+}
+
+fn parse_tolerance(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(s) if s.is_finite() && s > 0.0 => Ok(s),
+        _ => Err(format!(
+            "`{text}` is not a tolerance: give a time in seconds > 0, e.g. 1e-7"
+        )),
+    }
 }
 
 #[derive(Debug, Args)]
@@ -286,10 +333,9 @@ fn run(args: &RunArgs) -> Result<()> {
     let scenario = load_scenario(args.scenario.as_deref())?;
     let ngspice = Ngspice::locate(args.simulator.ngspice.as_deref())?;
     let options = RunOptions {
-        timeout: Duration::from_secs_f64(args.simulator.timeout),
         keep_workdir: args.keep_workdir,
-        element: args.simulator.element,
         compare_ideal: !args.no_ideal,
+        ..args.simulator.run_options()
     };
     let mut result = match &args.measured {
         Some(csv) => {
@@ -336,11 +382,7 @@ fn run(args: &RunArgs) -> Result<()> {
 fn check(args: &CheckArgs) -> Result<Status> {
     let scenario = load_scenario(args.scenario.as_deref())?;
     let needs_ngspice = scenario.coil.is_some() || scenario.probes.iter().any(|p| p.has_limits());
-    let options = RunOptions {
-        timeout: Duration::from_secs_f64(args.simulator.timeout),
-        element: args.simulator.element,
-        ..RunOptions::default()
-    };
+    let options = args.simulator.run_options();
     let (verdict, evidence) = if needs_ngspice {
         let ngspice = Ngspice::locate(args.simulator.ngspice.as_deref())?;
         check::run_with(&scenario, &ngspice, &options)?
@@ -636,8 +678,7 @@ fn sweep(args: &SweepArgs) -> Result<Status> {
         options.jobs = jobs;
     }
     options.shard = args.shard.unwrap_or(Shard::WHOLE);
-    options.run.timeout = Duration::from_secs_f64(args.simulator.timeout);
-    options.run.element = args.simulator.element;
+    options.run = args.simulator.run_options();
 
     std::fs::create_dir_all(&dir)
         .with_context(|| format!("{}: cannot create the output directory", dir.display()))?;

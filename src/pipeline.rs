@@ -55,6 +55,9 @@ pub struct RunOptions {
     pub element: Option<ContactElement>,
     /// Also run the ideal contact and compare (needs a first impact).
     pub compare_ideal: bool,
+    /// For a coil-driven relay: how the coupling iterates (its `timeout`
+    /// is replaced by the one above).
+    pub coupling: CouplingOptions,
 }
 
 impl Default for RunOptions {
@@ -64,6 +67,7 @@ impl Default for RunOptions {
             keep_workdir: false,
             element: None,
             compare_ideal: true,
+            coupling: CouplingOptions::default(),
         }
     }
 }
@@ -415,7 +419,7 @@ fn run_coil(
         runner,
         &CouplingOptions {
             timeout: options.timeout,
-            ..CouplingOptions::default()
+            ..options.coupling.clone()
         },
     )
     .map_err(|e| RunError::Coupling(Box::new(e)))?;

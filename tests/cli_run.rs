@@ -388,3 +388,23 @@ fn run_couples_a_coil_driven_relay_in_its_transistor_driver() {
     let first_closure = &v["probes"][1]["current"]["per_closure"][0];
     assert_eq!(first_closure["start"].as_f64().unwrap(), make);
 }
+
+#[test]
+fn a_coupling_that_does_not_converge_in_the_passes_allowed_is_exit_2() {
+    let _ng = ngspice_or_skip!();
+    let scenario =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenarios/relay-driver.toml");
+    chatterspice()
+        .arg("run")
+        .arg(&scenario)
+        .args(["--max-iterations", "2"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("did not converge in 2 iterations"))
+        .stderr(predicate::str::contains("--max-iterations"));
+    chatterspice()
+        .args(["run", "--coupling-tolerance=-1"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("--coupling-tolerance"));
+}

@@ -191,7 +191,8 @@ pub enum CouplingError {
     MissingVector { iteration: usize, vector: String },
     #[error(
         "{}: the coupling did not converge in {iterations} iterations: event times still \
-         moved by {change:e} s (tolerance {tolerance:e} s); allow more iterations, or look \
+         moved by {change:e} s (tolerance {tolerance:e} s); allow more iterations \
+         (`--max-iterations`), or look \
          for a drive that chatters itself",
         netlist.display()
     )]
