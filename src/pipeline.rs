@@ -25,6 +25,7 @@ use thiserror::Error;
 use crate::analysis::{self, AnalysisError, Comparison, ProbeAnalysis};
 use crate::chatter::{Chatter, ContactState, Interval};
 use crate::coil::coupled::Iteration;
+use crate::coil::coupled::nc_include;
 use crate::coil::{CouplingError, CouplingOptions, Operation, run_coupled};
 use crate::mechanics::{MechanicsError, contact_forces, simulate};
 use crate::netlist::{self, ContactElement, ContactInclude, Deck, DeckRequest, NetlistError};
@@ -436,7 +437,12 @@ fn run_coil(
     let element = options
         .element
         .unwrap_or_else(|| ContactElement::for_waveform(&waveform));
-    let include = netlist::contact_include(&waveform, &circuit.subckt, element)?;
+    let mut include = netlist::contact_include(&waveform, &circuit.subckt, element)?;
+    if let Some(nc) = &circuit.nc_subckt {
+        let nc = nc_include(&coupled.back, &model, nc, &scenario.origin)
+            .map_err(|e| RunError::Coupling(Box::new(e)))?;
+        include.text.push_str(&nc);
+    }
     let probes = probe_results(scenario, &coupled.chatter, ("coupled", &coupled.plot), None)?;
     let elapsed: f64 = coupled.iterations.iter().map(|i| i.ngspice_elapsed).sum();
     let netlist_path = circuit.netlist.clone();

@@ -252,6 +252,10 @@ pub struct CircuitSection {
     /// The subcircuit name the netlist instantiates for the coil.
     #[serde(default = "default_coil_subckt")]
     pub coil_subckt: String,
+    /// With a `[coil]`: the subcircuit name of the normally-closed
+    /// contact (the armature on its rest stop), for a changeover relay
+    /// whose NC side switches part of the circuit. `None`: there is none.
+    pub nc_subckt: Option<String>,
 }
 
 fn default_subckt() -> String {
@@ -942,6 +946,16 @@ impl Check<'_> {
         self.simulation(&d.simulation)?;
         if let Some(circuit) = &d.circuit {
             self.circuit(circuit)?;
+            if circuit.nc_subckt.is_some() && d.coil.is_none() {
+                return Err(ScenarioError::Conflict {
+                    at: self.at("circuit.nc_subckt"),
+                    key: "circuit.nc_subckt".to_owned(),
+                    other: "mechanics.force".to_owned(),
+                    advice: "the normally-closed contact follows the armature back to its \
+                             rest stop on release, which needs a [coil]; give one or remove \
+                             the key",
+                });
+            }
         }
         for (i, probe) in d.probe.iter().enumerate() {
             self.probe(i, probe)?;
@@ -1331,7 +1345,24 @@ impl Check<'_> {
             "circuit.coil_subckt",
             &c.coil_subckt,
             "the subcircuit name the netlist uses for the coil",
-        )
+        )?;
+        if let Some(nc) = &c.nc_subckt {
+            self.not_empty(
+                "circuit.nc_subckt",
+                nc,
+                "the subcircuit name the netlist uses for the normally-closed contact",
+            )?;
+            if nc.eq_ignore_ascii_case(&c.subckt) || nc.eq_ignore_ascii_case(&c.coil_subckt) {
+                return Err(ScenarioError::Conflict {
+                    at: self.at("circuit.nc_subckt"),
+                    key: "circuit.nc_subckt".to_owned(),
+                    other: "circuit.subckt".to_owned(),
+                    advice: "the normally-closed contact needs a subcircuit name of its own, \
+                             e.g. CONTACT_NC",
+                });
+            }
+        }
+        Ok(())
     }
 
     fn probe(&self, i: usize, p: &Probe) -> Result<(), ScenarioError> {
@@ -2419,6 +2450,27 @@ high = 2.31
         fails_on(
             &format!("{VALID}\n[limits]\nmax_release_time = 1e-3\n"),
             "limits.max_release_time",
+        );
+        // So is a normally-closed contact in the circuit; with a coil it
+        // needs a name of its own.
+        let nc = "netlist = \"net/input.cir\"\nnc_subckt = \"CONTACT_NC\"\n";
+        fails_on(
+            &VALID.replace("netlist = \"net/input.cir\"\n", nc),
+            "circuit.nc_subckt",
+        );
+        let with_nc = coil.replace("netlist = \"net/input.cir\"\n", nc);
+        assert_eq!(
+            parse(&with_nc)
+                .unwrap()
+                .circuit
+                .unwrap()
+                .nc_subckt
+                .as_deref(),
+            Some("CONTACT_NC")
+        );
+        fails_on(
+            &with_nc.replace("\"CONTACT_NC\"", "\"contact\""),
+            "circuit.nc_subckt",
         );
         let limits = "\n[limits]\nmax_release_time = 1e-3\nmax_nc_bounces = 3\n";
         let s = parse(&format!("{coil}{limits}")).unwrap();

@@ -102,3 +102,42 @@ fn interpolate(samples: &[(f64, f64)], t: f64) -> f64 {
     let ((t0, v0), (t1, v1)) = (samples[k - 1], samples[k]);
     v0 + (v1 - v0) * (t - t0) / (t1 - t0)
 }
+
+#[test]
+fn the_nc_contact_of_a_changeover_relay_switches_its_own_circuit() {
+    let ng = ngspice_or_skip!();
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/coil/changeover.toml");
+    let scenario = Scenario::load(&path).unwrap();
+    let run = chatterspice::pipeline::run(
+        &scenario,
+        &ng,
+        &chatterspice::pipeline::RunOptions::default(),
+    )
+    .unwrap_or_else(|e| panic!("{}", common::chain(&e)));
+    let [op] = run.operations.as_slice() else {
+        panic!("{:?}", run.operations)
+    };
+    let s = &op.stroke;
+    assert!(op.coil_off.is_some() && s.back_make.is_some(), "{op:?}");
+    let (no, nc) = (&run.probes[0].analysis, &run.probes[1].analysis);
+    // Each contact pulls a bare 10 kΩ pull-up: every change of state is
+    // an edge. NO: the make, its bounces, the break. NC: it opens at
+    // lift-off, makes again on the return, and bounces.
+    assert_eq!(no.edges, 2 + 2 * s.bounces, "{no:?}");
+    assert_eq!(nc.edges, 2 + 2 * s.back_bounces, "{nc:?}");
+    let close = |a: Option<f64>, b: f64| (a.unwrap() - b).abs() < 1e-6;
+    assert!(
+        close(nc.first_edge, s.lift_off),
+        "{:?} {}",
+        nc.first_edge,
+        s.lift_off
+    );
+    assert!(close(nc.last_edge, s.back_last_make.unwrap()));
+    assert!(close(no.last_edge, s.break_time.unwrap()));
+    // The include written for the run carries both contacts.
+    assert!(
+        run.include.text.contains(".subckt CONTACT_NC"),
+        "{}",
+        run.include.text
+    );
+}

@@ -160,6 +160,12 @@ pub enum CouplingError {
         subckt: String,
         found: usize,
     },
+    #[error(
+        "{}: `circuit.nc_subckt` = `{subckt}` is not instantiated in the netlist: add \
+         an X line for the normally-closed contact (X3 a b {subckt}), or remove the key",
+        netlist.display()
+    )]
+    NcNotInstantiated { netlist: PathBuf, subckt: String },
     #[error(transparent)]
     Scenario(#[from] ScenarioError),
     #[error(transparent)]
@@ -236,6 +242,14 @@ pub fn run_coupled(
             found: instances.len(),
         });
     };
+    if let Some(nc) = &circuit.nc_subckt {
+        if instances_of(&netlist_text, nc).is_empty() {
+            return Err(CouplingError::NcNotInstantiated {
+                netlist: netlist_path,
+                subckt: nc.clone(),
+            });
+        }
+    }
     let m = &scenario.mechanics;
     let mechanics = Mechanics {
         mass: m.mass,
@@ -267,7 +281,8 @@ pub fn run_coupled(
 
     // Iteration 0: the armature at rest, the contact open.
     let mut chatter = open_chatter(settings.t_end);
-    let mut back = open_chatter(settings.t_end);
+    // The armature starts on its rest stop: the NC contact closed.
+    let mut back = closed_chatter(settings.t_end);
     let mut path = vec![(0.0, m.initial_position)];
     let mut iterations: Vec<Iteration> = Vec::new();
     for iteration in 1..=options.max_iterations {
@@ -276,11 +291,16 @@ pub fn run_coupled(
                 path: origin.clone(),
                 source,
             })?;
-        let contact = contact_include(
+        let mut contact = contact_include(
             &waveform,
             &circuit.subckt,
             ContactElement::for_waveform(&waveform),
         )?;
+        if let Some(nc) = &circuit.nc_subckt {
+            contact
+                .text
+                .push_str(&nc_include(&back, &model, nc, &origin)?);
+        }
         let end = chatter.intervals.last().map_or(0.0, |iv| iv.start);
         let deck = netlist::prepare_deck(&DeckRequest {
             netlist_text: &netlist_text,
@@ -420,6 +440,34 @@ pub fn thin(path: &[(f64, f64)], tolerance: f64) -> Vec<(f64, f64)> {
         out.push(path[path.len() - 1]);
     }
     out
+}
+
+/// A contact closed from 0 to `t_end`: the NC contact before the first
+/// iteration.
+fn closed_chatter(t_end: f64) -> Chatter {
+    Chatter::from_intervals(vec![Interval {
+        state: ContactState::Closed,
+        start: 0.0,
+        end: t_end,
+    }])
+}
+
+/// The normally-closed contact's subcircuit `subckt`, following the
+/// rest stop's chatter `back`, with the NO contact's electrical model: a
+/// PWL include appended to the contact's (its few dozen points never need
+/// the event-driven element, which would also need a data file).
+pub fn nc_include(
+    back: &Chatter,
+    model: &ContactModel,
+    subckt: &str,
+    origin: &std::path::Path,
+) -> Result<String, CouplingError> {
+    let waveform =
+        Waveform::from_chatter(back, model).map_err(|source| CouplingError::Waveform {
+            path: origin.to_owned(),
+            source,
+        })?;
+    Ok(contact_include(&waveform, subckt, ContactElement::Pwl)?.text)
 }
 
 /// A contact open from 0 to `t_end`: before the first iteration.
