@@ -81,6 +81,24 @@ pub struct Impact {
     pub max_gap_after: Option<f64>,
 }
 
+impl Impact {
+    /// A touch at `time` (s) at `velocity` (m/s), before anything else
+    /// about the contact is known.
+    pub fn touch(time: f64, velocity: f64) -> Impact {
+        Impact {
+            impact_time: time,
+            impact_velocity: velocity,
+            release_time: None,
+            release_velocity: None,
+            restitution: None,
+            contact_time: None,
+            peak_force: None,
+            min_force: None,
+            max_gap_after: None,
+        }
+    }
+}
+
 /// Electrical state of the contact over an interval.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]

@@ -41,7 +41,7 @@
 //! them, bisected on the interpolant, as the closing engine does.
 
 use super::CoilError;
-use super::sequence::{Drive, RTOL, State, first_true, monotone_parts, state_on, surface_force};
+use super::sequence::{self, Drive, State, first_true, monotone_parts, state_on, surface_force};
 use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome};
 use crate::mechanics::integrate::{Dopri5, Step, Tolerance};
 use crate::mechanics::{Mechanics, Settings, Surface};
@@ -122,20 +122,8 @@ pub(crate) fn run<D: Drive>(
     drive: &D,
     e0: f64,
 ) -> Result<Cycle, CoilError> {
-    let omega = (m.stiffness / m.mass).sqrt();
-    let tol = Tolerance {
-        rtol: RTOL,
-        atol: State::new(RTOL * m.gap, RTOL * m.gap * omega, RTOL * drive.e_scale()),
-    };
+    let tol = sequence::start(m, drive, e0)?;
     let x0 = m.initial_position;
-    let f0 = drive.force(0.0, x0, e0);
-    if !f0.is_finite() {
-        return Err(CoilError::DriveNotFinite {
-            time: 0.0,
-            position: x0,
-            value: f0,
-        });
-    }
     let held = x0 == 0.0 && m.initial_velocity <= 0.0;
     let back_state = if held {
         ContactState::Closed
@@ -224,17 +212,7 @@ impl Track {
             last.max_gap_after = Some(farthest);
         }
         self.change(t, ContactState::Closed);
-        self.impacts.push(Impact {
-            impact_time: t,
-            impact_velocity: speed,
-            release_time: None,
-            release_velocity: None,
-            restitution: None,
-            contact_time: None,
-            peak_force: None,
-            min_force: None,
-            max_gap_after: None,
-        });
+        self.impacts.push(Impact::touch(t, speed));
     }
 
     /// The contact opens at `t`, separating at `speed` (> 0).
@@ -742,18 +720,8 @@ fn moving_event<D: Drive>(
             let y = state_on(step, t);
             model.force_rate(side, t, &y)
         };
-        let (r0, r1) = (rate(step.t0), rate(t_last));
         let mut seen = vec![y_last];
-        if (r0 > 0.0 && r1 < 0.0) || (r0 < 0.0 && r1 > 0.0) {
-            let rising = r0 > 0.0;
-            let tz = first_true(
-                |t| {
-                    let r = rate(t);
-                    if rising { r <= 0.0 } else { r >= 0.0 }
-                },
-                step.t0,
-                t_last,
-            );
+        if let Some(tz) = sequence::sign_change(rate, step.t0, t_last) {
             seen.push(state_on(step, tz));
         }
         for y in seen {

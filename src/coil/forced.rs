@@ -44,21 +44,7 @@ pub fn simulate_forced_path(
     settings: &Settings,
     force: impl Fn(f64, f64) -> f64,
 ) -> Result<(Chatter, Vec<(f64, f64)>), CoilError> {
-    mechanics::validate(
-        &Mechanics {
-            force: 0.0,
-            ..*mechanics
-        },
-        surface,
-        settings,
-    )?;
-    if mechanics.initial_position < 0.0 {
-        return Err(CoilError::InvalidParameter {
-            name: "mechanics.initial_position",
-            value: mechanics.initial_position,
-            requirement: "a position in m at or above the rest stop at 0 (and below the gap)",
-        });
-    }
+    validate(mechanics, &[surface], settings)?;
     let drive = Forced::new(mechanics, force);
     let run = sequence::run(mechanics, surface, settings, &drive, 0.0)?;
     let gap = mechanics.gap;
@@ -86,13 +72,26 @@ pub fn simulate_cycle(
     settings: &Settings,
     force: impl Fn(f64, f64) -> f64,
 ) -> Result<Cycle, CoilError> {
+    let surfaces: Vec<&Surface> = std::iter::once(&stops.make).chain(&stops.back).collect();
+    validate(mechanics, &surfaces, settings)?;
+    let drive = Forced::new(mechanics, force);
+    cycle::run(mechanics, stops, settings, &drive, 0.0)
+}
+
+/// The engine's checks of the relay (its `force` unused: the drive
+/// replaces it) and of every surface, and a start on or above the rest
+/// stop.
+fn validate(
+    mechanics: &Mechanics,
+    surfaces: &[&Surface],
+    settings: &Settings,
+) -> Result<(), CoilError> {
     let unforced = Mechanics {
         force: 0.0,
         ..*mechanics
     };
-    mechanics::validate(&unforced, &stops.make, settings)?;
-    if let Some(back) = &stops.back {
-        mechanics::validate(&unforced, back, settings)?;
+    for surface in surfaces {
+        mechanics::validate(&unforced, surface, settings)?;
     }
     if mechanics.initial_position < 0.0 {
         return Err(CoilError::InvalidParameter {
@@ -101,8 +100,7 @@ pub fn simulate_cycle(
             requirement: "a position in m at or above the rest stop at 0 (and below the gap)",
         });
     }
-    let drive = Forced::new(mechanics, force);
-    cycle::run(mechanics, stops, settings, &drive, 0.0)
+    Ok(())
 }
 
 /// A drive given as a function. Its state `e` is the impulse `∫F dt`:

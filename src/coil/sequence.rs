@@ -223,11 +223,7 @@ pub(crate) fn run<D: Drive>(
     drive: &D,
     e0: f64,
 ) -> Result<Run, CoilError> {
-    let omega = (m.stiffness / m.mass).sqrt();
-    let tol = Tolerance {
-        rtol: RTOL,
-        atol: State::new(RTOL * m.gap, RTOL * m.gap * omega, RTOL * drive.e_scale()),
-    };
+    let tol = start(m, drive, e0)?;
     let model = Model {
         m: *m,
         surface: *surface,
@@ -237,14 +233,6 @@ pub(crate) fn run<D: Drive>(
     };
     let x0 = m.initial_position;
     let v0 = m.initial_velocity;
-    let f0 = drive.force(0.0, x0, e0);
-    if !f0.is_finite() {
-        return Err(CoilError::DriveNotFinite {
-            time: 0.0,
-            position: x0,
-            value: f0,
-        });
-    }
     Sequence {
         model,
         rec: Record {
@@ -257,6 +245,29 @@ pub(crate) fn run<D: Drive>(
         },
     }
     .run(State::new(x0 - m.gap, v0, e0))
+}
+
+/// The integration tolerance for `m` under `drive`, once the drive is
+/// known to be finite where the run starts (drive state `e0`).
+pub(crate) fn start<D: Drive>(
+    m: &Mechanics,
+    drive: &D,
+    e0: f64,
+) -> Result<Tolerance<3>, CoilError> {
+    let x0 = m.initial_position;
+    let f0 = drive.force(0.0, x0, e0);
+    if !f0.is_finite() {
+        return Err(CoilError::DriveNotFinite {
+            time: 0.0,
+            position: x0,
+            value: f0,
+        });
+    }
+    let omega = (m.stiffness / m.mass).sqrt();
+    Ok(Tolerance {
+        rtol: RTOL,
+        atol: State::new(RTOL * m.gap, RTOL * m.gap * omega, RTOL * drive.e_scale()),
+    })
 }
 
 impl<D: Drive> Model<'_, D> {
@@ -355,21 +366,8 @@ impl<D: Drive> Model<'_, D> {
     /// rate, and the force at `until`.
     fn force_extrema(&self, step: &Step<3>, until: f64, range: &mut ForceRange) {
         let force = |y: &State| self.contact_force(y[0], y[1]);
-        let rate = |t: f64| self.contact_force_rate(t, &step.at(t));
-        let (r0, r1) = (
-            self.contact_force_rate(step.t0, &step.y0),
-            self.contact_force_rate(until, &state_on(step, until)),
-        );
-        if (r0 > 0.0 && r1 < 0.0) || (r0 < 0.0 && r1 > 0.0) {
-            let rising = r0 > 0.0;
-            let tz = first_true(
-                |t| {
-                    let r = rate(t);
-                    if rising { r <= 0.0 } else { r >= 0.0 }
-                },
-                step.t0,
-                until,
-            );
+        let rate = |t: f64| self.contact_force_rate(t, &state_on(step, t));
+        if let Some(tz) = sign_change(rate, step.t0, until) {
             range.see(force(&step.at(tz)));
         }
         range.see(force(&state_on(step, until)));
@@ -512,6 +510,24 @@ pub(crate) fn first_true(cond: impl Fn(f64) -> bool, mut lo: f64, mut hi: f64) -
             lo = mid;
         }
     }
+}
+
+/// Where `f` changes sign strictly between `lo` and `hi` (opposite
+/// signs at the ends), bisected to adjacent floats; `None` otherwise.
+pub(crate) fn sign_change(f: impl Fn(f64) -> f64, lo: f64, hi: f64) -> Option<f64> {
+    let (a, b) = (f(lo), f(hi));
+    if !((a > 0.0 && b < 0.0) || (a < 0.0 && b > 0.0)) {
+        return None;
+    }
+    let falling = a > 0.0;
+    Some(first_true(
+        |t| {
+            let r = f(t);
+            if falling { r <= 0.0 } else { r >= 0.0 }
+        },
+        lo,
+        hi,
+    ))
 }
 
 /// A step split at the velocity zero it may contain.
@@ -670,17 +686,7 @@ impl<D: Drive> Sequence<'_, D> {
                 start: open_since,
                 end: t_hit,
             });
-            self.rec.impacts.push(Impact {
-                impact_time: t_hit,
-                impact_velocity: v_hit,
-                release_time: None,
-                release_velocity: None,
-                restitution: None,
-                contact_time: None,
-                peak_force: None,
-                min_force: None,
-                max_gap_after: None,
-            });
+            self.rec.impacts.push(Impact::touch(t_hit, v_hit));
             match self.contact(t_hit, y_hit)? {
                 End::Released(tr, yr) => {
                     let last = self.rec.impacts.last_mut().expect("impact pushed above");
