@@ -324,7 +324,7 @@ impl LinearPiece {
     /// [`LinearPiece::zeros`], and when under-damped the basis phase at the
     /// first zero: e^(−at), cos wt and sin wt there, which the closed form
     /// gives for free (see above).
-    #[inline]
+    #[inline(always)]
     fn zeros_and_phase(&self, c: Combo, d: Combo) -> (Zeros, Option<Phase>) {
         if c.p == 0.0 && c.q == 0.0 {
             return (Zeros::NONE, None);
@@ -650,7 +650,6 @@ impl LinearPiece {
             ..
         } = self.mode;
         let k2 = 1.0 + kappa * kappa;
-        let target = offset / y_lo;
         let mirrored = mirror.and_then(|turn| {
             let u = w * t_lo;
             let cot = turn.cos / turn.sin;
@@ -665,7 +664,7 @@ impl LinearPiece {
             // The undamped start: a half cosine between the two extreme
             // values H(0) = 1 and H(π) = −e^(−κπ), where cos and sin are
             // known exactly.
-            let frac = ((1.0 - target) * inv_swing).clamp(0.0, 1.0);
+            let frac = ((1.0 - offset / y_lo) * inv_swing).clamp(0.0, 1.0);
             let theta = (1.0 - 2.0 * frac).acos();
             let p = Phase {
                 cos: 1.0 - 2.0 * frac,
@@ -681,19 +680,24 @@ impl LinearPiece {
         // move of any kind (Halley must beat bisection, or bisect).
         let mut step_before = f64::NAN;
         let mut moved = std::f64::consts::PI;
+        // The residual is y_lo·H(θ) − offset, positions rather than their
+        // ratio: no division before the first step, and the same steps.
+        let falling = y_lo > 0.0;
         for _ in 0..100 {
-            let f = p.decay * (p.cos + kappa * p.sin) - target;
+            let scale = y_lo * p.decay;
+            let f = scale * (p.cos + kappa * p.sin) - offset;
             if f == 0.0 {
                 break;
             }
-            // H decreases: a positive residual means the root is ahead.
-            if f > 0.0 {
+            // H decreases: a residual of the sign of y_lo means the root
+            // is ahead.
+            if (f > 0.0) == falling {
                 lo = theta;
             } else {
                 hi = theta;
             }
-            let d1 = -k2 * p.decay * p.sin;
-            let d2 = -k2 * p.decay * (p.cos - kappa * p.sin);
+            let d1 = -k2 * scale * p.sin;
+            let d2 = -k2 * scale * (p.cos - kappa * p.sin);
             let step = -2.0 * f * d1 / (2.0 * d1 * d1 - f * d2);
             let next = theta + step;
             if !(next > lo && next < hi && 2.0 * step.abs() <= moved) {
@@ -723,8 +727,8 @@ impl LinearPiece {
             if converged && step.abs() <= TAYLOR_STEP {
                 // The velocity at θ + step from the derivatives at θ, to
                 // second order: the error, O(step³), is below rounding.
-                let d3 = -k2 * p.decay * ((kappa * kappa - 1.0) * p.sin - 2.0 * kappa * p.cos);
-                let velocity = y_lo * w * (d1 + step * (d2 + 0.5 * step * d3));
+                let d3 = -k2 * scale * ((kappa * kappa - 1.0) * p.sin - 2.0 * kappa * p.cos);
+                let velocity = w * (d1 + step * (d2 + 0.5 * step * d3));
                 return (t_lo + next * inv_w, velocity);
             }
             p = p.advance(step, kappa, next);
@@ -753,6 +757,7 @@ impl Phase {
     /// short series where the step is small enough for them to be exact
     /// to rounding (the first omitted terms are below 1e-17 relative):
     /// far cheaper than `sin_cos` and `exp`, which serve larger steps.
+    #[inline(always)]
     fn advance(self, step: f64, kappa: f64, theta_new: f64) -> Phase {
         let x = -kappa * step;
         let decay = if x.abs() <= SMALL_DECAY {
