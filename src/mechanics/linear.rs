@@ -760,6 +760,21 @@ impl Phase {
     #[inline(always)]
     fn advance(self, step: f64, kappa: f64, theta_new: f64) -> Phase {
         let x = -kappa * step;
+        if step.abs() <= TINY_STEP && x.abs() <= TINY_STEP {
+            // A converging Halley step: to δ⁵, δ⁴ and x⁵ (the first
+            // omitted terms are below 5e-18).
+            let d2 = step * step;
+            let sin = step + (step * d2) * (-1.0 / 6.0 + d2 * (1.0 / 120.0));
+            let cos_m1 = d2 * (-0.5 + d2 * (1.0 / 24.0));
+            let x2 = x * x;
+            let exp_m1 =
+                x * ((1.0 + 0.5 * x) + x2 * ((1.0 / 6.0 + x * (1.0 / 24.0)) + x2 * (1.0 / 120.0)));
+            return Phase {
+                decay: self.decay + self.decay * exp_m1,
+                cos: self.cos + (self.cos * cos_m1 - self.sin * sin),
+                sin: self.sin + (self.sin * cos_m1 + self.cos * sin),
+            };
+        }
         let decay = if x.abs() <= SMALL_DECAY {
             // eˣ − 1 to x⁷, grouped (Estrin) to shorten the dependency
             // chain.
@@ -803,6 +818,7 @@ const TAYLOR_STEP: f64 = 1.0 / 131072.0;
 /// [`Phase::advance`] takes by series: Halley's steps, and the step from a
 /// turn to the mirrored start ([`LinearPiece::polish_half_swing`]).
 const SMALL_STEP: f64 = 1.0 / 4.0;
+const TINY_STEP: f64 = 1.0 / 256.0;
 const SMALL_DECAY: f64 = 1.0 / 64.0;
 
 #[cfg(test)]
