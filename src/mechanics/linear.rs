@@ -27,7 +27,10 @@
 //! an under-damped piece is solved in the phase from the first extremum,
 //! where the motion is one exact formula and Halley's iterates advance by
 //! addition theorems rather than fresh `exp`/`sin_cos` calls
-//! ([`LinearPiece::crossing`]); any combination of y and ẏ (a
+//! ([`LinearPiece::crossing`]); a piece that returns to the level it
+//! started at (every impact and release) starts that iteration from the
+//! mirror image of its way out, whose phase the turn already gives, so a
+//! crossing costs one `atan2` and one `exp`; any combination of y and ẏ (a
 //! Kelvin–Voigt force) is y itself shifted in time and scaled
 //! ([`Mode::combination_shift`]), so its extrema need no trigonometry.
 
@@ -315,8 +318,16 @@ impl LinearPiece {
     /// A zero at t = 0 itself (up to the rounding of the phase, 64 ulps of
     /// the period) is not reported: it is where the piece starts.
     pub fn zeros(&self, c: Combo, d: Combo) -> Zeros {
+        self.zeros_and_phase(c, d).0
+    }
+
+    /// [`LinearPiece::zeros`], and when under-damped the basis phase at the
+    /// first zero: e^(−at), cos wt and sin wt there, which the closed form
+    /// gives for free (see above).
+    #[inline(always)]
+    fn zeros_and_phase(&self, c: Combo, d: Combo) -> (Zeros, Option<Phase>) {
         if c.p == 0.0 && c.q == 0.0 {
-            return Zeros::NONE;
+            return (Zeros::NONE, None);
         }
         if self.q > 0.0 {
             let (w, inv_w, period) = (self.mode.w, self.mode.inv_w, self.mode.period);
@@ -342,25 +353,32 @@ impl LinearPiece {
             };
             // The amplitude part is ready long before the exponential.
             let amplitude = (c.p * d.q - c.q * d.p) / (w * r);
-            let value = sign * (-self.a * t).exp() * amplitude;
-            Zeros {
+            let decay = (-self.a * t).exp();
+            let value = sign * decay * amplitude;
+            let zeros = Zeros {
                 next: t,
                 period,
                 value,
                 factor: -self.mode.half_period_decay,
-            }
+            };
+            let phase = Phase {
+                decay,
+                cos: -sign * qw / r,
+                sin: sign * c.p / r,
+            };
+            (zeros, Some(phase))
         } else {
             let t = if self.q < 0.0 {
                 let w = self.mode.w;
                 let r = -c.p * w / c.q;
                 if !(r > 0.0 && r < 1.0) {
-                    return Zeros::NONE;
+                    return (Zeros::NONE, None);
                 }
                 r.atanh() * self.mode.inv_w
             } else {
                 -c.p / c.q
             };
-            if t > 64.0 * f64::EPSILON * self.time_scale() {
+            let zeros = if t > 64.0 * f64::EPSILON * self.time_scale() {
                 Zeros {
                     next: t,
                     period: f64::INFINITY,
@@ -369,7 +387,8 @@ impl LinearPiece {
                 }
             } else {
                 Zeros::NONE
-            }
+            };
+            (zeros, None)
         }
     }
 
@@ -411,12 +430,17 @@ impl LinearPiece {
     /// two segments with the right slope need looking at: the answer is
     /// exact, not a scan.
     pub fn crossing(&self, level: f64, upward: bool) -> Option<Crossing> {
-        let mut extrema = self.zeros(self.v, self.y);
+        let (mut extrema, first_phase) = self.zeros_and_phase(self.v, self.y);
         // Positions are tracked as y = x − x_eq (so that small swings about
         // a distant equilibrium keep their relative precision).
         let offset = level - self.x_eq;
         let mut t0 = 0.0;
         let mut y_start = self.y.p;
+        // Back through the start level after the first turn (every
+        // crossing of the engine: it starts each piece at the gap), the
+        // way out mirrors the way back: see `polish_half_swing`.
+        let returns = offset == self.y.p;
+        let mut mirror = None;
         // Velocity zeros are simple, so segments alternate direction. The
         // first one's comes from the start state, never from sampling the
         // velocity (which may underflow to 0 far into a decay).
@@ -442,8 +466,13 @@ impl LinearPiece {
                         // speed at an extremum is a graze, not an impact.
                         if crosses(y_end) {
                             let between_extrema = t1.is_some() && (t0 > 0.0 || self.v0 == 0.0);
-                            let (time, velocity) =
-                                self.polish((t0, y_start), (t_end, y_end), offset, between_extrema);
+                            let (time, velocity) = self.polish(
+                                (t0, y_start),
+                                (t_end, y_end),
+                                offset,
+                                between_extrema,
+                                mirror,
+                            );
                             return Some(Crossing {
                                 time,
                                 velocity,
@@ -460,6 +489,8 @@ impl LinearPiece {
             }
             match t1 {
                 Some((t1, y1)) => {
+                    // The phase known at the first extremum only.
+                    mirror = (t0 == 0.0 && returns).then_some(first_phase).flatten();
                     t0 = t1;
                     y_start = y1;
                     rising = !rising;
@@ -540,11 +571,12 @@ impl LinearPiece {
         (t_hi, y_hi): (f64, f64),
         offset: f64,
         between_extrema: bool,
+        mirror: Option<Phase>,
     ) -> (f64, f64) {
         // Up to κ = 1 (a half swing decays by e^(−π) or less) the undamped
         // start is close; beyond, the generic iteration serves.
         if between_extrema && self.q > 0.0 && self.mode.kappa <= 1.0 {
-            return self.polish_half_swing(t_lo, y_lo, offset);
+            return self.polish_half_swing(t_lo, y_lo, offset, mirror);
         }
         let frac = (offset - y_lo) / (y_hi - y_lo);
         let start = if between_extrema {
@@ -588,7 +620,28 @@ impl LinearPiece {
     /// theorems, [`Phase::advance`]) instead of calling `exp` and
     /// `sin_cos` anew: per crossing, one `acos` and one `exp`. Bisection
     /// takes over if Halley leaves the bracket or stalls.
-    fn polish_half_swing(&self, t_lo: f64, y_lo: f64, offset: f64) -> (f64, f64) {
+    ///
+    /// Back through the level the piece started at, u = w·t_lo after it,
+    /// `mirror` is the phase of that start seen from the turn, e^(−κu),
+    /// cos u and sin u (known from [`LinearPiece::zeros`] at no cost). The
+    /// start is then θ = −u, so the crossing solves H(θ) = H(−u): undamped,
+    /// the way back takes as long as the way out, θ = u. To second order
+    /// in κ (expand H in κ and θ about u) the root is
+    /// `θ ≈ u + δ·(1 + κu − δ·cos u/(2 sin u))`, δ = 2κ(1 − u·cot u). Where
+    /// that step from u is within [`SMALL_STEP`] it is as close as the
+    /// `acos` start or closer (within 3e-2 rad for κ ≤ 1; about 1e-3 for
+    /// the engine's relays), and its phase follows from the turn's by
+    /// [`Phase::advance`]: no `acos` and no second `exp`. Beyond (a slow
+    /// start near the bottom of the swing, or heavy damping), the `acos`
+    /// start serves.
+    fn polish_half_swing(
+        &self,
+        t_lo: f64,
+        y_lo: f64,
+        offset: f64,
+        mirror: Option<Phase>,
+    ) -> (f64, f64) {
+        use std::f64::consts::PI;
         let Mode {
             w,
             inv_w,
@@ -597,36 +650,54 @@ impl LinearPiece {
             ..
         } = self.mode;
         let k2 = 1.0 + kappa * kappa;
-        let target = offset / y_lo;
-        // The undamped start: a half cosine between the two extreme values
-        // H(0) = 1 and H(π) = −e^(−κπ), where cos and sin are known exactly.
-        let frac = ((1.0 - target) * inv_swing).clamp(0.0, 1.0);
-        let mut theta = (1.0 - 2.0 * frac).acos();
-        let mut p = Phase {
-            cos: 1.0 - 2.0 * frac,
-            sin: 2.0 * (frac * (1.0 - frac)).sqrt(),
-            decay: (-kappa * theta).exp(),
-        };
-        let (mut lo, mut hi) = (0.0, std::f64::consts::PI);
+        let mirrored = mirror.and_then(|turn| {
+            let u = w * t_lo;
+            let cot = turn.cos / turn.sin;
+            let delta = 2.0 * kappa * (1.0 - u * cot);
+            let step = delta * (1.0 + kappa * u - 0.5 * delta * cot);
+            let theta = u + step;
+            // Also refuses a NaN (sin u = 0: the start was at rest).
+            (step.abs() <= SMALL_STEP && theta > 0.0 && theta < PI)
+                .then(|| (theta, turn.advance(step, kappa, theta)))
+        });
+        let (mut theta, mut p) = mirrored.unwrap_or_else(|| {
+            // The undamped start: a half cosine between the two extreme
+            // values H(0) = 1 and H(π) = −e^(−κπ), where cos and sin are
+            // known exactly.
+            let frac = ((1.0 - offset / y_lo) * inv_swing).clamp(0.0, 1.0);
+            let theta = (1.0 - 2.0 * frac).acos();
+            let p = Phase {
+                cos: 1.0 - 2.0 * frac,
+                sin: 2.0 * (frac * (1.0 - frac)).sqrt(),
+                decay: (-kappa * theta).exp(),
+            };
+            (theta, p)
+        });
+        let (mut lo, mut hi) = (0.0, PI);
         // The phase w·t at the root is ~w·t_lo + θ: its ulps set the tolerance.
         let phase_ulps = |theta: f64| 4.0 * f64::EPSILON * (w * t_lo + theta);
         // The last Halley step (for the convergence rate), and the last
         // move of any kind (Halley must beat bisection, or bisect).
         let mut step_before = f64::NAN;
         let mut moved = std::f64::consts::PI;
+        // The residual is y_lo·H(θ) − offset, positions rather than their
+        // ratio: no division before the first step, and the same steps.
+        let falling = y_lo > 0.0;
         for _ in 0..100 {
-            let f = p.decay * (p.cos + kappa * p.sin) - target;
+            let scale = y_lo * p.decay;
+            let f = scale * (p.cos + kappa * p.sin) - offset;
             if f == 0.0 {
                 break;
             }
-            // H decreases: a positive residual means the root is ahead.
-            if f > 0.0 {
+            // H decreases: a residual of the sign of y_lo means the root
+            // is ahead.
+            if (f > 0.0) == falling {
                 lo = theta;
             } else {
                 hi = theta;
             }
-            let d1 = -k2 * p.decay * p.sin;
-            let d2 = -k2 * p.decay * (p.cos - kappa * p.sin);
+            let d1 = -k2 * scale * p.sin;
+            let d2 = -k2 * scale * (p.cos - kappa * p.sin);
             let step = -2.0 * f * d1 / (2.0 * d1 * d1 - f * d2);
             let next = theta + step;
             if !(next > lo && next < hi && 2.0 * step.abs() <= moved) {
@@ -656,8 +727,8 @@ impl LinearPiece {
             if converged && step.abs() <= TAYLOR_STEP {
                 // The velocity at θ + step from the derivatives at θ, to
                 // second order: the error, O(step³), is below rounding.
-                let d3 = -k2 * p.decay * ((kappa * kappa - 1.0) * p.sin - 2.0 * kappa * p.cos);
-                let velocity = y_lo * w * (d1 + step * (d2 + 0.5 * step * d3));
+                let d3 = -k2 * scale * ((kappa * kappa - 1.0) * p.sin - 2.0 * kappa * p.cos);
+                let velocity = w * (d1 + step * (d2 + 0.5 * step * d3));
                 return (t_lo + next * inv_w, velocity);
             }
             p = p.advance(step, kappa, next);
@@ -684,15 +755,32 @@ struct Phase {
 impl Phase {
     /// The same at θ + `step` (= `theta_new`), by addition theorems with
     /// short series where the step is small enough for them to be exact
-    /// to rounding (the first omitted terms are below 1e-19 relative):
+    /// to rounding (the first omitted terms are below 1e-17 relative):
     /// far cheaper than `sin_cos` and `exp`, which serve larger steps.
+    #[inline(always)]
     fn advance(self, step: f64, kappa: f64, theta_new: f64) -> Phase {
         let x = -kappa * step;
+        if step.abs() <= TINY_STEP && x.abs() <= TINY_STEP {
+            // A converging Halley step: to δ⁵, δ⁴ and x⁵ (the first
+            // omitted terms are below 5e-18).
+            let d2 = step * step;
+            let sin = step + (step * d2) * (-1.0 / 6.0 + d2 * (1.0 / 120.0));
+            let cos_m1 = d2 * (-0.5 + d2 * (1.0 / 24.0));
+            let x2 = x * x;
+            let exp_m1 =
+                x * ((1.0 + 0.5 * x) + x2 * ((1.0 / 6.0 + x * (1.0 / 24.0)) + x2 * (1.0 / 120.0)));
+            return Phase {
+                decay: self.decay + self.decay * exp_m1,
+                cos: self.cos + (self.cos * cos_m1 - self.sin * sin),
+                sin: self.sin + (self.sin * cos_m1 + self.cos * sin),
+            };
+        }
         let decay = if x.abs() <= SMALL_DECAY {
-            // eˣ − 1 to x⁶, grouped (Estrin) to shorten the dependency
+            // eˣ − 1 to x⁷, grouped (Estrin) to shorten the dependency
             // chain.
             let x2 = x * x;
-            let high = (1.0 / 6.0 + x * (1.0 / 24.0)) + x2 * (1.0 / 120.0 + x * (1.0 / 720.0));
+            let high = (1.0 / 6.0 + x * (1.0 / 24.0))
+                + x2 * ((1.0 / 120.0 + x * (1.0 / 720.0)) + x2 * (1.0 / 5040.0));
             let exp_m1 = x * ((1.0 + 0.5 * x) + x2 * high);
             self.decay + self.decay * exp_m1
         } else {
@@ -702,22 +790,18 @@ impl Phase {
             let (sin, cos) = theta_new.sin_cos();
             return Phase { decay, cos, sin };
         }
+        // sin δ and cos δ − 1 to δ¹¹ and δ¹² as polynomials in δ², grouped
+        // (Estrin) to shorten the dependency chain; the reciprocal
+        // factorials are constants, so no divisions.
         let d2 = step * step;
-        // sin δ and cos δ − 1 to δ⁹ and δ¹⁰ in nested (Horner) form; the
-        // reciprocals are constants, so no divisions.
-        let sin = step
-            * (1.0
-                - d2 * (1.0 / 6.0)
-                    * (1.0
-                        - d2 * (1.0 / 20.0)
-                            * (1.0 - d2 * (1.0 / 42.0) * (1.0 - d2 * (1.0 / 72.0)))));
-        let cos_m1 = -d2
-            * 0.5
-            * (1.0
-                - d2 * (1.0 / 12.0)
-                    * (1.0
-                        - d2 * (1.0 / 30.0)
-                            * (1.0 - d2 * (1.0 / 56.0) * (1.0 - d2 * (1.0 / 90.0)))));
+        let d4 = d2 * d2;
+        let sin_high = (-1.0 / 6.0 + d2 * (1.0 / 120.0))
+            + d4 * ((-1.0 / 5040.0 + d2 * (1.0 / 362880.0)) + d4 * (-1.0 / 39916800.0));
+        let sin = step + (step * d2) * sin_high;
+        let cos_m1 = d2
+            * ((-0.5 + d2 * (1.0 / 24.0))
+                + d4 * ((-1.0 / 720.0 + d2 * (1.0 / 40320.0))
+                    + d4 * (-1.0 / 3628800.0 + d2 * (1.0 / 479001600.0))));
         Phase {
             decay,
             cos: self.cos + (self.cos * cos_m1 - self.sin * sin),
@@ -731,9 +815,11 @@ impl Phase {
 const TAYLOR_STEP: f64 = 1.0 / 131072.0;
 
 /// The largest step (radians) and change of the decay exponent that
-/// [`Phase::advance`] takes by series.
-const SMALL_STEP: f64 = 1.0 / 16.0;
-const SMALL_DECAY: f64 = 1.0 / 256.0;
+/// [`Phase::advance`] takes by series: Halley's steps, and the step from a
+/// turn to the mirrored start ([`LinearPiece::polish_half_swing`]).
+const SMALL_STEP: f64 = 1.0 / 4.0;
+const TINY_STEP: f64 = 1.0 / 256.0;
+const SMALL_DECAY: f64 = 1.0 / 64.0;
 
 #[cfg(test)]
 mod tests {
@@ -809,6 +895,90 @@ mod tests {
                 assert!((q.sin - sin).abs() < 4e-16, "{kappa} {step}");
                 assert!((q.cos - cos).abs() < 4e-16, "{kappa} {step}");
                 assert!((q.decay - decay).abs() < 4e-16 * decay, "{kappa} {step}");
+            }
+        }
+    }
+
+    #[test]
+    fn phase_advance_by_long_series_is_exact_to_rounding() {
+        // The mirrored start's step, up to SMALL_STEP, and decay changes up
+        // to SMALL_DECAY.
+        for kappa in [0.0f64, 0.01, 1.0 / 16.0] {
+            for theta in [0.1f64, 1.3, 2.9] {
+                let (sin, cos) = theta.sin_cos();
+                let p = Phase {
+                    decay: (-kappa * theta).exp(),
+                    cos,
+                    sin,
+                };
+                for step in [0.07, -0.1, 0.18, 0.25, -0.25] {
+                    let q = p.advance(step, kappa, theta + step);
+                    let (sin, cos) = (theta + step).sin_cos();
+                    let decay = (-kappa * (theta + step)).exp();
+                    let ctx = format!("κ={kappa} θ={theta} step={step}");
+                    assert!((q.sin - sin).abs() < 4e-16, "{ctx}");
+                    assert!((q.cos - cos).abs() < 4e-16, "{ctx}");
+                    assert!((q.decay - decay).abs() < 4e-16 * decay, "{ctx}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn crossings_back_through_the_start_level_match_bisection() {
+        // The engine's case: each piece starts at the level it next
+        // crosses, so the mirrored start serves (or, far from the turn,
+        // the `acos` one).
+        let mut modes = modes();
+        modes.extend(
+            [1e-3, 0.03, 0.0517, 0.2]
+                .iter()
+                .map(|&kappa| Mode::new(1.0, 2.0 * kappa, 1.0 + kappa * kappa, 0.0)),
+        );
+        for mode in modes {
+            for &(x0, v0) in &[
+                (-0.1, 0.8),
+                (-0.1, -0.8),
+                (-0.9, 0.05),
+                (-0.5, 1e-3),
+                (0.3, -2.0),
+                (0.3, 0.01),
+                (-1e-3, 1.0),
+            ] {
+                let piece = LinearPiece::start(&mode, x0, v0);
+                let upward = v0 < 0.0;
+                let mut turns = piece.zeros(piece.v_combo(), piece.y_combo());
+                let (Some((t1, y1)), Some((t2, _))) = (turns.next(), turns.next()) else {
+                    continue;
+                };
+                let ctx = format!("{mode:?} x0={x0} v0={v0}");
+                let Some(c) = piece.crossing(x0, upward) else {
+                    // No return: the second turn falls short of x0.
+                    let x2 = piece.state(t2).0;
+                    assert!(if upward { x2 <= x0 } else { x2 >= x0 }, "{ctx}");
+                    continue;
+                };
+                // Independent: bisection on x(t) − x0 between the turns.
+                let (mut lo, mut hi) = (t1, t2);
+                for _ in 0..200 {
+                    let mid = 0.5 * (lo + hi);
+                    if (piece.state(mid).0 < x0) == upward {
+                        lo = mid
+                    } else {
+                        hi = mid
+                    }
+                }
+                // A slow crossing is ill-conditioned: positions carry
+                // rounding of a few ulps of the swing, so the time does so
+                // divided by the speed.
+                let v = piece.state(c.time).1;
+                let conditioning = 8.0 * f64::EPSILON * y1.abs().max(x0.abs()) / v.abs();
+                assert!(
+                    (c.time - lo).abs() <= 1e-13 * lo + conditioning,
+                    "{ctx}: {} vs {lo}",
+                    c.time
+                );
+                assert!((c.velocity - v).abs() <= 1e-12 * v.abs(), "{ctx}");
             }
         }
     }
