@@ -81,6 +81,17 @@ pub struct Impact {
     pub max_gap_after: Option<f64>,
 }
 
+/// Releases after the first impact that opened the contact, in a
+/// sequence of intervals that starts open: every open interval but the
+/// one before the first impact.
+pub(crate) fn bounces(intervals: &[Interval]) -> usize {
+    intervals
+        .iter()
+        .filter(|i| i.state == ContactState::Open)
+        .count()
+        .saturating_sub(1)
+}
+
 impl Impact {
     /// A touch at `time` (s) at `velocity` (m/s), before anything else
     /// about the contact is known.

@@ -148,25 +148,32 @@ impl From<&ContactSection> for ContactModel {
     }
 }
 
+/// A finite `value` for which `ok` holds, or the error naming `key`.
+fn check(
+    key: &'static str,
+    value: f64,
+    ok: bool,
+    requirement: impl Into<String>,
+) -> Result<(), WaveformError> {
+    if value.is_finite() && ok {
+        Ok(())
+    } else {
+        Err(WaveformError::InvalidContact {
+            key,
+            value,
+            requirement: requirement.into(),
+        })
+    }
+}
+
 impl ContactModel {
     /// Check every parameter; the error names its scenario key.
     pub fn validate(&self) -> Result<(), WaveformError> {
-        let check = |key: &'static str, value: f64, ok: bool, requirement: String| {
-            if value.is_finite() && ok {
-                Ok(())
-            } else {
-                Err(WaveformError::InvalidContact {
-                    key,
-                    value,
-                    requirement,
-                })
-            }
-        };
         check(
             "contact.r_closed",
             self.r_closed,
             self.r_closed > 0.0,
-            "must be a finite value > 0: the closed contact resistance, in Ω".to_owned(),
+            "must be a finite value > 0: the closed contact resistance, in Ω",
         )?;
         check(
             "contact.r_open",
@@ -182,7 +189,7 @@ impl ContactModel {
             "contact.edge_time",
             self.edge_time,
             self.edge_time > 0.0,
-            "must be a finite value > 0: the duration of each make or break edge, in s".to_owned(),
+            "must be a finite value > 0: the duration of each make or break edge, in s",
         )
     }
 
@@ -214,17 +221,6 @@ pub struct Holm {
 impl Holm {
     /// Check every parameter; the error names its scenario key.
     pub fn validate(&self) -> Result<(), WaveformError> {
-        let check = |key: &'static str, value: f64, ok: bool, requirement: &str| {
-            if value.is_finite() && ok {
-                Ok(())
-            } else {
-                Err(WaveformError::InvalidContact {
-                    key,
-                    value,
-                    requirement: requirement.to_owned(),
-                })
-            }
-        };
         check(
             "contact.holm.r_film",
             self.r_film,

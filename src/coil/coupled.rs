@@ -280,9 +280,9 @@ pub fn run_coupled(
     signals.extend([psi.as_str(), volts.as_str(), current.as_str()]);
 
     // Iteration 0: the armature at rest, the contact open.
-    let mut chatter = open_chatter(settings.t_end);
+    let mut chatter = steady_chatter(ContactState::Open, settings.t_end);
     // The armature starts on its rest stop: the NC contact closed.
-    let mut back = closed_chatter(settings.t_end);
+    let mut back = steady_chatter(ContactState::Closed, settings.t_end);
     let mut path = vec![(0.0, m.initial_position)];
     let mut iterations: Vec<Iteration> = Vec::new();
     for iteration in 1..=options.max_iterations {
@@ -442,16 +442,6 @@ pub fn thin(path: &[(f64, f64)], tolerance: f64) -> Vec<(f64, f64)> {
     out
 }
 
-/// A contact closed from 0 to `t_end`: the NC contact before the first
-/// iteration.
-fn closed_chatter(t_end: f64) -> Chatter {
-    Chatter::from_intervals(vec![Interval {
-        state: ContactState::Closed,
-        start: 0.0,
-        end: t_end,
-    }])
-}
-
 /// The normally-closed contact's subcircuit `subckt`, following the
 /// rest stop's chatter `back`, with the NO contact's electrical model: a
 /// PWL include appended to the contact's (its few dozen points never need
@@ -470,10 +460,11 @@ pub fn nc_include(
     Ok(contact_include(&waveform, subckt, ContactElement::Pwl)?.text)
 }
 
-/// A contact open from 0 to `t_end`: before the first iteration.
-fn open_chatter(t_end: f64) -> Chatter {
+/// A contact in `state` from 0 to `t_end`: before the first iteration,
+/// the NO contact open and the NC contact closed (the armature at rest).
+fn steady_chatter(state: ContactState, t_end: f64) -> Chatter {
     Chatter::from_intervals(vec![Interval {
-        state: ContactState::Open,
+        state,
         start: 0.0,
         end: t_end,
     }])

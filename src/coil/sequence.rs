@@ -56,7 +56,7 @@
 use nalgebra::Vector3;
 
 use super::CoilError;
-use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome};
+use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome, bounces};
 use crate::mechanics::integrate::{Dopri5, Step, Tolerance};
 use crate::mechanics::linear::LinearPiece;
 use crate::mechanics::{Mechanics, Settings, Surface};
@@ -1002,15 +1002,6 @@ impl<D: Drive> Sequence<'_, D> {
         debug_assert_eq!(closed.state, ContactState::Closed);
         self.finish_closed(Outcome::Resolved, closed.start, accumulation, (t, y))
     }
-}
-
-/// Releases after the first impact that opened the contact.
-fn bounces(intervals: &[Interval]) -> usize {
-    intervals
-        .iter()
-        .filter(|i| i.state == ContactState::Open)
-        .count()
-        .saturating_sub(1)
 }
 
 #[cfg(test)]

@@ -23,7 +23,7 @@
 use nalgebra::SVector;
 
 use super::MechanicsError;
-use super::integrate::Tolerance;
+use super::integrate::{Tolerance, trial_step};
 
 const C2: f64 = 0.526001519587677318785587544488e-01;
 const C3: f64 = 0.789002279381515978178381316732e-01;
@@ -351,15 +351,7 @@ where
         let f = &self.f;
         let (t, y, k1) = (self.t, self.y, self.k1);
         loop {
-            let mut h = self.h.min(t_stop - t);
-            let last = h >= t_stop - t;
-            if last {
-                h = t_stop - t;
-            }
-            let too_small = h.is_nan() || h <= 16.0 * f64::EPSILON * t.abs().max(h.abs());
-            if too_small && !last {
-                return Err(MechanicsError::StepSizeTooSmall { time: t, step: h });
-            }
+            let (h, last) = trial_step(self.h, t, t_stop)?;
             // Each stage's input is y + h·Σ a_ij k_j. The newest stage is
             // added last, on its own: the rest is ready earlier, so the
             // chain of dependent operations from one stage to the next is

@@ -26,7 +26,7 @@
 use super::hunt_crossley::{HcContact, HcEnd};
 use super::linear::{LinearPiece, Mode, Shift, Zeros};
 use super::{Mechanics, MechanicsError, Settings, Surface};
-use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome};
+use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome, bounces};
 
 /// Simulate one closing: the chatter sequence from t = 0 to an ending of
 /// model.md §4. Parameters are validated first; an invalid one is an
@@ -261,17 +261,7 @@ impl<'a> Engine<'a> {
                 start: open_since,
                 end: t_hit,
             });
-            self.impacts.push(Impact {
-                impact_time: t_hit,
-                impact_velocity: v_hit,
-                release_time: None,
-                release_velocity: None,
-                restitution: None,
-                contact_time: None,
-                peak_force: None,
-                min_force: None,
-                max_gap_after: None,
-            });
+            self.impacts.push(Impact::touch(t_hit, v_hit));
 
             // Contact from (t_hit, g, v_hit).
             match self.contact(t_hit, v_hit)? {
@@ -621,16 +611,6 @@ pub fn critical_impact_speed(
         }
     }
     Ok(0.5 * (lo + hi))
-}
-
-/// Releases after the first impact that opened the contact: every open
-/// interval but the one before the first impact.
-fn bounces(intervals: &[Interval]) -> usize {
-    intervals
-        .iter()
-        .filter(|i| i.state == ContactState::Open)
-        .count()
-        .saturating_sub(1)
 }
 
 /// Largest and smallest Kelvin–Voigt force `s0 (x − g) + r0 ẋ` over a

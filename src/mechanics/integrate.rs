@@ -64,6 +64,23 @@ where
     pub evaluations: usize,
 }
 
+/// The step to try from `t` with the controller's `h`: cut to land on
+/// `t_stop` (then `true`: the last), and an error when the controller has
+/// shrunk it to rounding level before getting there.
+#[inline(always)]
+pub(crate) fn trial_step(h: f64, t: f64, t_stop: f64) -> Result<(f64, bool), MechanicsError> {
+    let mut h = h.min(t_stop - t);
+    let last = h >= t_stop - t;
+    if last {
+        h = t_stop - t;
+    }
+    let too_small = h.is_nan() || h <= 16.0 * f64::EPSILON * t.abs().max(h.abs());
+    if too_small && !last {
+        return Err(MechanicsError::StepSizeTooSmall { time: t, step: h });
+    }
+    Ok((h, last))
+}
+
 // Butcher tableau of Dormand & Prince (1980).
 const C2: f64 = 1.0 / 5.0;
 const C3: f64 = 3.0 / 10.0;
@@ -138,15 +155,7 @@ where
         let f = &self.f;
         let (t, y, k1) = (self.t, self.y, self.k1);
         loop {
-            let mut h = self.h.min(t_stop - t);
-            let last = h >= t_stop - t;
-            if last {
-                h = t_stop - t;
-            }
-            let too_small = h.is_nan() || h <= 16.0 * f64::EPSILON * t.abs().max(h.abs());
-            if too_small && !last {
-                return Err(MechanicsError::StepSizeTooSmall { time: t, step: h });
-            }
+            let (h, last) = trial_step(self.h, t, t_stop)?;
             let k2 = f(t + C2 * h, &(y + k1 * (A21 * h)));
             let k3 = f(t + C3 * h, &(y + (k1 * A31 + k2 * A32) * h));
             let k4 = f(t + C4 * h, &(y + (k1 * A41 + k2 * A42 + k3 * A43) * h));
