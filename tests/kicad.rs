@@ -1,0 +1,81 @@
+//! The KiCad walkthrough of docs/kicad.md, as a user runs it: the netlist
+//! in `examples/kicad/` is laid out as KiCad's SPICE export writes it (CRLF,
+//! `/NET` names, `GND`, a `.include` of a contact model made by `pwl`), and
+//! `run` must see through the filter exactly the openings that the RC
+//! closed form says are long enough.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use assert_cmd::Command;
+use chatterspice::chatter::ContactState;
+use chatterspice::scenario::Scenario;
+use serde_json::Value;
+
+fn example(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples/kicad")
+        .join(name)
+}
+
+/// R, C and the thresholds as the exported netlist and the scenario give
+/// them: an opening shows at the pin when it lasts longer than the time the
+/// pin needs to charge through R1 + R2 from 0 to the upper threshold.
+fn visible_openings(scenario: &Scenario) -> (usize, usize) {
+    let (r_pu, r_f, c_f, vdd) = (10e3, 1e3, 8.2e-9, 3.3);
+    let tau = (r_pu + r_f) * c_f;
+    let high = scenario.probes[0].high;
+    let needed = tau * (vdd / (vdd - high)).ln();
+    let chatter = chatterspice::simulate(
+        &scenario.mechanics().unwrap(),
+        &scenario.surface(),
+        &scenario.settings(),
+    )
+    .unwrap();
+    let first = chatter.first_impact.unwrap();
+    let openings: Vec<f64> = chatter
+        .intervals
+        .iter()
+        .filter(|iv| iv.state == ContactState::Open && iv.start > first)
+        .map(|iv| iv.end - iv.start)
+        .collect();
+    // No opening so close to the threshold that ngspice's steps could
+    // decide it: the test must not pass by luck.
+    for d in &openings {
+        assert!((d - needed).abs() > 0.05 * needed, "{d} vs {needed}");
+    }
+    let long = openings.iter().filter(|d| **d > needed).count();
+    (long, openings.len())
+}
+
+#[test]
+fn the_exported_netlist_runs_as_the_walkthrough_says() {
+    let _ng = ngspice_or_skip!();
+    let netlist = example("mcu_input.cir");
+    let before = std::fs::read(&netlist).unwrap();
+    assert!(before.windows(2).any(|w| w == b"\r\n"), "KiCad-style CRLF");
+    let scenario_path = example("relay.toml");
+    let scenario = Scenario::load(&scenario_path).unwrap();
+    let (long, all) = visible_openings(&scenario);
+    assert!(long > 0 && long < all, "{long} of {all}: the filter must matter");
+
+    let out = Command::cargo_bin("chatterspice")
+        .unwrap()
+        .args(["run", "--format", "json"])
+        .arg(&scenario_path)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let probe = &report["probes"][0];
+    assert_eq!(probe["signal"], "v(/in)");
+    // One edge for the first make, two for every opening the pin sees.
+    assert_eq!(probe["edges"].as_u64().unwrap() as usize, 1 + 2 * long);
+    // The exported file is never edited.
+    assert_eq!(std::fs::read(&netlist).unwrap(), before);
+}
