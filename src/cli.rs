@@ -50,7 +50,7 @@ pub enum Command {
     /// Print a SPICE raw file: one plot as CSV, or a JSON summary of every plot.
     Raw(RawArgs),
     /// Run the scenario many times with the numbers of its [sweep] varied
-    /// (Monte Carlo or a grid): sweep.csv, summary.json, sweep.svg.
+    /// (Monte Carlo or a grid): sweep.csv, summary.json, sweep.svg, sweep.png.
     Sweep(SweepArgs),
     /// Join the CSVs of a sweep's shards (--shard K/N) into the CSV of one run.
     Merge(MergeArgs),
@@ -114,7 +114,7 @@ pub struct RunArgs {
     pub format: RunFormat,
 
     /// Also write every artefact into DIR: report.json, waveforms.csv,
-    /// netlist.cir, contact.inc, plot.svg. Existing files there are an
+    /// netlist.cir, contact.inc, plot.svg, plot.png. Existing files there are an
     /// error unless --force.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
@@ -375,6 +375,7 @@ fn run(args: &RunArgs) -> Result<()> {
         let files = report::bundle::run_files(&result, dimensionless.as_ref())
             .context("the run succeeded, but its files could not be made")?;
         report::write_bundle(dir, &files, args.force)?;
+        warn_if_no_fonts();
     }
     emit(&text, None, false)
 }
@@ -406,6 +407,16 @@ fn check(args: &CheckArgs) -> Result<Status> {
     })
 }
 
+/// A PNG drawn without a font has no text: say how to get one.
+fn warn_if_no_fonts() {
+    if !report::png::fonts_available() {
+        eprintln!(
+            "warning: no font found, so the PNG plots have no text; install one \
+             (Debian: apt-get install fonts-dejavu-core) or use the SVG"
+        );
+    }
+}
+
 /// Fail before any work if `--out DIR` already holds a file the run
 /// would write.
 fn refuse_existing_bundle(dir: &Path, force: bool) -> Result<()> {
@@ -418,6 +429,7 @@ fn refuse_existing_bundle(dir: &Path, force: bool) -> Result<()> {
         "netlist.cir",
         pipeline::INCLUDE_FILE,
         "plot.svg",
+        "plot.png",
     ];
     if let Some(existing) = names.iter().map(|n| dir.join(n)).find(|p| p.exists()) {
         bail!(
@@ -571,7 +583,7 @@ pub struct SweepArgs {
     #[arg(short = 'j', long, value_name = "J")]
     pub jobs: Option<NonZeroUsize>,
 
-    /// Directory for sweep.csv, summary.json and sweep.svg (created if
+    /// Directory for sweep.csv, summary.json, sweep.svg and sweep.png (created if
     /// needed) [default: the current directory]. Existing files there are
     /// an error unless --force.
     #[arg(long, value_name = "DIR")]
@@ -631,6 +643,7 @@ fn sweep_files(shard: Option<Shard>) -> Vec<String> {
             "sweep.csv".to_owned(),
             "summary.json".to_owned(),
             "sweep.svg".to_owned(),
+            "sweep.png".to_owned(),
         ],
     }
 }
@@ -721,6 +734,9 @@ fn sweep(args: &SweepArgs) -> Result<Status> {
         )?;
         let svg = sweep::plot::render(&collected, &sampler)?;
         report::write_new_file(&dir.join(&names[2]), svg.as_bytes(), args.force)?;
+        let png = report::png::render(&svg)?;
+        report::write_new_file(&dir.join(&names[3]), &png.bytes, args.force)?;
+        warn_if_no_fonts();
     }
     let mut text = summary.render_table();
     text.push_str(&format!(

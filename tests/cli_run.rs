@@ -115,9 +115,12 @@ fn out_writes_every_artefact_and_never_overwrites_without_force() {
         "netlist.cir",
         "contact.inc",
         "plot.svg",
+        "plot.png",
     ] {
         assert!(out.join(file).is_file(), "{file} not written");
     }
+    let png = std::fs::read(out.join("plot.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"), "plot.png is a PNG");
     let deck = std::fs::read_to_string(out.join("netlist.cir")).unwrap();
     assert!(deck.contains(".include contact.inc"), "{deck}");
     let csv = std::fs::read_to_string(out.join("waveforms.csv")).unwrap();

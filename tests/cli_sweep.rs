@@ -64,7 +64,7 @@ fn mechanics_only_csv_is_the_same_for_one_and_two_jobs() {
     );
     assert_eq!(one, two);
     assert_eq!(String::from_utf8(one).unwrap().lines().count(), 2001);
-    for file in ["summary.json", "sweep.svg"] {
+    for file in ["summary.json", "sweep.svg", "sweep.png"] {
         assert_eq!(
             std::fs::read(dir.path().join("j1").join(file)).unwrap(),
             std::fs::read(dir.path().join("j2").join(file)).unwrap(),

@@ -9,13 +9,14 @@
 //! | `netlist.cir` | the deck that was run: the user's netlist plus the `.include` |
 //! | `contact.inc` | the contact subcircuit (and any data files it reads) |
 //! | `plot.svg` | the contact and the probes over the chatter |
+//! | `plot.png` | the same plot as a picture ([`png`]) |
 //!
 //! `cd DIR && ngspice netlist.cir` runs the same simulation again.
 
 use thiserror::Error;
 
 use super::svg::{self, ContactTrace, ProbePanel, Series, SvgPlot};
-use super::{csv, json};
+use super::{csv, json, png};
 use crate::analysis::{AnalysisError, signal_values};
 use crate::mechanics::Dimensionless;
 use crate::pipeline::{INCLUDE_FILE, RunResult};
@@ -28,6 +29,8 @@ pub enum BundleError {
     Waveforms(#[from] AnalysisError),
     #[error("cannot draw the plot")]
     Plot(#[from] svg::SvgError),
+    #[error("cannot render the plot as PNG")]
+    Png(#[from] png::PngError),
 }
 
 /// The files of `run`: (file name, contents), in the order of the table
@@ -61,7 +64,9 @@ pub fn run_files(
     for (name, contents) in &run.include.data_files {
         files.push((name.clone(), contents.clone().into_bytes()));
     }
-    files.push(("plot.svg".to_owned(), plot(run)?.into_bytes()));
+    let svg = plot(run)?;
+    files.push(("plot.png".to_owned(), png::render(&svg)?.bytes));
+    files.push(("plot.svg".to_owned(), svg.into_bytes()));
     Ok(files)
 }
 

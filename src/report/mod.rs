@@ -16,6 +16,7 @@
 pub mod bundle;
 pub mod csv;
 pub mod json;
+pub mod png;
 pub mod svg;
 pub mod table;
 pub(crate) mod units;
