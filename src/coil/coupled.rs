@@ -24,6 +24,7 @@ use std::time::{Duration, Instant};
 
 use thiserror::Error;
 
+use super::accelerate::{CircuitRun, settle};
 use super::cycle::Stops;
 use super::forced::simulate_cycle;
 use super::timing::{Operation, Switching, operations};
@@ -51,6 +52,11 @@ pub struct CouplingOptions {
     pub max_iterations: usize,
     /// Wall-clock limit of each ngspice run.
     pub timeout: Duration,
+    /// Settle the coil and the mechanics against each ngspice run's coil
+    /// voltage before the next run (see [`super::accelerate`]); `false`
+    /// is the plain relaxation, which hands the mechanics' path straight
+    /// back to ngspice. Both converge to the same events.
+    pub accelerate: bool,
 }
 
 impl Default for CouplingOptions {
@@ -65,6 +71,7 @@ impl Default for CouplingOptions {
             tolerance: 1e-7,
             max_iterations: 20,
             timeout: RunRequest::DEFAULT_TIMEOUT,
+            accelerate: true,
         }
     }
 }
@@ -362,9 +369,71 @@ pub fn run_coupled(
             change,
             ngspice_elapsed,
         });
-        let tolerance = PATH_TOLERANCE * (coil.air_gap + coil.iron_gap);
-        (chatter, back, path) = (cycle.make, cycle.back, thin(&cycle.path, tolerance));
-        if change <= options.tolerance && iteration > 1 {
+        if std::env::var_os("CS_TRACE").is_some() {
+            let ev: Vec<(f64, Option<f64>)> = cycle
+                .make
+                .impacts
+                .iter()
+                .map(|i| (i.impact_time, i.release_time))
+                .collect();
+            let bv: Vec<(f64, Option<f64>)> = cycle
+                .back
+                .impacts
+                .iter()
+                .map(|i| (i.impact_time, i.release_time))
+                .collect();
+            eprintln!(
+                "pass {iteration}: change {change:e} make {:?} back {:?}",
+                &ev[ev.len().saturating_sub(2)..],
+                &bv[..bv.len().min(2)]
+            );
+        }
+        let converged = change <= options.tolerance && iteration > 1;
+        let thinning = PATH_TOLERANCE * (coil.air_gap + coil.iron_gap);
+        if converged || !options.accelerate {
+            (chatter, back, path) = (cycle.make, cycle.back, thin(&cycle.path, thinning));
+        } else {
+            let Some(Vector::Real(time)) = plot.scale() else {
+                return Err(CouplingError::MissingVector {
+                    iteration,
+                    vector: "time".to_owned(),
+                });
+            };
+            let coil_volts = plot
+                .real(&volts)
+                .ok_or_else(|| CouplingError::MissingVector {
+                    iteration,
+                    vector: volts.clone(),
+                })?;
+            let flux_values: Vec<f64> = flux.iter().map(|&(_, v)| v).collect();
+            let run = CircuitRun {
+                time,
+                volts: coil_volts,
+                flux: &flux_values,
+                path: &path,
+            };
+            let (next, inner) = settle(
+                &coil,
+                &run,
+                cycle,
+                &mechanics,
+                &stops,
+                &settings,
+                options.tolerance,
+                thinning,
+            )
+            .map_err(|source| CouplingError::Coil {
+                path: origin.clone(),
+                iteration,
+                source,
+            })?;
+            if std::env::var_os("CS_TRACE").is_some() {
+                eprintln!("  inner {inner}");
+            }
+            (chatter, back, path) = (next.make, next.back, thin(&next.path, thinning));
+            continue;
+        }
+        if converged {
             let vector = |name: &str| {
                 plot.real(name).ok_or_else(|| CouplingError::MissingVector {
                     iteration,
@@ -472,7 +541,7 @@ fn steady_chatter(state: ContactState, t_end: f64) -> Chatter {
 
 /// s, the largest move of an impact or release time between two
 /// sequences; infinite when they do not have the same events.
-fn event_change(a: &Chatter, b: &Chatter) -> f64 {
+pub(super) fn event_change(a: &Chatter, b: &Chatter) -> f64 {
     if a.impacts.len() != b.impacts.len() {
         return f64::INFINITY;
     }
@@ -498,7 +567,7 @@ fn series(plot: &Plot, name: &str) -> Option<Vec<(f64, f64)>> {
 }
 
 /// Linear interpolation in (time, value) samples, held beyond both ends.
-fn interpolate(samples: &[(f64, f64)], t: f64) -> f64 {
+pub(super) fn interpolate(samples: &[(f64, f64)], t: f64) -> f64 {
     let k = samples.partition_point(|&(s, _)| s <= t);
     if k == 0 {
         return samples.first().map_or(0.0, |&(_, v)| v);
