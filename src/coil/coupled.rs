@@ -369,25 +369,6 @@ pub fn run_coupled(
             change,
             ngspice_elapsed,
         });
-        if std::env::var_os("CS_TRACE").is_some() {
-            let ev: Vec<(f64, Option<f64>)> = cycle
-                .make
-                .impacts
-                .iter()
-                .map(|i| (i.impact_time, i.release_time))
-                .collect();
-            let bv: Vec<(f64, Option<f64>)> = cycle
-                .back
-                .impacts
-                .iter()
-                .map(|i| (i.impact_time, i.release_time))
-                .collect();
-            eprintln!(
-                "pass {iteration}: change {change:e} make {:?} back {:?}",
-                &ev[ev.len().saturating_sub(2)..],
-                &bv[..bv.len().min(2)]
-            );
-        }
         let converged = change <= options.tolerance && iteration > 1;
         let thinning = PATH_TOLERANCE * (coil.air_gap + coil.iron_gap);
         if converged || !options.accelerate {
@@ -412,7 +393,7 @@ pub fn run_coupled(
                 flux: &flux_values,
                 path: &path,
             };
-            let (next, inner) = settle(
+            let (next, _) = settle(
                 &coil,
                 &run,
                 cycle,
@@ -427,9 +408,6 @@ pub fn run_coupled(
                 iteration,
                 source,
             })?;
-            if std::env::var_os("CS_TRACE").is_some() {
-                eprintln!("  inner {inner}");
-            }
             (chatter, back, path) = (next.make, next.back, thin(&next.path, thinning));
             continue;
         }
