@@ -1,5 +1,5 @@
 //! The coil in the user's own driver circuit: two-way coupling between
-//! ngspice and the mechanics by waveform relaxation (issue 6).
+//! ngspice and the mechanics by waveform relaxation.
 //!
 //! Each iteration runs the whole circuit in ngspice with the coil's
 //! inductance following the armature path of the previous iteration
@@ -8,7 +8,10 @@
 //! runs the mechanics under the magnetic pull it makes,
 //! F_m = ψ²/(2 μ0 N² A) ([`Coil::force_from_flux`]), which depends on the
 //! flux alone and not on where the armature is ([`simulate_forced_path`]).
-//! The new path goes into the next circuit run. The first iteration holds
+//! The new path goes into the next circuit run, after the coil and the
+//! mechanics have been settled against that run's coil voltage with no
+//! ngspice ([`super::accelerate`], unless `accelerate` is off): the same
+//! fixed point in fewer runs. The first iteration holds
 //! the armature at rest. The loop stops when no event time (lift-off
 //! excluded: every impact and release) moves by more than the tolerance
 //! between two iterations, and fails when it has not after the allowed
@@ -17,7 +20,7 @@
 //! Why waveform relaxation: it uses ngspice as it is, in batch runs, with
 //! the user's driver untouched, and each half keeps its own exact event
 //! handling. A lock-step co-simulation through libngspice was not built
-//! (issue 6 asks for it only if measured faster or more robust).
+//! (see docs/coupling.md for the measurements and the reasons).
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -61,11 +64,10 @@ pub struct CouplingOptions {
 
 impl Default for CouplingOptions {
     /// 0.1 µs is far below any relay's bounce (tens of µs) and well above
-    /// the integrators' precision. A closing converges in about five
-    /// iterations; a whole cycle takes more, as each pass settles the
-    /// events a little further along (a slow release, whose break moves
-    /// with every small change of the held current, took eleven): twenty
-    /// allows for both.
+    /// the integrators' precision. Settled against each run's coil
+    /// voltage, a whole cycle converges in three to five ngspice passes
+    /// (the plain relaxation took five to eleven, a slow diode release the
+    /// most): twenty allows for both schemes.
     fn default() -> Self {
         CouplingOptions {
             tolerance: 1e-7,
