@@ -46,6 +46,15 @@ pub struct CircuitRun<'a> {
     pub path: &'a [(f64, f64)],
 }
 
+/// The coupling's tolerances.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tolerances {
+    /// s, on the event times.
+    pub events: f64,
+    /// m, to which paths are thinned before they go to ngspice.
+    pub path: f64,
+}
+
 /// How many mechanics runs the inner relaxation may take per ngspice run:
 /// each costs a few milliseconds, and the inner map contracts as fast as
 /// the plain coupling did (some ten passes to 0.1 µs on the slow diode
@@ -60,8 +69,7 @@ const INNER_FRACTION: f64 = 0.1;
 
 /// The armature's cycle at the fixed point of the estimated pull (see the
 /// module notes), starting from `start`, the mechanics under the run's own
-/// flux. `thinning` (m) is the tolerance to which paths are thinned for
-/// ngspice. Returns the cycle and the number of mechanics runs it took.
+/// flux. Returns the cycle and the number of mechanics runs it took.
 pub fn settle(
     coil: &Coil,
     run: &CircuitRun,
@@ -69,8 +77,7 @@ pub fn settle(
     mechanics: &Mechanics,
     stops: &Stops,
     settings: &Settings,
-    tolerance: f64,
-    thinning: f64,
+    tolerances: Tolerances,
 ) -> Result<(Cycle, usize), CoilError> {
     let base = flux_along(coil, run, run.path);
     let mut current = start;
@@ -78,7 +85,11 @@ pub fn settle(
         // The path as ngspice would be given it (thinned like `run.path`):
         // at the fixed point the correction must vanish exactly, or its
         // leftover would bias the next run's events.
-        let phi = flux_along(coil, run, &super::coupled::thin(&current.path, thinning));
+        let phi = flux_along(
+            coil,
+            run,
+            &super::coupled::thin(&current.path, tolerances.path),
+        );
         let estimate: Vec<(f64, f64)> = (0..run.time.len())
             .map(|j| (run.time[j], run.flux[j] + phi[j] - base[j]))
             .collect();
@@ -88,7 +99,7 @@ pub fn settle(
         let moved = super::coupled::event_change(&current.make, &next.make)
             .max(super::coupled::event_change(&current.back, &next.back));
         current = next;
-        if moved <= INNER_FRACTION * tolerance {
+        if moved <= INNER_FRACTION * tolerances.events {
             return Ok((current, inner));
         }
     }

@@ -27,7 +27,7 @@ use std::time::{Duration, Instant};
 
 use thiserror::Error;
 
-use super::accelerate::{CircuitRun, settle};
+use super::accelerate::{CircuitRun, Tolerances, settle};
 use super::cycle::Stops;
 use super::forced::simulate_cycle;
 use super::timing::{Operation, Switching, operations};
@@ -402,8 +402,10 @@ pub fn run_coupled(
                 &mechanics,
                 &stops,
                 &settings,
-                options.tolerance,
-                thinning,
+                Tolerances {
+                    events: options.tolerance,
+                    path: thinning,
+                },
             )
             .map_err(|source| CouplingError::Coil {
                 path: origin.clone(),
