@@ -177,8 +177,9 @@ mod tests {
     }
 
     #[test]
-    fn a_closed_armature_holds_the_same_flux_at_a_smaller_current() {
-        // Held closed at x: the steady flux is V k / (R (a − x)) = L(x) V/R.
+    fn a_closed_armature_charges_with_the_closed_gaps_inductance() {
+        // Held closed at x: the flux heads for L(x) V/R, three times the open
+        // coil's.
         let coil = coil();
         let x = 4.5e-4;
         let time: Vec<f64> = (0..=200_000).map(|j| f64::from(j) * 1e-6).collect();
@@ -192,7 +193,13 @@ mod tests {
             path: &path,
         };
         let psi = flux_along(&coil, &run, &path);
-        let steady = coil.inductance(x) * 5.0 / coil.resistance;
-        assert!((psi.last().unwrap() / steady - 1.0).abs() < 1e-6);
+        // The RL charge with the closed gap's inductance, 12 of its time
+        // constants along.
+        let l = coil.inductance(x);
+        let steady = l * 5.0 / coil.resistance;
+        let t = *time.last().unwrap();
+        let exact = steady * (1.0 - (-t * coil.resistance / l).exp());
+        assert!((psi.last().unwrap() / exact - 1.0).abs() < 1e-9);
+        assert!(*psi.last().unwrap() > 2.0 * coil.inductance(0.0) * 5.0 / coil.resistance);
     }
 }
