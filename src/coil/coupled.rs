@@ -1,5 +1,5 @@
 //! The coil in the user's own driver circuit: two-way coupling between
-//! ngspice and the mechanics by waveform relaxation (issue 6).
+//! ngspice and the mechanics by waveform relaxation.
 //!
 //! Each iteration runs the whole circuit in ngspice with the coil's
 //! inductance following the armature path of the previous iteration
@@ -8,7 +8,10 @@
 //! runs the mechanics under the magnetic pull it makes,
 //! F_m = ψ²/(2 μ0 N² A) ([`Coil::force_from_flux`]), which depends on the
 //! flux alone and not on where the armature is ([`simulate_forced_path`]).
-//! The new path goes into the next circuit run. The first iteration holds
+//! The new path goes into the next circuit run, after the coil and the
+//! mechanics have been settled against that run's coil voltage with no
+//! ngspice ([`super::accelerate`], unless `accelerate` is off): the same
+//! fixed point in fewer runs. The first iteration holds
 //! the armature at rest. The loop stops when no event time (lift-off
 //! excluded: every impact and release) moves by more than the tolerance
 //! between two iterations, and fails when it has not after the allowed
@@ -17,13 +20,14 @@
 //! Why waveform relaxation: it uses ngspice as it is, in batch runs, with
 //! the user's driver untouched, and each half keeps its own exact event
 //! handling. A lock-step co-simulation through libngspice was not built
-//! (issue 6 asks for it only if measured faster or more robust).
+//! (see docs/coupling.md for the measurements and the reasons).
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use thiserror::Error;
 
+use super::accelerate::{CircuitRun, Tolerances, settle};
 use super::cycle::Stops;
 use super::forced::simulate_cycle;
 use super::timing::{Operation, Switching, operations};
@@ -51,20 +55,25 @@ pub struct CouplingOptions {
     pub max_iterations: usize,
     /// Wall-clock limit of each ngspice run.
     pub timeout: Duration,
+    /// Settle the coil and the mechanics against each ngspice run's coil
+    /// voltage before the next run (see [`super::accelerate`]); `false`
+    /// is the plain relaxation, which hands the mechanics' path straight
+    /// back to ngspice. Both converge to the same events.
+    pub accelerate: bool,
 }
 
 impl Default for CouplingOptions {
     /// 0.1 µs is far below any relay's bounce (tens of µs) and well above
-    /// the integrators' precision. A closing converges in about five
-    /// iterations; a whole cycle takes more, as each pass settles the
-    /// events a little further along (a slow release, whose break moves
-    /// with every small change of the held current, took eleven): twenty
-    /// allows for both.
+    /// the integrators' precision. Settled against each run's coil
+    /// voltage, a whole cycle converges in three to five ngspice passes
+    /// (the plain relaxation took five to eleven, a slow diode release the
+    /// most): twenty allows for both schemes.
     fn default() -> Self {
         CouplingOptions {
             tolerance: 1e-7,
             max_iterations: 20,
             timeout: RunRequest::DEFAULT_TIMEOUT,
+            accelerate: true,
         }
     }
 }
@@ -362,9 +371,51 @@ pub fn run_coupled(
             change,
             ngspice_elapsed,
         });
-        let tolerance = PATH_TOLERANCE * (coil.air_gap + coil.iron_gap);
-        (chatter, back, path) = (cycle.make, cycle.back, thin(&cycle.path, tolerance));
-        if change <= options.tolerance && iteration > 1 {
+        let converged = change <= options.tolerance && iteration > 1;
+        let thinning = PATH_TOLERANCE * (coil.air_gap + coil.iron_gap);
+        if converged || !options.accelerate {
+            (chatter, back, path) = (cycle.make, cycle.back, thin(&cycle.path, thinning));
+        } else {
+            let Some(Vector::Real(time)) = plot.scale() else {
+                return Err(CouplingError::MissingVector {
+                    iteration,
+                    vector: "time".to_owned(),
+                });
+            };
+            let coil_volts = plot
+                .real(&volts)
+                .ok_or_else(|| CouplingError::MissingVector {
+                    iteration,
+                    vector: volts.clone(),
+                })?;
+            let flux_values: Vec<f64> = flux.iter().map(|&(_, v)| v).collect();
+            let run = CircuitRun {
+                time,
+                volts: coil_volts,
+                flux: &flux_values,
+                path: &path,
+            };
+            let (next, _) = settle(
+                &coil,
+                &run,
+                cycle,
+                &mechanics,
+                &stops,
+                &settings,
+                Tolerances {
+                    events: options.tolerance,
+                    path: thinning,
+                },
+            )
+            .map_err(|source| CouplingError::Coil {
+                path: origin.clone(),
+                iteration,
+                source,
+            })?;
+            (chatter, back, path) = (next.make, next.back, thin(&next.path, thinning));
+            continue;
+        }
+        if converged {
             let vector = |name: &str| {
                 plot.real(name).ok_or_else(|| CouplingError::MissingVector {
                     iteration,
@@ -472,7 +523,7 @@ fn steady_chatter(state: ContactState, t_end: f64) -> Chatter {
 
 /// s, the largest move of an impact or release time between two
 /// sequences; infinite when they do not have the same events.
-fn event_change(a: &Chatter, b: &Chatter) -> f64 {
+pub(super) fn event_change(a: &Chatter, b: &Chatter) -> f64 {
     if a.impacts.len() != b.impacts.len() {
         return f64::INFINITY;
     }
@@ -498,7 +549,7 @@ fn series(plot: &Plot, name: &str) -> Option<Vec<(f64, f64)>> {
 }
 
 /// Linear interpolation in (time, value) samples, held beyond both ends.
-fn interpolate(samples: &[(f64, f64)], t: f64) -> f64 {
+pub(super) fn interpolate(samples: &[(f64, f64)], t: f64) -> f64 {
     let k = samples.partition_point(|&(s, _)| s <= t);
     if k == 0 {
         return samples.first().map_or(0.0, |&(_, v)| v);

@@ -36,6 +36,7 @@
 //! force extrema) bracketed on one step and polished by bisection on the
 //! step's interpolant.
 
+pub mod accelerate;
 pub mod coupled;
 pub mod cycle;
 pub mod direct;

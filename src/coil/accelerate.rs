@@ -1,0 +1,205 @@
+//! A better next path for the coupling: the circuit's last run taken as
+//! a voltage source, the coil and the mechanics settled against it with
+//! no ngspice run.
+//!
+//! The plain relaxation hands the mechanics' path straight back to
+//! ngspice, so every pass settles the two-way coupling between the
+//! armature and the coil's flux (the back-EMF `i L'(x) ẋ`, the current
+//! that a smaller gap draws at the same flux) only a little further. But
+//! that coupling lives in the coil, whose equation is known here:
+//!
+//! ```text
+//! dψ/dt = v(t) − R ψ (a − x(t)) / k
+//! ```
+//!
+//! What ngspice adds is only the driver, i.e. how the coil's terminal
+//! voltage `v(t)` answers the coil current; a transistor in saturation or
+//! a conducting flyback diode or zener hold it almost fixed. So, given
+//! ngspice's run `k` along the path `x_k` (its flux `ψ_k`, its terminal
+//! voltage `v_k`), the pull along another path `x` is estimated as
+//!
+//! ```text
+//! ψ(x) ≈ ψ_k + Φ(v_k, x) − Φ(v_k, x_k)
+//! ```
+//!
+//! with `Φ(v, x)` the coil equation integrated under the fixed voltage
+//! `v_k`. The correction vanishes at `x = x_k`, so a path that agrees with
+//! its own ngspice run is a fixed point here too: the accelerated loop
+//! converges to the same answer as the plain one, only with fewer
+//! ngspice runs (the estimate is a defect correction, exact up to how far
+//! the driver's voltage moves with the current). The path for the next
+//! ngspice run is the fixed point of this cheap map, found by relaxation
+//! among the mechanics runs alone.
+
+use super::cycle::{Cycle, Stops};
+use super::forced::simulate_cycle;
+use super::{Coil, CoilError};
+use crate::mechanics::{Mechanics, Settings};
+
+/// One ngspice run of the coil: its time points, the voltage across the
+/// coil and its flux linkage there, and the armature path it followed.
+pub struct CircuitRun<'a> {
+    pub time: &'a [f64],
+    pub volts: &'a [f64],
+    pub flux: &'a [f64],
+    /// (s, m): the path given to ngspice.
+    pub path: &'a [(f64, f64)],
+}
+
+/// The coupling's tolerances.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tolerances {
+    /// s, on the event times.
+    pub events: f64,
+    /// m, to which paths are thinned before they go to ngspice.
+    pub path: f64,
+}
+
+/// How many mechanics runs the inner relaxation may take per ngspice run:
+/// each costs a few milliseconds, and the inner map contracts as fast as
+/// the plain coupling did (some ten passes to 0.1 µs on the slow diode
+/// release); beyond this the next ngspice run starts from the best path
+/// found so far, which is still a valid start.
+const MAX_INNER: usize = 40;
+
+/// The inner relaxation settles to this fraction of the coupling's
+/// tolerance, so that the next ngspice run's change is its own defect,
+/// not the inner loop's leftover.
+const INNER_FRACTION: f64 = 0.1;
+
+/// The armature's cycle at the fixed point of the estimated pull (see the
+/// module notes), starting from `start`, the mechanics under the run's own
+/// flux. Returns the cycle and the number of mechanics runs it took.
+pub fn settle(
+    coil: &Coil,
+    run: &CircuitRun,
+    start: Cycle,
+    mechanics: &Mechanics,
+    stops: &Stops,
+    settings: &Settings,
+    tolerances: Tolerances,
+) -> Result<(Cycle, usize), CoilError> {
+    let base = flux_along(coil, run, run.path);
+    let mut current = start;
+    for inner in 1..=MAX_INNER {
+        // The path as ngspice would be given it (thinned like `run.path`):
+        // at the fixed point the correction must vanish exactly, or its
+        // leftover would bias the next run's events.
+        let phi = flux_along(
+            coil,
+            run,
+            &super::coupled::thin(&current.path, tolerances.path),
+        );
+        let estimate: Vec<(f64, f64)> = (0..run.time.len())
+            .map(|j| (run.time[j], run.flux[j] + phi[j] - base[j]))
+            .collect();
+        let pull =
+            |t: f64, _x: f64| coil.force_from_flux(super::coupled::interpolate(&estimate, t));
+        let next = simulate_cycle(mechanics, stops, settings, pull)?;
+        let moved = super::coupled::event_change(&current.make, &next.make)
+            .max(super::coupled::event_change(&current.back, &next.back));
+        current = next;
+        if moved <= INNER_FRACTION * tolerances.events {
+            return Ok((current, inner));
+        }
+    }
+    Ok((current, MAX_INNER))
+}
+
+/// Wb, the coil's flux linkage at each of the run's time points under
+/// its terminal voltage, with the armature following `path`: the
+/// trapezoidal rule, which for this linear equation in ψ is solved for
+/// the new value in closed form, from ngspice's own first value.
+pub fn flux_along(coil: &Coil, run: &CircuitRun, path: &[(f64, f64)]) -> Vec<f64> {
+    let n = run.time.len();
+    let mut out = Vec::with_capacity(n);
+    let Some(&first) = run.flux.first() else {
+        return out;
+    };
+    let k = coil.permeance_length();
+    let a = coil.air_gap + coil.iron_gap;
+    // dψ/dt = v − c ψ with c = R (a − x)/k.
+    let rate =
+        |j: usize| coil.resistance * (a - super::coupled::interpolate(path, run.time[j])) / k;
+    let mut psi = first;
+    let mut c0 = rate(0);
+    out.push(psi);
+    for j in 1..n {
+        let h = run.time[j] - run.time[j - 1];
+        let c1 = rate(j);
+        let rhs = psi + 0.5 * h * (run.volts[j - 1] - c0 * psi + run.volts[j]);
+        psi = rhs / (1.0 + 0.5 * h * c1);
+        out.push(psi);
+        c0 = c1;
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn coil() -> Coil {
+        Coil {
+            resistance: 70.0,
+            turns: 3000.0,
+            pole_area: 2e-5,
+            air_gap: 6e-4,
+            iron_gap: 5e-5,
+        }
+    }
+
+    #[test]
+    fn the_held_coil_charges_as_an_rl_circuit() {
+        // A held armature under a 5 V step: ψ = L V/R (1 − e^(−t R/L)).
+        let coil = coil();
+        let time: Vec<f64> = (0..=20_000).map(|j| f64::from(j) * 1e-6).collect();
+        let volts = vec![5.0; time.len()];
+        let flux = vec![0.0; time.len()];
+        let path = [(0.0, 0.0), (1.0, 0.0)];
+        let run = CircuitRun {
+            time: &time,
+            volts: &volts,
+            flux: &flux,
+            path: &path,
+        };
+        let psi = flux_along(&coil, &run, &path);
+        let l = coil.inductance(0.0);
+        let tau = l / coil.resistance;
+        for (j, &t) in time.iter().enumerate().step_by(997) {
+            let exact = l * 5.0 / coil.resistance * (1.0 - (-t / tau).exp());
+            assert!(
+                (psi[j] - exact).abs() <= 1e-6 * l * 5.0 / 70.0,
+                "{t}: {} {exact}",
+                psi[j]
+            );
+        }
+    }
+
+    #[test]
+    fn a_closed_armature_charges_with_the_closed_gaps_inductance() {
+        // Held closed at x: the flux heads for L(x) V/R, three times the open
+        // coil's.
+        let coil = coil();
+        let x = 4.5e-4;
+        let time: Vec<f64> = (0..=200_000).map(|j| f64::from(j) * 1e-6).collect();
+        let volts = vec![5.0; time.len()];
+        let flux = vec![0.0; time.len()];
+        let path = [(0.0, x), (1.0, x)];
+        let run = CircuitRun {
+            time: &time,
+            volts: &volts,
+            flux: &flux,
+            path: &path,
+        };
+        let psi = flux_along(&coil, &run, &path);
+        // The RL charge with the closed gap's inductance, 12 of its time
+        // constants along.
+        let l = coil.inductance(x);
+        let steady = l * 5.0 / coil.resistance;
+        let t = *time.last().unwrap();
+        let exact = steady * (1.0 - (-t * coil.resistance / l).exp());
+        assert!((psi.last().unwrap() / exact - 1.0).abs() < 1e-9);
+        assert!(*psi.last().unwrap() > 2.0 * coil.inductance(0.0) * 5.0 / coil.resistance);
+    }
+}
