@@ -39,9 +39,11 @@
 //! into their bounds. It is a few dozen lines on nalgebra, which the crate
 //! already uses; the problem is tiny (≤ 6 parameters, tens of residuals),
 //! and the candidates (dropped pairs) and held keys need control of the
-//! residual function that a general crate's trait would only wrap. Several
-//! starts (the prior, then a Halton sequence through the log-bounds box:
-//! deterministic) are tried and the best kept.
+//! residual function that a general crate's trait would only wrap. With
+//! many bounces the misfit has local minima wherever the event count
+//! changes, so the solver starts from the prior and from the best points of
+//! a survey of the log-bounds box (a Halton sequence, 40 points per free
+//! key: deterministic and even), and the best result is kept.
 //!
 //! # What the evidence determines
 //!
@@ -85,8 +87,10 @@ const PRIOR_WEIGHT: f64 = 1e-2;
 const JACOBIAN_STEP: f64 = 1e-4;
 /// Below this eigenvalue ratio of JᵀJ a direction is not determined.
 const SINGULAR_RATIO: f64 = 1e-9;
-/// Starts besides the prior.
-const EXTRA_STARTS: usize = 5;
+/// Starts besides the prior: the best points of the survey.
+const EXTRA_STARTS: usize = 4;
+/// Survey points per free key.
+const SURVEY_PER_KEY: usize = 40;
 
 /// Why a fit cannot start.
 #[derive(Debug, Error)]
@@ -799,18 +803,29 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
 
     // Multistart over the full candidate.
     let mut active: Vec<usize> = (0..keys.len()).collect();
-    let mut starts = vec![u_prior.clone()];
-    const BASES: [usize; 6] = [2, 3, 5, 7, 11, 13];
-    for i in 1..=EXTRA_STARTS {
-        starts.push(
-            (0..keys.len())
+    // A coarse survey of the log-bounds box (a Halton sequence:
+    // deterministic and even) finds the basin: with many bounces the
+    // misfit has many local minima where the event count changes, and
+    // a local solver started far off lands in one of them.
+    const BASES: [usize; 8] = [2, 3, 5, 7, 11, 13, 17, 19];
+    let survey = SURVEY_PER_KEY * keys.len();
+    let mut sampled: Vec<(f64, Vec<f64>)> = (1..=survey)
+        .map(|i| {
+            let u: Vec<f64> = (0..keys.len())
                 .map(|k| {
                     let (lo, hi) = (problem.low[k].ln(), problem.high[k].ln());
                     lo + (hi - lo) * halton(i, BASES[k % BASES.len()])
                 })
-                .collect(),
-        );
-    }
+                .collect();
+            let cost = problem
+                .residuals(&u, &active, Candidate::All)
+                .map_or(f64::INFINITY, |r| r.iter().map(|x| x * x).sum());
+            (cost, u)
+        })
+        .collect();
+    sampled.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut starts = vec![u_prior.clone()];
+    starts.extend(sampled.into_iter().take(EXTRA_STARTS).map(|(_, u)| u));
     let mut best = (u_prior.clone(), f64::INFINITY);
     for start in &starts {
         let (u, cost) = problem.solve(start, &active, Candidate::All);

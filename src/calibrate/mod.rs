@@ -4,4 +4,5 @@
 
 pub mod fit;
 pub mod parts;
+pub mod render;
 pub mod sections;
