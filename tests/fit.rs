@@ -244,3 +244,72 @@ fn the_fitted_scenario_reads_back_with_its_provenance() {
     assert!((fitted.value - 0.1).abs() < 1e-3, "{fitted:?}");
     let _ = events_of(&[]);
 }
+
+#[test]
+fn the_fit_command_writes_json_a_scenario_and_a_report_and_never_overwrites() {
+    use assert_cmd::Command;
+    let dir = tempfile::tempdir().unwrap();
+    let truth = scenario(STEP);
+    let (record, _) = record(&truth, -1e-4, 0.0, false);
+    let mut csv = String::from("time,state\n0,open\n");
+    for i in record.intervals.iter().skip(1) {
+        csv.push_str(&format!("{:.12e},{}\n", i.start, i.state.as_str()));
+    }
+    let last = record.intervals.last().unwrap();
+    csv.push_str(&format!("{:.12e},{}\n", last.end, last.state.as_str()));
+    let measured = dir.path().join("chatter.csv");
+    std::fs::write(&measured, csv).unwrap();
+    let prior = dir.path().join("prior.toml");
+    let text = off(STEP, &[("damping = 0.5", "damping = 1.0")])
+        + "\n[fit]\nfree = [\"surface.damping\"]\n";
+    std::fs::write(&prior, text).unwrap();
+    let fitted = dir.path().join("fitted.toml");
+    let report = dir.path().join("report");
+    let out = Command::cargo_bin("chatterspice")
+        .unwrap()
+        .arg("fit")
+        .arg(&prior)
+        .arg("--measured")
+        .arg(&measured)
+        .arg("-o")
+        .arg(&fitted)
+        .arg("--report")
+        .arg(&report)
+        .args(["--format", "json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for field in ["parameters", "events", "bounce_count", "datasheet", "time_offset", "rms_residual", "evaluations", "elapsed"] {
+        assert!(json.get(field).is_some(), "no {field}: {json}");
+    }
+    let damping = json["parameters"][0]["value"].as_f64().unwrap();
+    assert!((damping - 0.5).abs() < 0.005, "{damping}");
+    assert!((json["time_offset"].as_f64().unwrap() + 1e-4).abs() < 1e-6);
+    let back = Scenario::load(&fitted).expect("the fitted scenario loads");
+    assert_eq!(back.surface.damping, Some(damping));
+    assert!(report.join("overlay.svg").exists() && report.join("fit.json").exists());
+    // A second run refuses to overwrite without --force.
+    Command::cargo_bin("chatterspice")
+        .unwrap()
+        .arg("fit")
+        .arg(&prior)
+        .arg("--measured")
+        .arg(&measured)
+        .arg("-o")
+        .arg(&fitted)
+        .assert()
+        .code(2);
+    // No free keys: exit 2 with a message naming what to add.
+    Command::cargo_bin("chatterspice")
+        .unwrap()
+        .arg("fit")
+        .arg(dir.path().join("fitted.toml"))
+        .arg("--measured")
+        .arg(&measured)
+        .arg("--free")
+        .arg("surface.bogus")
+        .assert()
+        .code(2)
+        .stderr(predicates::str::contains("surface.bogus"));
+}

@@ -28,8 +28,10 @@
 //! at pick-up the pull at rest equals the preload, `½ i² L'(0) = p` with
 //! `i = V_pu/R_c`; at drop-out the pull at the closed position equals the
 //! spring, `½ i² L'(g) = s·g + p`. The operate and bounce times come from
-//! the direct coil engine ([`crate::coil::simulate_direct`]), the release
-//! time from the cycle engine with the coil current cut at once.
+//! the direct coil engine ([`crate::coil::simulate_direct`]). A release
+//! time is shown but not fitted: a relay's release is paced by the decay
+//! of its flux (eddy currents, the coil's own circuit), which this magnet
+//! with an ideal switch does not have.
 //!
 //! # The solver
 //!
@@ -68,8 +70,7 @@ use thiserror::Error;
 
 use super::sections::{DatasheetSection, FittedParameter, ProvenanceSection};
 use crate::chatter::{ContactState, Interval};
-use crate::coil::cycle::Stops;
-use crate::coil::{Coil, Source, simulate_cycle, simulate_direct};
+use crate::coil::{Coil, Source, simulate_direct};
 use crate::mechanics::{Mechanics, simulate};
 use crate::scenario::{Scenario, ScenarioError};
 
@@ -383,7 +384,7 @@ pub fn datasheet_figures(s: &Scenario, d: &DatasheetSection) -> Vec<(&'static st
     let m = mechanics_of(s);
     let wants = |f: Option<f64>| f.is_some();
     let closing = match d.coil_voltage {
-        Some(v) if wants(d.operate_time) || wants(d.bounce_time) || wants(d.release_time) => {
+        Some(v) if wants(d.operate_time) || wants(d.bounce_time) => {
             simulate_direct(
                 &coil,
                 &Source {
@@ -412,35 +413,15 @@ pub fn datasheet_figures(s: &Scenario, d: &DatasheetSection) -> Vec<(&'static st
             ),
             "operate_time" => operate,
             "bounce_time" => operate.zip(settle).map(|(a, b)| b - a),
-            "release_time" => match (d.coil_voltage, settle) {
-                (Some(v), Some(settle)) => release_time(s, &coil, &m, v, settle),
-                _ => None,
-            },
+            // Not modelled: a relay's release time is set by the decay of
+            // its flux (eddy currents, the coil's own circuit), which the
+            // single-gap magnet with an ideal switch does not have.
+            "release_time" => None,
             _ => None,
         };
         out.push((name, value));
     }
     out
-}
-
-/// s, coil cut (current to zero at once: no suppression, as a datasheet
-/// measures) → the normally-open contact opens, for a relay held closed
-/// by `voltage` until well after it settled.
-fn release_time(s: &Scenario, coil: &Coil, m: &Mechanics, voltage: f64, settle: f64) -> Option<f64> {
-    let t_off = settle * 1.5 + 1e-3;
-    let i = voltage / coil.resistance;
-    let mut settings = s.settings();
-    settings.t_end = t_off + 0.02;
-    let stops = Stops {
-        make: s.surface(),
-        back: None,
-    };
-    let cycle = simulate_cycle(m, &stops, &settings, |t, x| {
-        if t < t_off { coil.force(i, x) } else { 0.0 }
-    })
-    .ok()?;
-    let stroke = cycle.strokes.first()?;
-    stroke.break_time.map(|b| b - t_off)
 }
 
 /// The fitting problem: the prior scenario, the free keys in log form,
@@ -521,9 +502,11 @@ impl Problem<'_> {
             r.resize(self.measured.as_ref().map_or(0, |m| m.len() + 1), 0.0);
         }
         if let Some(d) = &self.datasheet {
-            for ((_, target), (_, model)) in figures(d).iter().zip(&e.figures) {
+            for ((name, target), (_, model)) in figures(d).iter().zip(&e.figures) {
                 r.push(match model {
                     Some(m) => (m - target) / target / RELATIVE_SCALE,
+                    // Shown, not fitted (see `datasheet_figures`).
+                    None if *name == "release_time" => 0.0,
                     None => 1.0 / RELATIVE_SCALE,
                 });
             }
@@ -635,6 +618,37 @@ impl Problem<'_> {
         }
         (u, cost)
     }
+}
+
+/// The prior, with the preload and the spring stiffness (when free)
+/// solved in closed form from the pick-up and drop-out voltages:
+/// `p = ½ (V_pu/R)² L'(0)` and `s = (½ (V_do/R)² L'(g) − p)/g`. The
+/// solver starts there: those two figures pin them exactly, and the rest
+/// of the fit (the times) starts from a point that already meets them.
+fn closed_form_start(problem: &Problem, u_prior: &[f64]) -> Vec<f64> {
+    let mut u = u_prior.to_vec();
+    let (Some(d), Some(s)) = (&problem.datasheet, problem.scenario_at(u_prior)) else {
+        return u;
+    };
+    let Some(c) = &s.coil else {
+        return u;
+    };
+    let coil = Coil::from(c);
+    let key = |name: &str| problem.keys.iter().position(|k| k == name);
+    let mut preload = s.mechanics.preload;
+    if let (Some(v), Some(k)) = (d.pick_up_voltage, key("mechanics.preload")) {
+        preload = 0.5 * (v / coil.resistance).powi(2) * coil.d_inductance(0.0);
+        u[k] = preload.ln();
+    }
+    if let (Some(v), Some(k)) = (d.drop_out_voltage, key("mechanics.stiffness")) {
+        let g = s.mechanics.gap;
+        let spring = (0.5 * (v / coil.resistance).powi(2) * coil.d_inductance(g) - preload) / g;
+        if spring > 0.0 {
+            u[k] = spring.ln();
+        }
+    }
+    problem.clamp(&mut u);
+    u
 }
 
 /// Halton point `i` (from 1) in base `b`: a deterministic, even spread.
@@ -757,7 +771,7 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
                 figure: figures(d)[0].0,
             });
         }
-        let timed = d.operate_time.is_some() || d.bounce_time.is_some() || d.release_time.is_some();
+        let timed = d.operate_time.is_some() || d.bounce_time.is_some();
         if timed && d.coil_voltage.is_none() {
             return Err(FitError::NeedsVoltage { path: path.clone() });
         }
@@ -824,7 +838,7 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
         })
         .collect();
     sampled.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut starts = vec![u_prior.clone()];
+    let mut starts = vec![closed_form_start(&problem, &u_prior)];
     starts.extend(sampled.into_iter().take(EXTRA_STARTS).map(|(_, u)| u));
     let mut best = (u_prior.clone(), f64::INFINITY);
     for start in &starts {
@@ -1030,6 +1044,7 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
         let worst = datasheet_rows
             .iter()
             .enumerate()
+            .filter(|(_, r)| r.figure != "release_time")
             .map(|(i, r)| (i, r.residual.map_or(f64::INFINITY, f64::abs)))
             .fold((usize::MAX, -1.0), |acc, (i, v)| if v > acc.1 { (i, v) } else { acc });
         if let Some(row) = datasheet_rows.get_mut(worst.0) {
@@ -1041,6 +1056,7 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
         None => {
             let rel: Vec<f64> = datasheet_rows
                 .iter()
+                .filter(|r| r.figure != "release_time")
                 .map(|r| r.residual.unwrap_or(1.0))
                 .collect();
             (rel.iter().map(|x| x * x).sum::<f64>() / rel.len().max(1) as f64).sqrt()
