@@ -90,10 +90,18 @@ fn value(report: &chatterspice::calibrate::fit::FitReport, key: &str) -> (f64, f
     (p.prior, p.value, p.determined)
 }
 
-fn assert_recovered(report: &chatterspice::calibrate::fit::FitReport, key: &str, truth: f64, tol: f64) {
+fn assert_recovered(
+    report: &chatterspice::calibrate::fit::FitReport,
+    key: &str,
+    truth: f64,
+    tol: f64,
+) {
     let (prior, v, determined) = value(report, key);
     let prior_off = (prior / truth).max(truth / prior);
-    assert!(prior_off >= 1.5, "{key}: the prior {prior} is only {prior_off}× off {truth}");
+    assert!(
+        prior_off >= 1.5,
+        "{key}: the prior {prior} is only {prior_off}× off {truth}"
+    );
     assert!(
         ((v - truth) / truth).abs() <= tol,
         "{key}: fitted {v}, truth {truth} (prior {prior}); notes {:?}",
@@ -151,7 +159,10 @@ fn force_and_gap_together_are_not_determined_and_one_is_held() {
     let (record, _) = record(&truth, 2e-4, 0.0, false);
     let prior = scenario(&off(
         STEP,
-        &[("force = 0.5", "force = 1.0"), ("gap = 5.0e-4", "gap = 6.0e-4")],
+        &[
+            ("force = 0.5", "force = 1.0"),
+            ("gap = 5.0e-4", "gap = 6.0e-4"),
+        ],
     ));
     let request = FitRequest {
         record: Some(record),
@@ -165,8 +176,15 @@ fn force_and_gap_together_are_not_determined_and_one_is_held() {
     // What the capture does fix: the ratio force/gap.
     let ratio = force / gap;
     let truth_ratio = 0.5 / 5.0e-4;
-    assert!(((ratio - truth_ratio) / truth_ratio).abs() < 0.01, "{ratio} vs {truth_ratio}");
-    assert!(report.notes.iter().any(|n| n.contains("mechanics.gap")), "{:?}", report.notes);
+    assert!(
+        ((ratio - truth_ratio) / truth_ratio).abs() < 0.01,
+        "{ratio} vs {truth_ratio}"
+    );
+    assert!(
+        report.notes.iter().any(|n| n.contains("mechanics.gap")),
+        "{:?}",
+        report.notes
+    );
 }
 
 const REFERENCE: &str = r#"
@@ -207,18 +225,22 @@ free = ["mechanics.preload", "mechanics.stiffness"]
 fn a_datasheet_fit_of_the_reference_relay_recovers_preload_and_spring() {
     let prior = scenario(&off(
         REFERENCE,
-        &[("preload = 0.1", "preload = 0.2"), ("stiffness = 800.0", "stiffness = 400.0")],
+        &[
+            ("preload = 0.1", "preload = 0.2"),
+            ("stiffness = 800.0", "stiffness = 400.0"),
+        ],
     ));
     let report = fit(&prior, &FitRequest::default()).expect("fit runs");
     assert_recovered(&report, "mechanics.preload", 0.1, 0.01);
     assert_recovered(&report, "mechanics.stiffness", 800.0, 0.01);
     for row in &report.datasheet {
         let model = row.model.expect("modelled");
-        let tol = if row.figure.ends_with("time") { 0.02 } else { 0.01 };
-        assert!(
-            ((model - row.target) / row.target).abs() < tol,
-            "{row:?}"
-        );
+        let tol = if row.figure.ends_with("time") {
+            0.02
+        } else {
+            0.01
+        };
+        assert!(((model - row.target) / row.target).abs() < tol, "{row:?}");
     }
     assert_eq!(report.datasheet.iter().filter(|r| r.binds).count(), 1);
 }
@@ -278,9 +300,22 @@ fn the_fit_command_writes_json_a_scenario_and_a_report_and_never_overwrites() {
         .args(["--format", "json"])
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    for field in ["parameters", "events", "bounce_count", "datasheet", "time_offset", "rms_residual", "evaluations", "elapsed"] {
+    for field in [
+        "parameters",
+        "events",
+        "bounce_count",
+        "datasheet",
+        "time_offset",
+        "rms_residual",
+        "evaluations",
+        "elapsed",
+    ] {
         assert!(json.get(field).is_some(), "no {field}: {json}");
     }
     let damping = json["parameters"][0]["value"].as_f64().unwrap();

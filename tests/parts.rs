@@ -40,7 +40,12 @@ fn there_are_six_parts_and_each_meets_its_datasheet() {
         assert!(checked >= 2, "{}: nothing checked", part.name);
         // The fit moved the free keys away from the priors it started from.
         for (key, p) in &provenance.parameters {
-            assert_eq!(scenario.number(key).unwrap(), Some(p.value), "{}: {key}", part.name);
+            assert_eq!(
+                scenario.number(key).unwrap(),
+                Some(p.value),
+                "{}: {key}",
+                part.name
+            );
         }
     }
 }

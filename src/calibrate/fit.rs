@@ -105,7 +105,7 @@ pub enum FitError {
         path: String,
         key: String,
         #[source]
-        source: ScenarioError,
+        source: Box<ScenarioError>,
     },
     #[error(
         "{path}: free key `{key}` has no value in the scenario to start from: give it a prior value"
@@ -114,7 +114,11 @@ pub enum FitError {
     #[error(
         "{path}: free key `{key}` = {value} cannot be fitted: the fit works in logarithms and needs a positive prior"
     )]
-    NotPositive { path: String, key: String, value: f64 },
+    NotPositive {
+        path: String,
+        key: String,
+        value: f64,
+    },
     #[error(
         "{path}: [fit] bounds for `{key}` = [{low}, {high}] must be positive, increasing and contain the prior {prior}"
     )]
@@ -367,8 +371,9 @@ pub fn model_events(s: &Scenario, voltage: Option<f64>) -> Result<Vec<Event>, St
             .chatter
         }
         (Some(_), None) => return Err("a coil-driven relay needs [datasheet] coil_voltage".into()),
-        (None, _) => simulate(&mechanics_of(s), &s.surface(), &s.settings())
-            .map_err(|e| e.to_string())?,
+        (None, _) => {
+            simulate(&mechanics_of(s), &s.surface(), &s.settings()).map_err(|e| e.to_string())?
+        }
     };
     Ok(events_of(&chatter.intervals))
 }
@@ -384,19 +389,17 @@ pub fn datasheet_figures(s: &Scenario, d: &DatasheetSection) -> Vec<(&'static st
     let m = mechanics_of(s);
     let wants = |f: Option<f64>| f.is_some();
     let closing = match d.coil_voltage {
-        Some(v) if wants(d.operate_time) || wants(d.bounce_time) => {
-            simulate_direct(
-                &coil,
-                &Source {
-                    voltage: v,
-                    series_resistance: 0.0,
-                },
-                &m,
-                &s.surface(),
-                &s.settings(),
-            )
-            .ok()
-        }
+        Some(v) if wants(d.operate_time) || wants(d.bounce_time) => simulate_direct(
+            &coil,
+            &Source {
+                voltage: v,
+                series_resistance: 0.0,
+            },
+            &m,
+            &s.surface(),
+            &s.settings(),
+        )
+        .ok(),
         _ => None,
     };
     let operate = closing.as_ref().and_then(|r| r.events.first_make);
@@ -669,7 +672,10 @@ fn event_residuals(measured: &[Event], model: &[Event]) -> (Vec<f64>, f64) {
     let n = measured.len();
     let k = n.min(model.len());
     let offset = if k > 0 {
-        (0..k).map(|i| model[i].time - measured[i].time).sum::<f64>() / k as f64
+        (0..k)
+            .map(|i| model[i].time - measured[i].time)
+            .sum::<f64>()
+            / k as f64
     } else {
         0.0
     };
@@ -716,7 +722,7 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
             .map_err(|source| FitError::UnknownKey {
                 path: path.clone(),
                 key: key.clone(),
-                source,
+                source: Box::new(source),
             })?
             .ok_or_else(|| FitError::NoPrior {
                 path: path.clone(),
@@ -747,7 +753,10 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
         low.push(lo);
         high.push(hi);
     }
-    let datasheet = scenario.datasheet.clone().filter(|d| !figures(d).is_empty());
+    let datasheet = scenario
+        .datasheet
+        .clone()
+        .filter(|d| !figures(d).is_empty());
     if let Some(d) = &scenario.datasheet {
         let all = [("coil_voltage", d.coil_voltage)]
             .into_iter()
@@ -852,9 +861,7 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
 
     // One bad edge: a glitch in the record, or a bounce it missed.
     if let Some(measured) = &problem.measured {
-        let n_model = problem
-            .evaluate(&best.0)
-            .map_or(0, |e| e.model.len());
+        let n_model = problem.evaluate(&best.0).map_or(0, |e| e.model.len());
         let mut alternatives = Vec::new();
         for j in 0..measured.len().saturating_sub(1) {
             alternatives.push(Candidate::DropMeasured(j));
@@ -897,12 +904,10 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
         let a = j.transpose() * &j;
         let eigen = SymmetricEigen::new(a);
         let max = eigen.eigenvalues.iter().cloned().fold(0.0, f64::max);
-        let (imin, min) = eigen
-            .eigenvalues
-            .iter()
-            .cloned()
-            .enumerate()
-            .fold((0, f64::INFINITY), |acc, (i, v)| if v < acc.1 { (i, v) } else { acc });
+        let (imin, min) = eigen.eigenvalues.iter().cloned().enumerate().fold(
+            (0, f64::INFINITY),
+            |acc, (i, v)| if v < acc.1 { (i, v) } else { acc },
+        );
         if max > 0.0 && min > SINGULAR_RATIO * max {
             jacobian = Some(j);
             break;
@@ -1046,7 +1051,10 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
             .enumerate()
             .filter(|(_, r)| r.figure != "release_time")
             .map(|(i, r)| (i, r.residual.map_or(f64::INFINITY, f64::abs)))
-            .fold((usize::MAX, -1.0), |acc, (i, v)| if v > acc.1 { (i, v) } else { acc });
+            .fold(
+                (usize::MAX, -1.0),
+                |acc, (i, v)| if v > acc.1 { (i, v) } else { acc },
+            );
         if let Some(row) = datasheet_rows.get_mut(worst.0) {
             row.binds = true;
         }
@@ -1126,10 +1134,19 @@ mod tests {
         let (r, offset) = event_residuals(&measured, &model);
         assert!((offset - 1e-3).abs() < 1e-15);
         assert!(r.iter().all(|x| x.abs() < 1e-15), "{r:?}");
-        let longer = [model[0], model[1], model[2], ev(Break, 1.4e-3), ev(Make, 1.5e-3)];
+        let longer = [
+            model[0],
+            model[1],
+            model[2],
+            ev(Break, 1.4e-3),
+            ev(Make, 1.5e-3),
+        ];
         let (r, _) = event_residuals(&measured, &longer);
         let extra = r.last().copied().unwrap();
-        assert!((extra - (2e-4 + 2.0 * COUNT_PENALTY)).abs() < 1e-12, "{extra}");
+        assert!(
+            (extra - (2e-4 + 2.0 * COUNT_PENALTY)).abs() < 1e-12,
+            "{extra}"
+        );
     }
 
     #[test]

@@ -46,7 +46,10 @@ pub struct Part {
 impl Part {
     /// The part's scenario, parsed.
     pub fn load(&self) -> Result<Scenario, ScenarioError> {
-        Scenario::parse(self.scenario, Path::new(&format!("parts/{}.toml", self.name)))
+        Scenario::parse(
+            self.scenario,
+            Path::new(&format!("parts/{}.toml", self.name)),
+        )
     }
 }
 

@@ -60,7 +60,10 @@ pub fn table(report: &FitReport) -> String {
         let _ = writeln!(out, "bounces: measured {}, model {}", b.measured, b.model);
     }
     if let Some(t) = report.time_offset {
-        let _ = writeln!(out, "time offset: {t:.6e} s (model time of the record's zero)");
+        let _ = writeln!(
+            out,
+            "time offset: {t:.6e} s (model time of the record's zero)"
+        );
     }
     if !report.datasheet.is_empty() {
         let _ = writeln!(out);
@@ -104,9 +107,10 @@ pub fn overlay_svg(measured: &[Interval], report: &FitReport) -> String {
         .filter_map(|e| e.model.map(|t| (e.kind, t)))
         .collect();
     let start = measured.first().map_or(0.0, |i| i.start);
-    let end = measured.last().map_or(1.0, |i| i.end).max(
-        model.last().map_or(start, |m| m.1),
-    );
+    let end = measured
+        .last()
+        .map_or(1.0, |i| i.end)
+        .max(model.last().map_or(start, |m| m.1));
     let span = (end - start).max(1e-12);
     let (w, h, left, right) = (900.0, 300.0, 60.0, 20.0);
     let x = |t: f64| left + (t - start) / span * (w - left - right);
@@ -131,7 +135,14 @@ pub fn overlay_svg(measured: &[Interval], report: &FitReport) -> String {
         let mut state = false;
         let _ = write!(points, "{:.2},{:.2} ", x(start), y(state));
         for &(t, closed) in steps {
-            let _ = write!(points, "{:.2},{:.2} {:.2},{:.2} ", x(t), y(state), x(t), y(closed));
+            let _ = write!(
+                points,
+                "{:.2},{:.2} {:.2},{:.2} ",
+                x(t),
+                y(state),
+                x(t),
+                y(closed)
+            );
             state = closed;
         }
         let _ = write!(points, "{:.2},{:.2}", x(end), y(state));

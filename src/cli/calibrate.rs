@@ -73,9 +73,10 @@ fn read_record(args: &FitArgs) -> Result<Option<Record>> {
     let text = std::fs::read_to_string(csv)
         .with_context(|| format!("{}: cannot read the measured chatter", csv.display()))?;
     let intervals = read_state_csv(&text, csv)?;
-    let name = csv
-        .file_name()
-        .map_or_else(|| csv.display().to_string(), |n| n.to_string_lossy().into_owned());
+    let name = csv.file_name().map_or_else(
+        || csv.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
     Ok(Some(Record { name, intervals }))
 }
 
@@ -103,7 +104,11 @@ pub fn fit(args: &FitArgs) -> Result<()> {
     if let Some(dir) = &args.report {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("{}: cannot create the report directory", dir.display()))?;
-        report::write_new_file(&dir.join("fit.json"), render::json(&result).as_bytes(), args.force)?;
+        report::write_new_file(
+            &dir.join("fit.json"),
+            render::json(&result).as_bytes(),
+            args.force,
+        )?;
         let intervals = record.map(|r| r.intervals).unwrap_or_default();
         let svg = render::overlay_svg(&intervals, &result);
         report::write_new_file(&dir.join("overlay.svg"), svg.as_bytes(), args.force)?;
