@@ -257,7 +257,7 @@ fn the_fitted_scenario_reads_back_with_its_provenance() {
         },
     )
     .expect("fit runs");
-    let text = chatterspice::calibrate::fit::fitted_toml(&prior_text, &report).expect("toml");
+    let text = chatterspice::calibrate::fit::fitted_toml(&prior_text, &report, None).expect("toml");
     let back = Scenario::parse(&text, Path::new("fitted.toml")).expect("reads back");
     let p = back.provenance.expect("provenance");
     assert_eq!(p.fitted_to, "datasheet");
@@ -347,4 +347,43 @@ fn the_fit_command_writes_json_a_scenario_and_a_report_and_never_overwrites() {
         .assert()
         .code(2)
         .stderr(predicates::str::contains("surface.bogus"));
+}
+
+#[test]
+fn a_record_that_missed_one_bounce_still_fits() {
+    let truth = scenario(STEP);
+    let (mut record, n) = record(&truth, 4e-4, 0.2e-6, false);
+    assert!(n >= 8);
+    // Merge the third bounce's opening into the closed time around it: the
+    // scope missed that break and make.
+    let k = 4; // intervals: open, closed, open, closed, open(k), closed(k+1)
+    assert_eq!(record.intervals[k].state, ContactState::Open);
+    let merged_end = record.intervals[k + 1].end;
+    record.intervals[k - 1].end = merged_end;
+    record.intervals.drain(k..=k + 1);
+    let prior = scenario(&off(
+        STEP,
+        &[
+            ("stiffness = 800.0", "stiffness = 1300.0"),
+            ("damping = 0.5", "damping = 0.8"),
+        ],
+    ));
+    let report = fit(
+        &prior,
+        &FitRequest {
+            record: Some(record),
+            free: vec!["mechanics.stiffness".into(), "surface.damping".into()],
+        },
+    )
+    .expect("fit runs");
+    assert_recovered(&report, "mechanics.stiffness", 800.0, 0.05);
+    assert_recovered(&report, "surface.damping", 0.5, 0.10);
+    assert!(
+        report
+            .notes
+            .iter()
+            .any(|n| n.contains("bounce the record lacks")),
+        "{:?}",
+        report.notes
+    );
 }

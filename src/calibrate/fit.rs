@@ -261,7 +261,7 @@ pub struct FigureRow {
 pub struct FitReport {
     pub parameters: Vec<ParameterRow>,
     pub events: Vec<EventRow>,
-    #[serde(skip_serializing_if = "Option::is_none")]
+    /// `None` (null) without a record.
     pub bounce_count: Option<BounceCount>,
     pub datasheet: Vec<FigureRow>,
     pub time_offset: Option<f64>,
@@ -1098,8 +1098,22 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
 /// The fitted scenario as TOML: the prior file's text with the fitted
 /// values put in and a `[provenance]` section, so that every key the user
 /// wrote stays (comments do not survive).
-pub fn fitted_toml(prior_text: &str, report: &FitReport) -> Result<String, toml::de::Error> {
+///
+/// `netlist`, when given, replaces `circuit.netlist`: a relative path in
+/// the prior is relative to the prior's directory, which is not the fitted
+/// file's when it is written elsewhere.
+pub fn fitted_toml(
+    prior_text: &str,
+    report: &FitReport,
+    netlist: Option<&std::path::Path>,
+) -> Result<String, toml::de::Error> {
     let mut table: toml::Table = toml::from_str(prior_text)?;
+    if let (Some(path), Some(toml::Value::Table(circuit))) = (netlist, table.get_mut("circuit")) {
+        circuit.insert(
+            "netlist".to_owned(),
+            toml::Value::String(path.display().to_string()),
+        );
+    }
     for p in &report.parameters {
         let mut parts = p.key.splitn(2, '.');
         let (Some(section), Some(name)) = (parts.next(), parts.next()) else {

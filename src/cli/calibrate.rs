@@ -97,7 +97,14 @@ pub fn fit(args: &FitArgs) -> Result<()> {
     };
     let result = fit::fit(&scenario, &request)?;
     if let Some(path) = &args.output {
-        let toml = fit::fitted_toml(&text, &result)
+        // A relative netlist path is relative to the prior's directory:
+        // written elsewhere, the fitted file names it absolutely.
+        let same_dir = path.parent().map(Path::new) == args.scenario.parent();
+        let netlist = match (&scenario.circuit, same_dir) {
+            (Some(c), false) => std::fs::canonicalize(&c.netlist).ok(),
+            _ => None,
+        };
+        let toml = fit::fitted_toml(&text, &result, netlist.as_deref())
             .with_context(|| format!("{}: cannot re-read the scenario", args.scenario.display()))?;
         report::write_new_file(path, toml.as_bytes(), args.force)?;
     }
