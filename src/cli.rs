@@ -14,6 +14,8 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use std::time::Duration;
 
+mod calibrate;
+
 use chatterspice::check;
 use chatterspice::coil::CouplingOptions;
 use chatterspice::mechanics::Dimensionless;
@@ -54,6 +56,12 @@ pub enum Command {
     Sweep(SweepArgs),
     /// Join the CSVs of a sweep's shards (--shard K/N) into the CSV of one run.
     Merge(MergeArgs),
+    /// Fit the scenario's free keys to a record of the contact and/or its
+    /// [datasheet] figures; writes the fitted scenario with [provenance].
+    Fit(calibrate::FitArgs),
+    /// The bundled relay parts (each fitted to its datasheet), or one
+    /// part's scenario.
+    Parts(calibrate::PartsArgs),
 }
 
 /// How a command that did its job ended.
@@ -76,6 +84,8 @@ impl Command {
             Command::Raw(args) => done(raw(args)),
             Command::Sweep(args) => sweep(args),
             Command::Merge(args) => done(merge(args)),
+            Command::Fit(args) => done(calibrate::fit(args)),
+            Command::Parts(args) => done(calibrate::parts(args)),
         }
     }
 }

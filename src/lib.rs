@@ -10,6 +10,7 @@
 //! an analysis of the probed signals.
 
 pub mod analysis;
+pub mod calibrate;
 pub mod chatter;
 pub mod check;
 pub mod coil;

@@ -13,6 +13,7 @@
 //! A validated [`Scenario`] converts into the library's inputs:
 //! [`Scenario::mechanics`], [`Scenario::surface`], [`Scenario::settings`].
 
+pub use crate::calibrate::sections::{DatasheetSection, FitSection, ProvenanceSection};
 use std::collections::BTreeMap;
 use std::fmt;
 use std::ops::Range;
@@ -358,6 +359,9 @@ struct Document {
     probe: Vec<Probe>,
     limits: Option<LimitsSection>,
     sweep: Option<SweepSection>,
+    datasheet: Option<DatasheetSection>,
+    fit: Option<FitSection>,
+    provenance: Option<ProvenanceSection>,
 }
 
 /// A loaded and validated scenario file.
@@ -381,6 +385,12 @@ pub struct Scenario {
     pub limits: Option<LimitsSection>,
     /// `[sweep]`, for `chatterspice sweep`.
     pub sweep: Option<SweepSection>,
+    /// `[datasheet]`: the relay's published figures, for `fit`.
+    pub datasheet: Option<DatasheetSection>,
+    /// `[fit]`: which keys `fit` may move, and within what bounds.
+    pub fit: Option<FitSection>,
+    /// `[provenance]`: what a `fit` fitted this scenario to.
+    pub provenance: Option<ProvenanceSection>,
     /// Computed once during validation: converting a Hunt–Crossley
     /// restitution into χ is a root solve that can fail.
     resolved_surface: Surface,
@@ -590,6 +600,9 @@ impl Scenario {
             probes: document.probe,
             limits: document.limits,
             sweep: document.sweep,
+            datasheet: document.datasheet,
+            fit: document.fit,
+            provenance: document.provenance,
             resolved_surface,
             resolved_back_stop,
             embedded_netlist: None,

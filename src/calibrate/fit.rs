@@ -1,0 +1,1172 @@
+//! Fitting a scenario to evidence: a record of the contact's make and
+//! break times (a scope capture or a `time,state` file) and/or the figures
+//! of the relay's datasheet.
+//!
+//! # What is fitted
+//!
+//! The free keys are scenario numbers (`surface.damping`,
+//! `mechanics.preload`, …). They are fitted as logarithms: every key is
+//! positive and their sizes span many decades, so a step of 0.1 means
+//! "10 % more" for each of them alike, which keeps the normal equations
+//! well scaled.
+//!
+//! **A record** gives make/break times. The model's events are matched to
+//! the measured ones in order; the record's time zero is its trigger, not
+//! the moment the force was applied, so the offset between the two time
+//! axes is a parameter too. It is linear and solved in closed form at every
+//! evaluation (the mean of the matched differences), which is the same as
+//! fitting it jointly. A differing number of events is penalised (each
+//! unmatched event costs its distance to the model's last event plus a
+//! fixed penalty), never ignored. One spurious glitch (a break and make
+//! pair the model does not have) or one missing bounce is absorbed by
+//! refitting with each adjacent pair of measured, or modelled, events
+//! dropped, and keeping the drop that reduces the misfit tenfold.
+//!
+//! **A datasheet** gives figures in IEC 61810 meanings, computed here as a
+//! datasheet measures them: an ideal DC step on the coil, no driver
+//! circuit. With the single-gap magnet `L(x) = μ0N²A/(g_a − x + l_eq)`:
+//! at pick-up the pull at rest equals the preload, `½ i² L'(0) = p` with
+//! `i = V_pu/R_c`; at drop-out the pull at the closed position equals the
+//! spring, `½ i² L'(g) = s·g + p`. The operate and bounce times come from
+//! the direct coil engine ([`crate::coil::simulate_direct`]). A release
+//! time is shown but not fitted: a relay's release is paced by the decay
+//! of its flux (eddy currents, the coil's own circuit), which this magnet
+//! with an ideal switch does not have.
+//!
+//! # The solver
+//!
+//! Levenberg–Marquardt with a central-difference Jacobian (the event
+//! times come out of an adaptive integrator, so there is no analytic
+//! derivative), Marquardt's diagonal scaling, and the parameters clamped
+//! into their bounds. It is a few dozen lines on nalgebra, which the crate
+//! already uses; the problem is tiny (≤ 6 parameters, tens of residuals),
+//! and the candidates (dropped pairs) and held keys need control of the
+//! residual function that a general crate's trait would only wrap. With
+//! many bounces the misfit has local minima wherever the event count
+//! changes, so the solver starts from the prior and from the best points of
+//! a survey of the log-bounds box (a Halton sequence, 40 points per free
+//! key: deterministic and even), and the best result is kept.
+//!
+//! # What the evidence determines
+//!
+//! At the optimum, with `J` the Jacobian of the data residuals in the log
+//! parameters and `rms²` their mean square per degree of freedom, the
+//! covariance is `(JᵀJ)⁻¹·rms²`; a key's 1σ is its value times the square
+//! root of its diagonal entry. A direction in which `JᵀJ` is near-singular
+//! (smallest/largest eigenvalue below 1e-9) is one the data cannot see:
+//! e.g. a step force closing on a Kelvin–Voigt surface depends on the force
+//! and the gap only through their ratio (with the mass and stiffness fixed).
+//! The key that dominates such a direction is held at its prior and the
+//! rest refitted; a weak penalty toward the prior (1 % of the timing scale
+//! per e-fold) keeps the iteration away from absurd values meanwhile. A
+//! held key, or one whose σ exceeds its value, is reported as not
+//! determined.
+
+use std::time::Instant;
+
+use nalgebra::{DMatrix, DVector, SymmetricEigen};
+use serde::Serialize;
+use thiserror::Error;
+
+use super::sections::{DatasheetSection, FittedParameter, ProvenanceSection};
+use crate::chatter::{ContactState, Interval};
+use crate::coil::{Coil, Source, simulate_direct};
+use crate::mechanics::{Mechanics, simulate};
+use crate::scenario::{Scenario, ScenarioError};
+
+/// s: residuals of event times are divided by this before they are
+/// squared, so that they weigh like relative datasheet misfits.
+const TIME_SCALE: f64 = 1e-6;
+/// Datasheet residuals are relative, divided by this (0.1 %).
+const RELATIVE_SCALE: f64 = 1e-3;
+/// s, the cost of each event the model lacks or adds, on top of its
+/// distance.
+const COUNT_PENALTY: f64 = 50e-6;
+/// Weight of the pull toward the prior, per e-fold of a key.
+const PRIOR_WEIGHT: f64 = 1e-2;
+/// Central-difference step in the log parameters.
+const JACOBIAN_STEP: f64 = 1e-4;
+/// Below this eigenvalue ratio of JᵀJ a direction is not determined.
+const SINGULAR_RATIO: f64 = 1e-9;
+/// Starts besides the prior: the best points of the survey.
+const EXTRA_STARTS: usize = 4;
+/// Survey points per free key.
+const SURVEY_PER_KEY: usize = 40;
+
+/// Why a fit cannot start.
+#[derive(Debug, Error)]
+pub enum FitError {
+    #[error(
+        "no free keys: list the keys the fit may move in [fit] free = [...] or with --free KEY,..."
+    )]
+    NoFreeKeys,
+    #[error("{path}: free key `{key}`: {source}")]
+    UnknownKey {
+        path: String,
+        key: String,
+        #[source]
+        source: Box<ScenarioError>,
+    },
+    #[error(
+        "{path}: free key `{key}` has no value in the scenario to start from: give it a prior value"
+    )]
+    NoPrior { path: String, key: String },
+    #[error(
+        "{path}: free key `{key}` = {value} cannot be fitted: the fit works in logarithms and needs a positive prior"
+    )]
+    NotPositive {
+        path: String,
+        key: String,
+        value: f64,
+    },
+    #[error(
+        "{path}: [fit] bounds for `{key}` = [{low}, {high}] must be positive, increasing and contain the prior {prior}"
+    )]
+    Bounds {
+        path: String,
+        key: String,
+        low: f64,
+        high: f64,
+        prior: f64,
+    },
+    #[error(
+        "nothing to fit to: pass --capture or --measured, or give figures in the scenario's [datasheet]"
+    )]
+    NoEvidence,
+    #[error(
+        "{path}: [datasheet] {figure} needs a coil: add a [coil] section (the datasheet figures are those of a coil-driven relay)"
+    )]
+    NeedsCoil { path: String, figure: &'static str },
+    #[error(
+        "{path}: [datasheet] coil_voltage is needed: the times and a coil-driven record are measured with that DC step on the coil"
+    )]
+    NeedsVoltage { path: String },
+    #[error("{path}: [datasheet] {figure} = {value} must be a positive, finite number")]
+    BadFigure {
+        path: String,
+        figure: &'static str,
+        value: f64,
+    },
+    #[error("{name}: the record has no make or break edge to fit")]
+    EmptyRecord { name: String },
+    #[error("{path}: the prior scenario cannot be simulated: {message}")]
+    Prior { path: String, message: String },
+}
+
+/// A make (the contact closes) or a break (it opens).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EventKind {
+    Make,
+    Break,
+}
+
+impl EventKind {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            EventKind::Make => "make",
+            EventKind::Break => "break",
+        }
+    }
+}
+
+/// One change of contact state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Event {
+    pub kind: EventKind,
+    /// s
+    pub time: f64,
+}
+
+/// The changes of state of a tiling of intervals: every interval's start
+/// but the first's.
+pub fn events_of(intervals: &[Interval]) -> Vec<Event> {
+    intervals
+        .iter()
+        .skip(1)
+        .map(|i| Event {
+            kind: match i.state {
+                ContactState::Closed => EventKind::Make,
+                ContactState::Open => EventKind::Break,
+            },
+            time: i.start,
+        })
+        .collect()
+}
+
+/// A measured record of the contact: its name (for messages and the
+/// provenance) and its states.
+#[derive(Debug, Clone)]
+pub struct Record {
+    pub name: String,
+    pub intervals: Vec<Interval>,
+}
+
+/// What to fit to and what may move.
+#[derive(Debug, Clone, Default)]
+pub struct FitRequest {
+    /// A record of make/break times.
+    pub record: Option<Record>,
+    /// Free keys replacing `[fit] free` (empty: use the scenario's).
+    pub free: Vec<String>,
+}
+
+/// One free key's outcome.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ParameterRow {
+    pub key: String,
+    pub prior: f64,
+    pub value: f64,
+    /// 1σ; `None` for a key held at its prior.
+    pub sigma: Option<f64>,
+    pub determined: bool,
+}
+
+/// One measured event against the model's.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct EventRow {
+    pub kind: EventKind,
+    /// s, on the record's time axis; `None` for a model event the record
+    /// lacks.
+    pub measured: Option<f64>,
+    /// s, on the record's time axis (model time less the offset); `None`
+    /// for a measured event the model lacks.
+    pub model: Option<f64>,
+    pub residual: Option<f64>,
+    /// The event was set aside as the one bad edge.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub dropped: bool,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct BounceCount {
+    pub measured: usize,
+    pub model: usize,
+}
+
+/// One datasheet figure against the model's.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FigureRow {
+    pub figure: &'static str,
+    pub target: f64,
+    pub model: Option<f64>,
+    /// (model − target)/target.
+    pub residual: Option<f64>,
+    /// This figure limits the fit: the largest relative misfit.
+    pub binds: bool,
+}
+
+/// The result of [`fit`].
+#[derive(Debug, Clone, Serialize)]
+pub struct FitReport {
+    pub parameters: Vec<ParameterRow>,
+    pub events: Vec<EventRow>,
+    /// `None` (null) without a record.
+    pub bounce_count: Option<BounceCount>,
+    pub datasheet: Vec<FigureRow>,
+    pub time_offset: Option<f64>,
+    /// s for a record fit (events only); relative for a datasheet-only fit.
+    pub rms_residual: f64,
+    pub evaluations: usize,
+    /// s, wall clock.
+    pub elapsed: f64,
+    /// What the fit decided on its own (held keys, a dropped edge).
+    pub notes: Vec<String>,
+    #[serde(skip)]
+    pub fitted: Scenario,
+    #[serde(skip)]
+    pub fitted_to: String,
+}
+
+impl FitReport {
+    /// The `[provenance]` section for the fitted scenario.
+    pub fn provenance(&self) -> ProvenanceSection {
+        ProvenanceSection {
+            fitted_to: self.fitted_to.clone(),
+            rms_residual: self.rms_residual,
+            time_offset: self.time_offset,
+            parameters: self
+                .parameters
+                .iter()
+                .map(|p| {
+                    (
+                        p.key.clone(),
+                        FittedParameter {
+                            prior: p.prior,
+                            value: p.value,
+                            sigma: p.sigma,
+                            determined: p.determined,
+                        },
+                    )
+                })
+                .collect(),
+        }
+    }
+}
+
+/// Which events take part: none dropped, or one adjacent pair of the
+/// measured or of the modelled events.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Candidate {
+    All,
+    DropMeasured(usize),
+    DropModel(usize),
+}
+
+fn drop_pair(events: &[Event], j: usize) -> Vec<Event> {
+    events
+        .iter()
+        .enumerate()
+        .filter(|&(i, _)| i != j && i != j + 1)
+        .map(|(_, e)| *e)
+        .collect()
+}
+
+/// The datasheet figures that were given, in a fixed order.
+fn figures(d: &DatasheetSection) -> Vec<(&'static str, f64)> {
+    [
+        ("pick_up_voltage", d.pick_up_voltage),
+        ("drop_out_voltage", d.drop_out_voltage),
+        ("operate_time", d.operate_time),
+        ("bounce_time", d.bounce_time),
+        ("release_time", d.release_time),
+    ]
+    .into_iter()
+    .filter_map(|(name, v)| v.map(|v| (name, v)))
+    .collect()
+}
+
+/// The relay's mechanics as the engines take them (the force of a
+/// coil-driven relay is made by the coil).
+fn mechanics_of(s: &Scenario) -> Mechanics {
+    let m = &s.mechanics;
+    Mechanics {
+        mass: m.mass,
+        stiffness: m.stiffness,
+        damping: m.damping,
+        force: m.force.unwrap_or(0.0),
+        gap: m.gap,
+        initial_position: m.initial_position,
+        initial_velocity: m.initial_velocity,
+        preload: m.preload,
+    }
+}
+
+/// The modelled events of one closing: the step-force engine, or with a
+/// coil the direct engine on an ideal `voltage` step.
+pub fn model_events(s: &Scenario, voltage: Option<f64>) -> Result<Vec<Event>, String> {
+    let chatter = match (&s.coil, voltage) {
+        (Some(c), Some(v)) => {
+            simulate_direct(
+                &Coil::from(c),
+                &Source {
+                    voltage: v,
+                    series_resistance: 0.0,
+                },
+                &mechanics_of(s),
+                &s.surface(),
+                &s.settings(),
+            )
+            .map_err(|e| e.to_string())?
+            .chatter
+        }
+        (Some(_), None) => return Err("a coil-driven relay needs [datasheet] coil_voltage".into()),
+        (None, _) => {
+            simulate(&mechanics_of(s), &s.surface(), &s.settings()).map_err(|e| e.to_string())?
+        }
+    };
+    Ok(events_of(&chatter.intervals))
+}
+
+/// The datasheet figures of scenario `s` (which has a coil), computed as
+/// a datasheet measures them; `None` for a figure the relay does not
+/// show (it never closes, say).
+pub fn datasheet_figures(s: &Scenario, d: &DatasheetSection) -> Vec<(&'static str, Option<f64>)> {
+    let Some(section) = &s.coil else {
+        return figures(d).into_iter().map(|(n, _)| (n, None)).collect();
+    };
+    let coil = Coil::from(section);
+    let m = mechanics_of(s);
+    let wants = |f: Option<f64>| f.is_some();
+    let closing = match d.coil_voltage {
+        Some(v) if wants(d.operate_time) || wants(d.bounce_time) => simulate_direct(
+            &coil,
+            &Source {
+                voltage: v,
+                series_resistance: 0.0,
+            },
+            &m,
+            &s.surface(),
+            &s.settings(),
+        )
+        .ok(),
+        _ => None,
+    };
+    let operate = closing.as_ref().and_then(|r| r.events.first_make);
+    let settle = closing.as_ref().and_then(|r| r.events.settle_time);
+    let mut out = Vec::new();
+    for (name, _) in figures(d) {
+        let value = match name {
+            "pick_up_voltage" => {
+                Some(coil.resistance * (2.0 * m.preload / coil.d_inductance(0.0)).sqrt())
+            }
+            "drop_out_voltage" => Some(
+                coil.resistance
+                    * (2.0 * (m.stiffness * m.gap + m.preload) / coil.d_inductance(m.gap)).sqrt(),
+            ),
+            "operate_time" => operate,
+            "bounce_time" => operate.zip(settle).map(|(a, b)| b - a),
+            // Not modelled: a relay's release time is set by the decay of
+            // its flux (eddy currents, the coil's own circuit), which the
+            // single-gap magnet with an ideal switch does not have.
+            "release_time" => None,
+            _ => None,
+        };
+        out.push((name, value));
+    }
+    out
+}
+
+/// The fitting problem: the prior scenario, the free keys in log form,
+/// and the evidence.
+struct Problem<'a> {
+    base: &'a Scenario,
+    keys: Vec<String>,
+    prior: Vec<f64>,
+    low: Vec<f64>,
+    high: Vec<f64>,
+    measured: Option<Vec<Event>>,
+    datasheet: Option<DatasheetSection>,
+    voltage: Option<f64>,
+    evaluations: std::cell::Cell<usize>,
+}
+
+/// What one evaluation produced, for the residuals and the report.
+struct Evaluation {
+    model: Vec<Event>,
+    figures: Vec<(&'static str, Option<f64>)>,
+}
+
+impl Problem<'_> {
+    fn scenario_at(&self, u: &[f64]) -> Option<Scenario> {
+        let mut s = self.base.clone();
+        let values: Vec<(&str, f64)> = self
+            .keys
+            .iter()
+            .zip(u)
+            .zip(&self.prior)
+            // A key at its prior keeps the prior's exact bits.
+            .map(|((k, &v), &p)| (k.as_str(), if v == p.ln() { p } else { v.exp() }))
+            .collect();
+        s.set_numbers(&values).ok()?;
+        Some(s)
+    }
+
+    fn evaluate(&self, u: &[f64]) -> Option<Evaluation> {
+        self.evaluations.set(self.evaluations.get() + 1);
+        let s = self.scenario_at(u)?;
+        let model = match &self.measured {
+            Some(_) => model_events(&s, self.voltage).ok()?,
+            None => Vec::new(),
+        };
+        let figures = match &self.datasheet {
+            Some(d) => datasheet_figures(&s, d),
+            None => Vec::new(),
+        };
+        Some(Evaluation { model, figures })
+    }
+
+    /// The events of a candidate: (measured, model).
+    fn matched(&self, e: &Evaluation, c: Candidate) -> (Vec<Event>, Vec<Event>) {
+        let measured = self.measured.clone().unwrap_or_default();
+        match c {
+            Candidate::All => (measured, e.model.clone()),
+            Candidate::DropMeasured(j) => (drop_pair(&measured, j), e.model.clone()),
+            Candidate::DropModel(j) => (measured, drop_pair(&e.model, j)),
+        }
+    }
+
+    fn data_len(&self) -> usize {
+        self.measured.as_ref().map_or(0, |m| m.len() + 1)
+            + self.datasheet.as_ref().map_or(0, |d| figures(d).len())
+    }
+
+    /// The scaled data residuals (no prior rows); `None` when the
+    /// scenario is invalid at `u`.
+    fn data_residuals(&self, u: &[f64], c: Candidate) -> Option<Vec<f64>> {
+        let e = self.evaluate(u)?;
+        let mut r = Vec::with_capacity(self.data_len());
+        if self.measured.is_some() {
+            let (measured, model) = self.matched(&e, c);
+            let (rows, _) = event_residuals(&measured, &model);
+            r.extend(rows.iter().map(|x| x / TIME_SCALE));
+            // A dropped pair shortens the measured list: pad so that every
+            // candidate has the same length.
+            r.resize(self.measured.as_ref().map_or(0, |m| m.len() + 1), 0.0);
+        }
+        if let Some(d) = &self.datasheet {
+            for ((name, target), (_, model)) in figures(d).iter().zip(&e.figures) {
+                r.push(match model {
+                    Some(m) => (m - target) / target / RELATIVE_SCALE,
+                    // Shown, not fitted (see `datasheet_figures`).
+                    None if *name == "release_time" => 0.0,
+                    None => 1.0 / RELATIVE_SCALE,
+                });
+            }
+        }
+        Some(r)
+    }
+
+    /// Data residuals then the prior rows of the active keys.
+    fn residuals(&self, u: &[f64], active: &[usize], c: Candidate) -> Option<Vec<f64>> {
+        let mut r = self.data_residuals(u, c)?;
+        let prior = self.prior.iter().map(|p| p.ln());
+        for (k, p) in prior.enumerate() {
+            if active.contains(&k) {
+                r.push(PRIOR_WEIGHT * (u[k] - p));
+            }
+        }
+        Some(r)
+    }
+
+    fn clamp(&self, u: &mut [f64]) {
+        for (k, x) in u.iter_mut().enumerate() {
+            *x = x.clamp(self.low[k].ln(), self.high[k].ln());
+        }
+    }
+
+    /// Central-difference Jacobian of `f` over the active keys.
+    fn jacobian(
+        &self,
+        u: &[f64],
+        active: &[usize],
+        f: impl Fn(&[f64]) -> Option<Vec<f64>>,
+        rows: usize,
+    ) -> Option<DMatrix<f64>> {
+        let mut j = DMatrix::zeros(rows, active.len());
+        for (col, &k) in active.iter().enumerate() {
+            let mut up = u.to_vec();
+            let mut down = u.to_vec();
+            up[k] += JACOBIAN_STEP;
+            down[k] -= JACOBIAN_STEP;
+            let (a, b) = (f(&up)?, f(&down)?);
+            for row in 0..rows {
+                j[(row, col)] = (a[row] - b[row]) / (2.0 * JACOBIAN_STEP);
+            }
+        }
+        Some(j)
+    }
+
+    /// Levenberg–Marquardt from `u0` over the active keys; the best point
+    /// and its cost (sum of squares, prior rows included).
+    fn solve(&self, u0: &[f64], active: &[usize], c: Candidate) -> (Vec<f64>, f64) {
+        let mut u = u0.to_vec();
+        self.clamp(&mut u);
+        let f = |x: &[f64]| self.residuals(x, active, c);
+        let Some(mut r) = f(&u) else {
+            return (u, f64::INFINITY);
+        };
+        let mut cost = r.iter().map(|x| x * x).sum::<f64>();
+        if active.is_empty() {
+            return (u, cost);
+        }
+        let mut lambda = 1e-3;
+        for _ in 0..100 {
+            let Some(j) = self.jacobian(&u, active, f, r.len()) else {
+                break;
+            };
+            let jt = j.transpose();
+            let a = &jt * &j;
+            let g = &jt * DVector::from_vec(r.clone());
+            let mut improved = false;
+            while lambda < 1e12 {
+                let mut damped = a.clone();
+                for d in 0..active.len() {
+                    damped[(d, d)] += lambda * (a[(d, d)] + 1e-12);
+                }
+                let Some(step) = damped.lu().solve(&(-&g)) else {
+                    lambda *= 10.0;
+                    continue;
+                };
+                let mut trial = u.clone();
+                for (col, &k) in active.iter().enumerate() {
+                    trial[k] += step[col];
+                }
+                self.clamp(&mut trial);
+                match f(&trial) {
+                    Some(rt) => {
+                        let ct = rt.iter().map(|x| x * x).sum::<f64>();
+                        if ct < cost {
+                            let gain = cost - ct;
+                            let moved = trial
+                                .iter()
+                                .zip(&u)
+                                .map(|(a, b)| (a - b).abs())
+                                .fold(0.0, f64::max);
+                            u = trial;
+                            r = rt;
+                            cost = ct;
+                            lambda = (lambda / 3.0).max(1e-12);
+                            improved = gain > 1e-12 * cost.max(1e-30) && moved > 1e-10;
+                            break;
+                        }
+                        lambda *= 4.0;
+                    }
+                    None => lambda *= 4.0,
+                }
+            }
+            if !improved {
+                break;
+            }
+        }
+        (u, cost)
+    }
+}
+
+/// The prior, with the preload and the spring stiffness (when free)
+/// solved in closed form from the pick-up and drop-out voltages:
+/// `p = ½ (V_pu/R)² L'(0)` and `s = (½ (V_do/R)² L'(g) − p)/g`. The
+/// solver starts there: those two figures pin them exactly, and the rest
+/// of the fit (the times) starts from a point that already meets them.
+fn closed_form_start(problem: &Problem, u_prior: &[f64]) -> Vec<f64> {
+    let mut u = u_prior.to_vec();
+    let (Some(d), Some(s)) = (&problem.datasheet, problem.scenario_at(u_prior)) else {
+        return u;
+    };
+    let Some(c) = &s.coil else {
+        return u;
+    };
+    let coil = Coil::from(c);
+    let key = |name: &str| problem.keys.iter().position(|k| k == name);
+    let mut preload = s.mechanics.preload;
+    if let (Some(v), Some(k)) = (d.pick_up_voltage, key("mechanics.preload")) {
+        preload = 0.5 * (v / coil.resistance).powi(2) * coil.d_inductance(0.0);
+        u[k] = preload.ln();
+    }
+    if let (Some(v), Some(k)) = (d.drop_out_voltage, key("mechanics.stiffness")) {
+        let g = s.mechanics.gap;
+        let spring = (0.5 * (v / coil.resistance).powi(2) * coil.d_inductance(g) - preload) / g;
+        if spring > 0.0 {
+            u[k] = spring.ln();
+        }
+    }
+    problem.clamp(&mut u);
+    u
+}
+
+/// Halton point `i` (from 1) in base `b`: a deterministic, even spread.
+fn halton(mut i: usize, b: usize) -> f64 {
+    let (mut f, mut r) = (1.0, 0.0);
+    while i > 0 {
+        f /= b as f64;
+        r += f * (i % b) as f64;
+        i /= b;
+    }
+    r
+}
+
+/// The event residuals (s) of `measured` against `model` matched in order,
+/// and the time offset (s, model time of the record's zero). One residual
+/// per measured event and one for the model's extra events.
+fn event_residuals(measured: &[Event], model: &[Event]) -> (Vec<f64>, f64) {
+    let n = measured.len();
+    let k = n.min(model.len());
+    let offset = if k > 0 {
+        (0..k)
+            .map(|i| model[i].time - measured[i].time)
+            .sum::<f64>()
+            / k as f64
+    } else {
+        0.0
+    };
+    let last = model.last().map_or(0.0, |e| e.time);
+    let mut r = Vec::with_capacity(n + 1);
+    for (i, e) in measured.iter().enumerate() {
+        r.push(if i < k {
+            let kind = if model[i].kind == e.kind {
+                0.0
+            } else {
+                COUNT_PENALTY
+            };
+            model[i].time - offset - e.time + kind
+        } else {
+            (last - offset - e.time) - COUNT_PENALTY
+        });
+    }
+    r.push(if model.len() > n && n > 0 {
+        (last - model[n - 1].time) + COUNT_PENALTY * (model.len() - n) as f64
+    } else {
+        0.0
+    });
+    (r, offset)
+}
+
+/// Fit `scenario`'s free keys to the evidence; the scenario's own
+/// `[datasheet]` figures take part whenever it has any.
+pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitError> {
+    let started = Instant::now();
+    let path = scenario.origin.display().to_string();
+    let section = scenario.fit.clone().unwrap_or_default();
+    let keys = if request.free.is_empty() {
+        section.free.clone()
+    } else {
+        request.free.clone()
+    };
+    if keys.is_empty() {
+        return Err(FitError::NoFreeKeys);
+    }
+    let (mut prior, mut low, mut high) = (Vec::new(), Vec::new(), Vec::new());
+    for key in &keys {
+        let value = scenario
+            .number(key)
+            .map_err(|source| FitError::UnknownKey {
+                path: path.clone(),
+                key: key.clone(),
+                source: Box::new(source),
+            })?
+            .ok_or_else(|| FitError::NoPrior {
+                path: path.clone(),
+                key: key.clone(),
+            })?;
+        if !(value > 0.0 && value.is_finite()) {
+            return Err(FitError::NotPositive {
+                path: path.clone(),
+                key: key.clone(),
+                value,
+            });
+        }
+        let [lo, hi] = section
+            .bounds
+            .get(key)
+            .copied()
+            .unwrap_or([value / 10.0, value * 10.0]);
+        if !(lo > 0.0 && lo <= value && value <= hi && hi.is_finite()) {
+            return Err(FitError::Bounds {
+                path: path.clone(),
+                key: key.clone(),
+                low: lo,
+                high: hi,
+                prior: value,
+            });
+        }
+        prior.push(value);
+        low.push(lo);
+        high.push(hi);
+    }
+    let datasheet = scenario
+        .datasheet
+        .clone()
+        .filter(|d| !figures(d).is_empty());
+    if let Some(d) = &scenario.datasheet {
+        let all = [("coil_voltage", d.coil_voltage)]
+            .into_iter()
+            .chain(figures(d).into_iter().map(|(n, v)| (n, Some(v))));
+        for (figure, v) in all {
+            if let Some(value) = v
+                && !(value > 0.0 && value.is_finite())
+            {
+                return Err(FitError::BadFigure {
+                    path: path.clone(),
+                    figure,
+                    value,
+                });
+            }
+        }
+    }
+    if let Some(d) = &datasheet {
+        if scenario.coil.is_none() {
+            return Err(FitError::NeedsCoil {
+                path: path.clone(),
+                figure: figures(d)[0].0,
+            });
+        }
+        let timed = d.operate_time.is_some() || d.bounce_time.is_some();
+        if timed && d.coil_voltage.is_none() {
+            return Err(FitError::NeedsVoltage { path: path.clone() });
+        }
+    }
+    let voltage = scenario.datasheet.as_ref().and_then(|d| d.coil_voltage);
+    let measured = match &request.record {
+        Some(record) => {
+            let events = events_of(&record.intervals);
+            if events.is_empty() {
+                return Err(FitError::EmptyRecord {
+                    name: record.name.clone(),
+                });
+            }
+            if scenario.coil.is_some() && voltage.is_none() {
+                return Err(FitError::NeedsVoltage { path: path.clone() });
+            }
+            Some(events)
+        }
+        None => None,
+    };
+    if measured.is_none() && datasheet.is_none() {
+        return Err(FitError::NoEvidence);
+    }
+    let problem = Problem {
+        base: scenario,
+        keys: keys.clone(),
+        prior: prior.clone(),
+        low,
+        high,
+        measured,
+        datasheet,
+        voltage,
+        evaluations: std::cell::Cell::new(0),
+    };
+    let u_prior: Vec<f64> = prior.iter().map(|p| p.ln()).collect();
+    if problem.data_residuals(&u_prior, Candidate::All).is_none() {
+        let message = match scenario.clone().set_numbers(&[]) {
+            Err(e) => e.to_string(),
+            Ok(()) => "its parameters are invalid".to_owned(),
+        };
+        return Err(FitError::Prior { path, message });
+    }
+
+    // Multistart over the full candidate.
+    let mut active: Vec<usize> = (0..keys.len()).collect();
+    // A coarse survey of the log-bounds box (a Halton sequence:
+    // deterministic and even) finds the basin: with many bounces the
+    // misfit has many local minima where the event count changes, and
+    // a local solver started far off lands in one of them.
+    const BASES: [usize; 8] = [2, 3, 5, 7, 11, 13, 17, 19];
+    let survey = SURVEY_PER_KEY * keys.len();
+    let mut sampled: Vec<(f64, Vec<f64>)> = (1..=survey)
+        .map(|i| {
+            let u: Vec<f64> = (0..keys.len())
+                .map(|k| {
+                    let (lo, hi) = (problem.low[k].ln(), problem.high[k].ln());
+                    lo + (hi - lo) * halton(i, BASES[k % BASES.len()])
+                })
+                .collect();
+            let cost = problem
+                .residuals(&u, &active, Candidate::All)
+                .map_or(f64::INFINITY, |r| r.iter().map(|x| x * x).sum());
+            (cost, u)
+        })
+        .collect();
+    sampled.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut starts = vec![closed_form_start(&problem, &u_prior)];
+    starts.extend(sampled.into_iter().take(EXTRA_STARTS).map(|(_, u)| u));
+    let mut best = (u_prior.clone(), f64::INFINITY);
+    for start in &starts {
+        let (u, cost) = problem.solve(start, &active, Candidate::All);
+        if cost < best.1 {
+            best = (u, cost);
+        }
+    }
+    let mut candidate = Candidate::All;
+    let mut notes = Vec::new();
+
+    // One bad edge: a glitch in the record, or a bounce it missed.
+    if let Some(measured) = &problem.measured {
+        let n_model = problem.evaluate(&best.0).map_or(0, |e| e.model.len());
+        let mut alternatives = Vec::new();
+        for j in 0..measured.len().saturating_sub(1) {
+            alternatives.push(Candidate::DropMeasured(j));
+        }
+        for j in 0..n_model.saturating_sub(1) {
+            alternatives.push(Candidate::DropModel(j));
+        }
+        let mut chosen = (candidate, best.clone());
+        for c in alternatives {
+            let (u, cost) = problem.solve(&best.0, &active, c);
+            if cost < 0.1 * best.1 && cost < chosen.1.1 {
+                chosen = (c, (u, cost));
+            }
+        }
+        if chosen.0 != Candidate::All {
+            candidate = chosen.0;
+            best = chosen.1;
+            notes.push(match candidate {
+                Candidate::DropMeasured(j) => format!(
+                    "set aside the measured {} at {:.6e} s and the {} after it as a spurious glitch",
+                    measured[j].kind.as_str(),
+                    measured[j].time,
+                    measured[j + 1].kind.as_str()
+                ),
+                _ => "the model has one bounce the record lacks (a missed edge pair); matched without it".to_owned(),
+            });
+        }
+    }
+
+    // Hold the keys the data cannot see at their priors, one per
+    // near-singular direction.
+    let data_rows = problem.data_len();
+    let mut held = vec![false; keys.len()];
+    let mut jacobian = None;
+    for _ in 0..keys.len() {
+        let f = |x: &[f64]| problem.data_residuals(x, candidate);
+        let Some(j) = problem.jacobian(&best.0, &active, f, data_rows) else {
+            break;
+        };
+        let a = j.transpose() * &j;
+        let eigen = SymmetricEigen::new(a);
+        let max = eigen.eigenvalues.iter().cloned().fold(0.0, f64::max);
+        let (imin, min) = eigen.eigenvalues.iter().cloned().enumerate().fold(
+            (0, f64::INFINITY),
+            |acc, (i, v)| if v < acc.1 { (i, v) } else { acc },
+        );
+        if max > 0.0 && min > SINGULAR_RATIO * max {
+            jacobian = Some(j);
+            break;
+        }
+        // The key with the largest share of the blind direction; on a tie
+        // (a pure ratio) the later key in the free list.
+        let v = eigen.eigenvectors.column(imin);
+        let mut pick = 0;
+        for i in 0..active.len() {
+            if v[i].abs() >= v[pick].abs() - 1e-6 {
+                pick = i;
+            }
+        }
+        let k = active[pick];
+        let partners: Vec<String> = active
+            .iter()
+            .enumerate()
+            .filter(|&(i, _)| i != pick && v[i].abs() > 0.1)
+            .map(|(_, &a)| format!("`{}`", keys[a]))
+            .collect();
+        held[k] = true;
+        active.retain(|&a| a != k);
+        best.0[k] = u_prior[k];
+        notes.push(format!(
+            "`{}` is not determined by the evidence (it moves only together with {}); held at its prior {}",
+            keys[k],
+            if partners.is_empty() { "nothing: the evidence does not depend on it".to_owned() } else { partners.join(", ") },
+            prior[k]
+        ));
+        best = problem.solve(&best.0, &active, candidate);
+        if active.is_empty() {
+            break;
+        }
+    }
+
+    // Uncertainties.
+    let data = problem
+        .data_residuals(&best.0, candidate)
+        .unwrap_or_default();
+    let ssr: f64 = data.iter().map(|x| x * x).sum();
+    let dof = data_rows.saturating_sub(active.len()).max(1);
+    let rms2 = ssr / dof as f64;
+    let covariance = jacobian
+        .as_ref()
+        .and_then(|j| (j.transpose() * j).try_inverse());
+    let mut parameters = Vec::new();
+    for (k, key) in keys.iter().enumerate() {
+        let value = if best.0[k] == u_prior[k] {
+            prior[k]
+        } else {
+            best.0[k].exp()
+        };
+        let sigma = if held[k] {
+            None
+        } else {
+            let col = active.iter().position(|&a| a == k);
+            Some(match (&covariance, col) {
+                (Some(c), Some(col)) => value * (c[(col, col)] * rms2).sqrt(),
+                _ => f64::INFINITY,
+            })
+        };
+        let determined = sigma.is_some_and(|s| s.is_finite() && s < value);
+        parameters.push(ParameterRow {
+            key: key.clone(),
+            prior: prior[k],
+            value,
+            sigma: sigma.filter(|s| s.is_finite()),
+            determined,
+        });
+    }
+
+    // The report's rows.
+    let fitted = problem
+        .scenario_at(&best.0)
+        .unwrap_or_else(|| scenario.clone());
+    let evaluation = problem.evaluate(&best.0);
+    let mut events = Vec::new();
+    let mut bounce_count = None;
+    let mut time_offset = None;
+    let mut event_rms = None;
+    if let (Some(measured), Some(e)) = (&problem.measured, &evaluation) {
+        let (m, model) = problem.matched(e, candidate);
+        let (rows, offset) = event_residuals(&m, &model);
+        time_offset = Some(offset);
+        let k = m.len().min(model.len());
+        event_rms = Some((rows.iter().map(|x| x * x).sum::<f64>() / m.len() as f64).sqrt());
+        let skipped = match candidate {
+            Candidate::DropMeasured(j) => Some(j),
+            _ => None,
+        };
+        let mut mi = 0;
+        for (i, ev) in measured.iter().enumerate() {
+            if skipped.is_some_and(|j| i == j || i == j + 1) {
+                events.push(EventRow {
+                    kind: ev.kind,
+                    measured: Some(ev.time),
+                    model: None,
+                    residual: None,
+                    dropped: true,
+                });
+                continue;
+            }
+            let model_time = (mi < k).then(|| model[mi].time - offset);
+            events.push(EventRow {
+                kind: ev.kind,
+                measured: Some(ev.time),
+                model: model_time,
+                residual: model_time.map(|t| t - ev.time),
+                dropped: false,
+            });
+            mi += 1;
+        }
+        for extra in model.iter().skip(m.len()) {
+            events.push(EventRow {
+                kind: extra.kind,
+                measured: None,
+                model: Some(extra.time - offset),
+                residual: None,
+                dropped: false,
+            });
+        }
+        let bounces = |ev: &[Event]| ev.iter().filter(|e| e.kind == EventKind::Break).count();
+        bounce_count = Some(BounceCount {
+            measured: bounces(&m),
+            model: bounces(&e.model),
+        });
+    }
+    let mut datasheet_rows = Vec::new();
+    if let (Some(d), Some(e)) = (&problem.datasheet, &evaluation) {
+        for ((figure, target), (_, model)) in figures(d).into_iter().zip(&e.figures) {
+            datasheet_rows.push(FigureRow {
+                figure,
+                target,
+                model: *model,
+                residual: model.map(|m| (m - target) / target),
+                binds: false,
+            });
+        }
+        let worst = datasheet_rows
+            .iter()
+            .enumerate()
+            .filter(|(_, r)| r.figure != "release_time")
+            .map(|(i, r)| (i, r.residual.map_or(f64::INFINITY, f64::abs)))
+            .fold(
+                (usize::MAX, -1.0),
+                |acc, (i, v)| if v > acc.1 { (i, v) } else { acc },
+            );
+        if let Some(row) = datasheet_rows.get_mut(worst.0) {
+            row.binds = true;
+        }
+    }
+    let rms_residual = match event_rms {
+        Some(r) => r,
+        None => {
+            let rel: Vec<f64> = datasheet_rows
+                .iter()
+                .filter(|r| r.figure != "release_time")
+                .map(|r| r.residual.unwrap_or(1.0))
+                .collect();
+            (rel.iter().map(|x| x * x).sum::<f64>() / rel.len().max(1) as f64).sqrt()
+        }
+    };
+    let mut fitted_to = Vec::new();
+    if let Some(r) = &request.record {
+        fitted_to.push(r.name.clone());
+    }
+    if problem.datasheet.is_some() {
+        fitted_to.push("datasheet".to_owned());
+    }
+    let mut fitted = fitted;
+    let report = FitReport {
+        parameters,
+        events,
+        bounce_count,
+        datasheet: datasheet_rows,
+        time_offset,
+        rms_residual,
+        evaluations: problem.evaluations.get(),
+        elapsed: started.elapsed().as_secs_f64(),
+        notes,
+        fitted: scenario.clone(),
+        fitted_to: fitted_to.join(" + "),
+    };
+    fitted.provenance = Some(report.provenance());
+    Ok(FitReport { fitted, ..report })
+}
+
+/// The fitted scenario as TOML: the prior file's text with the fitted
+/// values put in and a `[provenance]` section, so that every key the user
+/// wrote stays (comments do not survive).
+///
+/// `netlist`, when given, replaces `circuit.netlist`: a relative path in
+/// the prior is relative to the prior's directory, which is not the fitted
+/// file's when it is written elsewhere.
+pub fn fitted_toml(
+    prior_text: &str,
+    report: &FitReport,
+    netlist: Option<&std::path::Path>,
+) -> Result<String, toml::de::Error> {
+    let mut table: toml::Table = toml::from_str(prior_text)?;
+    if let (Some(path), Some(toml::Value::Table(circuit))) = (netlist, table.get_mut("circuit")) {
+        circuit.insert(
+            "netlist".to_owned(),
+            toml::Value::String(path.display().to_string()),
+        );
+    }
+    for p in &report.parameters {
+        let mut parts = p.key.splitn(2, '.');
+        let (Some(section), Some(name)) = (parts.next(), parts.next()) else {
+            continue;
+        };
+        let entry = table
+            .entry(section.to_owned())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        if let toml::Value::Table(t) = entry {
+            t.insert(name.to_owned(), toml::Value::Float(p.value));
+        }
+    }
+    let provenance =
+        toml::Value::try_from(report.provenance()).expect("provenance serializes to TOML");
+    table.insert("provenance".to_owned(), provenance);
+    Ok(toml::to_string(&table).expect("a TOML table serializes"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ev(kind: EventKind, time: f64) -> Event {
+        Event { kind, time }
+    }
+
+    #[test]
+    fn the_offset_is_the_mean_difference_and_extra_events_cost() {
+        use EventKind::*;
+        let measured = [ev(Make, 0.0), ev(Break, 1e-4), ev(Make, 3e-4)];
+        let model = [ev(Make, 1e-3), ev(Break, 1.1e-3), ev(Make, 1.3e-3)];
+        let (r, offset) = event_residuals(&measured, &model);
+        assert!((offset - 1e-3).abs() < 1e-15);
+        assert!(r.iter().all(|x| x.abs() < 1e-15), "{r:?}");
+        let longer = [
+            model[0],
+            model[1],
+            model[2],
+            ev(Break, 1.4e-3),
+            ev(Make, 1.5e-3),
+        ];
+        let (r, _) = event_residuals(&measured, &longer);
+        let extra = r.last().copied().unwrap();
+        assert!(
+            (extra - (2e-4 + 2.0 * COUNT_PENALTY)).abs() < 1e-12,
+            "{extra}"
+        );
+    }
+
+    #[test]
+    fn halton_points_spread_in_the_unit_interval() {
+        assert_eq!(halton(1, 2), 0.5);
+        assert_eq!(halton(2, 2), 0.25);
+        assert!((halton(1, 3) - 1.0 / 3.0).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,8 @@
+//! Calibration: from a real relay's evidence (a record of its contact
+//! state, a datasheet) to the parameters of a scenario, with an honest
+//! statement of what the evidence determined.
+
+pub mod fit;
+pub mod parts;
+pub mod render;
+pub mod sections;

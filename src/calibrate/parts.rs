@@ -1,0 +1,233 @@
+//! Bundled relay parts: one scenario per common class of relay, each
+//! fitted (`chatterspice fit`, datasheet figures only) to the figures its
+//! manufacturer's datasheet prints, with the `[provenance]` of that fit.
+//!
+//! A datasheet prints the coil (voltage, resistance), pick-up and drop-out
+//! voltages and operate/release times; it does not print the armature's
+//! mass, travel or magnet geometry. Those are generic assumptions of each
+//! part's prior (`parts/priors/`), and the fit moves the preload, the
+//! spring stiffness and (when an operate time is printed) the mass until
+//! the figures are met. The parts are regenerated with
+//! `scripts/fit-parts`.
+
+use std::path::Path;
+
+use serde::Serialize;
+use thiserror::Error;
+
+use super::fit::datasheet_figures;
+use crate::scenario::{Scenario, ScenarioError};
+
+/// No bundled part of that name.
+#[derive(Debug, Error)]
+#[error("no bundled part `{name}`; the parts are: {known}")]
+pub struct UnknownPart {
+    pub name: String,
+    pub known: String,
+}
+
+/// One bundled part.
+#[derive(Debug, Clone, Copy)]
+pub struct Part {
+    /// The name `parts NAME` takes.
+    pub name: &'static str,
+    /// The relay class it stands for.
+    pub class: &'static str,
+    /// Manufacturer, part number and the document the figures come from.
+    pub source: &'static str,
+    /// The contact rating as printed.
+    pub contact_rating: &'static str,
+    /// Anything about the figures a user should know.
+    pub remark: &'static str,
+    /// The fitted scenario (TOML).
+    pub scenario: &'static str,
+}
+
+impl Part {
+    /// The part's scenario, parsed.
+    pub fn load(&self) -> Result<Scenario, ScenarioError> {
+        Scenario::parse(
+            self.scenario,
+            Path::new(&format!("parts/{}.toml", self.name)),
+        )
+    }
+}
+
+const PARTS: &[Part] = &[
+    Part {
+        name: "omron-g5le-1-dc5",
+        class: "sugar-cube 10 A PCB power relay",
+        source: "Omron G5LE-1 DC5; Omron datasheet \"G5LE PCB Power Relay: Cubic, Single-pole 10A Power Relay\" (coil ratings: 5 VDC, 79.4 mA, 63 Ω, must operate 75 % max., must release 10 % min.; operate time 10 ms max., release time 5 ms max.)",
+        contact_rating: "single-pole 10 A power relay (SPDT)",
+        remark: "times are maxima: the fitted relay is the slowest the datasheet allows",
+        scenario: include_str!("../../parts/omron-g5le-1-dc5.toml"),
+    },
+    Part {
+        name: "songle-srd-05vdc-sl-c",
+        class: "sugar-cube 10 A PCB power relay (hobby modules)",
+        source: "Songle SRD-05VDC-SL-C; Ningbo Songle Relay SRD datasheet, coil data chart (high sensitivity 0.36 W: 5 VDC, 71.4 mA, 70 Ω ±10 %, pull-in 75 % max., drop-out 10 % min.; operation time 10 ms max., release time 5 ms max.)",
+        contact_rating: "10 A 125 VAC / 10 A 30 VDC resistive (form C)",
+        remark: "times are maxima: the fitted relay is the slowest the datasheet allows",
+        scenario: include_str!("../../parts/songle-srd-05vdc-sl-c.toml"),
+    },
+    Part {
+        name: "panasonic-tq4-5v",
+        class: "DIP signal relay",
+        source: "Panasonic TQ4-5V; Panasonic (NAIS) datasheet \"TQ-RELAYS: Low profile 2 Form C relay\", 4 Form C single side stable coil table (5 V DC, 56.2 mA, 89 Ω, pick-up 3.75 V max., drop-out 0.5 V min.; operate time max. 3 ms (approx. 2 ms), release time max. 3 ms (approx. 1 ms))",
+        contact_rating: "1 A 30 V DC / 0.5 A 125 V AC resistive",
+        remark: "fitted to the typical operate time (approx. 2 ms)",
+        scenario: include_str!("../../parts/panasonic-tq4-5v.toml"),
+    },
+    Part {
+        name: "finder-40.52-12vdc",
+        class: "industrial PCB/plug-in relay",
+        source: "Finder 40.52.9.012.0000; Finder datasheet \"40 Series - Miniature PCB/Plug-in relays 8 - 10 - 12 - 16 A\" (DC coil 0.65 W, operating range 0.73…1.5 U_N, must drop-out 0.1 U_N, operate/release time 7/3 ms); coil resistance 220 Ω as listed for 40.52.9.012.0000",
+        contact_rating: "2 CO 8 A 250 VAC",
+        remark: "pick-up 8.76 V = 0.73 × 12 V (the lower end of the operating range)",
+        scenario: include_str!("../../parts/finder-40.52-12vdc.toml"),
+    },
+    Part {
+        name: "coto-9104-05",
+        class: "reed relay (SIP)",
+        source: "Coto Technology 9104 (5 V); Coto 9100/9104 series reed relay datasheet, model 9104 4-pin SIP (5 VDC, coil 175 Ω ±10 %, must operate 3.75 V max., must release 0.5 V min.; operate time including bounce 0.75 ms typ., release time 0.5 ms typ.)",
+        contact_rating: "10 W, 0.5 A switching, 1000 V max. (DC/peak AC, resistive)",
+        remark: "the printed operate time includes bounce; it is fitted as the time to first make",
+        scenario: include_str!("../../parts/coto-9104-05.toml"),
+    },
+    Part {
+        name: "te-v23145-12v",
+        class: "automotive plug-in Micro ISO relay",
+        source: "TE Connectivity Micro Relay Low Noise V23145 (coil code *01-402); TE datasheet \"Automotive Relays, Plug-in Micro ISO Relays, Micro Relay Low Noise\" (12 VDC, operate 7.2 V, release 1.4 V, 181 Ω ±10 %, 796 mW)",
+        contact_rating: "20 A NO at 23 °C, 12 VDC",
+        remark: "no operate, bounce or release time printed in the coil data: the mass is the prior's",
+        scenario: include_str!("../../parts/te-v23145-12v.toml"),
+    },
+];
+
+/// Every bundled part, in a fixed order.
+pub fn all() -> &'static [Part] {
+    PARTS
+}
+
+/// The part called `name`.
+pub fn find(name: &str) -> Result<Part, UnknownPart> {
+    PARTS
+        .iter()
+        .find(|p| p.name == name)
+        .copied()
+        .ok_or_else(|| UnknownPart {
+            name: name.to_owned(),
+            known: PARTS.iter().map(|p| p.name).collect::<Vec<_>>().join(", "),
+        })
+}
+
+/// A datasheet figure as listed: the printed value and what the fitted
+/// scenario gives, or "not given".
+#[derive(Debug, Clone, Serialize)]
+#[serde(untagged)]
+pub enum Figure {
+    Given { value: f64, model: Option<f64> },
+    NotGiven(&'static str),
+}
+
+/// One part as `parts --format json` lists it.
+#[derive(Debug, Clone, Serialize)]
+pub struct Listing {
+    pub name: &'static str,
+    pub class: &'static str,
+    pub datasheet: std::collections::BTreeMap<&'static str, Figure>,
+    pub contact_rating: &'static str,
+    pub source: &'static str,
+    pub remark: &'static str,
+}
+
+const FIGURES: [&str; 7] = [
+    "coil_voltage",
+    "coil_resistance",
+    "pick_up_voltage",
+    "drop_out_voltage",
+    "operate_time",
+    "bounce_time",
+    "release_time",
+];
+
+/// The listing of `part`: its datasheet figures against its scenario's.
+pub fn listing(part: &Part) -> Listing {
+    let scenario = part.load().expect("a bundled part's scenario is valid");
+    let d = scenario.datasheet.clone().unwrap_or_default();
+    let modelled = datasheet_figures(&scenario, &d);
+    let model = |name: &str| {
+        modelled
+            .iter()
+            .find(|(n, _)| *n == name)
+            .and_then(|(_, v)| *v)
+    };
+    let mut datasheet = std::collections::BTreeMap::new();
+    for name in FIGURES {
+        let printed = match name {
+            "coil_voltage" => d.coil_voltage,
+            "coil_resistance" => scenario.coil.as_ref().map(|c| c.resistance),
+            "pick_up_voltage" => d.pick_up_voltage,
+            "drop_out_voltage" => d.drop_out_voltage,
+            "operate_time" => d.operate_time,
+            "bounce_time" => d.bounce_time,
+            "release_time" => d.release_time,
+            _ => None,
+        };
+        datasheet.insert(
+            name,
+            match printed {
+                Some(value) => Figure::Given {
+                    value,
+                    // The coil's voltage and resistance are the model's
+                    // own inputs.
+                    model: match name {
+                        "coil_voltage" | "coil_resistance" => Some(value),
+                        _ => model(name),
+                    },
+                },
+                None => Figure::NotGiven("not given"),
+            },
+        );
+    }
+    Listing {
+        name: part.name,
+        class: part.class,
+        datasheet,
+        contact_rating: part.contact_rating,
+        source: part.source,
+        remark: part.remark,
+    }
+}
+
+/// `parts --format json`.
+pub fn json() -> String {
+    let list: Vec<Listing> = PARTS.iter().map(listing).collect();
+    let mut text = serde_json::to_string_pretty(&list).expect("the parts serialize");
+    text.push('\n');
+    text
+}
+
+/// `parts` as a table: one block per part.
+pub fn table() -> String {
+    use std::fmt::Write;
+    let mut out = String::new();
+    for part in PARTS {
+        let l = listing(part);
+        let _ = writeln!(out, "{}  ({})", l.name, l.class);
+        for (name, figure) in &l.datasheet {
+            let text = match figure {
+                Figure::Given { value, model } => format!(
+                    "{value:.4e}  (model {})",
+                    model.map_or_else(|| "not modelled".to_owned(), |m| format!("{m:.4e}"))
+                ),
+                Figure::NotGiven(t) => (*t).to_owned(),
+            };
+            let _ = writeln!(out, "  {name:<17} {text}");
+        }
+        let _ = writeln!(out, "  contacts          {}", l.contact_rating);
+        let _ = writeln!(out, "  source            {}", l.source);
+        let _ = writeln!(out, "  note              {}\n", l.remark);
+    }
+    out
+}

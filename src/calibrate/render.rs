@@ -1,0 +1,174 @@
+//! A fit's report as a table, as JSON, and as an overlay plot of the
+//! measured and the fitted contact state.
+
+use std::fmt::Write;
+
+use super::fit::{EventKind, FitReport};
+use crate::chatter::{ContactState, Interval};
+
+/// `fit --format json`: the report's fields (see the calibration guide).
+pub fn json(report: &FitReport) -> String {
+    let mut text = serde_json::to_string_pretty(report).expect("a fit report serializes");
+    text.push('\n');
+    text
+}
+
+fn number(v: Option<f64>) -> String {
+    v.map_or_else(|| "-".to_owned(), |v| format!("{v:.6e}"))
+}
+
+/// `fit --format table`: parameters, then events, then datasheet figures,
+/// then the notes.
+pub fn table(report: &FitReport) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "{:<24} {:>13} {:>13} {:>13}  determined",
+        "parameter", "prior", "value", "sigma"
+    );
+    for p in &report.parameters {
+        let _ = writeln!(
+            out,
+            "{:<24} {:>13} {:>13} {:>13}  {}",
+            p.key,
+            number(Some(p.prior)),
+            number(Some(p.value)),
+            number(p.sigma),
+            if p.determined { "yes" } else { "no" }
+        );
+    }
+    if !report.events.is_empty() {
+        let _ = writeln!(out);
+        let _ = writeln!(
+            out,
+            "{:<6} {:>13} {:>13} {:>13}",
+            "event", "measured s", "model s", "residual s"
+        );
+        for e in &report.events {
+            let _ = writeln!(
+                out,
+                "{:<6} {:>13} {:>13} {:>13}{}",
+                e.kind.as_str(),
+                number(e.measured),
+                number(e.model),
+                number(e.residual),
+                if e.dropped { "  (set aside)" } else { "" }
+            );
+        }
+    }
+    if let Some(b) = report.bounce_count {
+        let _ = writeln!(out, "bounces: measured {}, model {}", b.measured, b.model);
+    }
+    if let Some(t) = report.time_offset {
+        let _ = writeln!(
+            out,
+            "time offset: {t:.6e} s (model time of the record's zero)"
+        );
+    }
+    if !report.datasheet.is_empty() {
+        let _ = writeln!(out);
+        let _ = writeln!(
+            out,
+            "{:<18} {:>13} {:>13} {:>10}",
+            "figure", "datasheet", "model", "misfit"
+        );
+        for f in &report.datasheet {
+            let _ = writeln!(
+                out,
+                "{:<18} {:>13} {:>13} {:>10}{}",
+                f.figure,
+                number(Some(f.target)),
+                number(f.model),
+                f.residual
+                    .map_or_else(|| "-".to_owned(), |r| format!("{:+.3}%", r * 100.0)),
+                if f.binds { "  (binds)" } else { "" }
+            );
+        }
+    }
+    let unit = if report.events.is_empty() { "" } else { " s" };
+    let _ = writeln!(
+        out,
+        "\nrms residual {:.3e}{unit}; {} evaluations in {:.3} s",
+        report.rms_residual, report.evaluations, report.elapsed
+    );
+    for n in &report.notes {
+        let _ = writeln!(out, "note: {n}");
+    }
+    out
+}
+
+/// An SVG of two contact-state traces on the record's time axis: the
+/// measured one on top, the fitted model's below (shifted by the time
+/// offset), with the edge thresholds of a two-level trace (30 % / 70 %).
+pub fn overlay_svg(measured: &[Interval], report: &FitReport) -> String {
+    let model: Vec<(EventKind, f64)> = report
+        .events
+        .iter()
+        .filter_map(|e| e.model.map(|t| (e.kind, t)))
+        .collect();
+    let start = measured.first().map_or(0.0, |i| i.start);
+    let end = measured
+        .last()
+        .map_or(1.0, |i| i.end)
+        .max(model.last().map_or(start, |m| m.1));
+    let span = (end - start).max(1e-12);
+    let (w, h, left, right) = (900.0, 300.0, 60.0, 20.0);
+    let x = |t: f64| left + (t - start) / span * (w - left - right);
+    let mut svg = String::new();
+    let _ = writeln!(
+        svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="sans-serif" font-size="12">"#
+    );
+    let _ = writeln!(svg, r#"<rect width="{w}" height="{h}" fill="white"/>"#);
+    // Lane `top` .. `top + 80`: open high, closed low.
+    let lane = |svg: &mut String, top: f64, label: &str, steps: &[(f64, bool)], colour: &str| {
+        let y = |closed: bool| if closed { top + 80.0 } else { top };
+        for frac in [0.3, 0.7] {
+            let yy = top + 80.0 * frac;
+            let _ = writeln!(
+                svg,
+                r##"<line x1="{left}" x2="{}" y1="{yy}" y2="{yy}" stroke="#bbb" stroke-dasharray="4 3"/>"##,
+                w - right
+            );
+        }
+        let mut points = String::new();
+        let mut state = false;
+        let _ = write!(points, "{:.2},{:.2} ", x(start), y(state));
+        for &(t, closed) in steps {
+            let _ = write!(
+                points,
+                "{:.2},{:.2} {:.2},{:.2} ",
+                x(t),
+                y(state),
+                x(t),
+                y(closed)
+            );
+            state = closed;
+        }
+        let _ = write!(points, "{:.2},{:.2}", x(end), y(state));
+        let _ = writeln!(
+            svg,
+            r#"<polyline points="{points}" fill="none" stroke="{colour}" stroke-width="1.5"/>"#
+        );
+        let _ = writeln!(svg, r#"<text x="4" y="{}">{label}</text>"#, top + 45.0);
+    };
+    let measured_steps: Vec<(f64, bool)> = measured
+        .iter()
+        .map(|i| (i.start, i.state == ContactState::Closed))
+        .collect();
+    let model_steps: Vec<(f64, bool)> = model
+        .iter()
+        .map(|&(k, t)| (t, k == EventKind::Make))
+        .collect();
+    lane(&mut svg, 30.0, "measured", &measured_steps, "#1f77b4");
+    lane(&mut svg, 170.0, "fitted", &model_steps, "#d62728");
+    let _ = writeln!(
+        svg,
+        r#"<text x="{left}" y="{}">{start:.4e} s</text><text x="{}" y="{}" text-anchor="end">{end:.4e} s</text>"#,
+        h - 8.0,
+        w - right,
+        h - 8.0
+    );
+    svg.push_str("</svg>\n");
+    svg
+}

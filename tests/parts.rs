@@ -1,0 +1,83 @@
+//! Every bundled part reproduces the datasheet figures it was fitted to,
+//! carries the provenance of that fit, and `parts NAME -o FILE` writes a
+//! scenario that loads back.
+
+use assert_cmd::Command;
+use chatterspice::calibrate::fit::datasheet_figures;
+use chatterspice::calibrate::parts;
+use chatterspice::scenario::Scenario;
+
+#[test]
+fn there_are_six_parts_and_each_meets_its_datasheet() {
+    assert!(parts::all().len() >= 6);
+    for part in parts::all() {
+        let scenario = part.load().unwrap_or_else(|e| panic!("{}: {e}", part.name));
+        let d = scenario.datasheet.clone().expect("a [datasheet]");
+        let provenance = scenario.provenance.clone().expect("a [provenance]");
+        assert_eq!(provenance.fitted_to, "datasheet", "{}", part.name);
+        let printed = [
+            ("pick_up_voltage", d.pick_up_voltage, 0.01),
+            ("drop_out_voltage", d.drop_out_voltage, 0.01),
+            ("operate_time", d.operate_time, 0.02),
+            ("bounce_time", d.bounce_time, 0.02),
+        ];
+        let model = datasheet_figures(&scenario, &d);
+        let mut checked = 0;
+        for (name, target, tol) in printed {
+            let Some(target) = target else { continue };
+            let value = model
+                .iter()
+                .find(|(n, _)| *n == name)
+                .and_then(|(_, v)| *v)
+                .unwrap_or_else(|| panic!("{}: no model {name}", part.name));
+            assert!(
+                ((value - target) / target).abs() < tol,
+                "{}: {name} model {value}, datasheet {target}",
+                part.name
+            );
+            checked += 1;
+        }
+        assert!(checked >= 2, "{}: nothing checked", part.name);
+        // The fit moved the free keys away from the priors it started from.
+        for (key, p) in &provenance.parameters {
+            assert_eq!(
+                scenario.number(key).unwrap(),
+                Some(p.value),
+                "{}: {key}",
+                part.name
+            );
+        }
+    }
+}
+
+#[test]
+fn parts_writes_a_scenario_that_loads_and_never_overwrites() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("relay.toml");
+    Command::cargo_bin("chatterspice")
+        .unwrap()
+        .args(["parts", "panasonic-tq4-5v", "-o"])
+        .arg(&file)
+        .assert()
+        .success();
+    let scenario = Scenario::load(&file).expect("loads back");
+    assert!(scenario.coil.is_some());
+    Command::cargo_bin("chatterspice")
+        .unwrap()
+        .args(["parts", "panasonic-tq4-5v", "-o"])
+        .arg(&file)
+        .assert()
+        .code(2);
+    let listed: serde_json::Value = serde_json::from_slice(
+        &Command::cargo_bin("chatterspice")
+            .unwrap()
+            .args(["parts", "--format", "json"])
+            .output()
+            .unwrap()
+            .stdout,
+    )
+    .unwrap();
+    let first = &listed[0];
+    assert!(first["name"].is_string() && first["source"].is_string());
+    assert_eq!(first["datasheet"]["bounce_time"], "not given");
+}
