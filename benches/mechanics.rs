@@ -1,6 +1,6 @@
 //! The mechanics engine's speed: one whole chatter sequence per iteration.
 //!
-//! `cargo bench --bench mechanics`. Targets (issue 2): the model.md
+//! `cargo bench --bench mechanics`. Targets: the docs/model.md
 //! reference sequence (Kelvin–Voigt, 18 contacts) ≤ 5 µs median; a
 //! Hunt–Crossley sequence ≤ 50 µs.
 
@@ -37,7 +37,7 @@ fn reference() -> (Mechanics, Surface, Settings) {
 /// (0.2 g, 800 N/m, 0.45 mm travel) driven with 1 N onto a Hertzian
 /// Hunt–Crossley contact (n = 1.5, 1e9 N/m^1.5) with e = 0.8 at 0.3 m/s.
 /// First impact at 0.45 ms and 1.9 m/s, 11 contacts, stuck at 2.1 ms:
-/// the 1–5 ms bounce of a datasheet signal relay (model.md §6).
+/// the 1–5 ms bounce of a datasheet signal relay (docs/model.md §6).
 fn hunt_crossley() -> (Mechanics, Surface, Settings) {
     let (m, _, _) = reference();
     let m = Mechanics {

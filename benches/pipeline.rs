@@ -12,7 +12,7 @@
 //! - `pipeline/default_process`: `chatterspice run` as a user starts it,
 //!   ngspice included.
 //!
-//! The overhead target (issue 4) is the first at most 5 % of the second.
+//! The overhead target is the first at most 5 % of the second.
 //! Needs ngspice (once, to record the raw files, and for the process).
 
 use std::hint::black_box;

@@ -4,7 +4,7 @@
 //!
 //! - `sweep/mechanics_only`: `sweep::run` with the mechanics alone on one
 //!   thread, 10 000 samples of the default relay with three varied keys,
-//!   CSV rows and summary included (written to memory). Target (issue 5):
+//!   CSV rows and summary included (written to memory). Target:
 //!   ≥ 100 000 samples/s on one core.
 //! - `sweep/draw_values`, `sweep/set_numbers`, `sweep/simulate`: the parts
 //!   of one sample, to see where the time goes.

@@ -16,7 +16,7 @@
 //! stored as two points at one time) are accepted: nothing divides by a
 //! time step.
 //!
-//! # Schmitt edges (`interfaces.md` §3)
+//! # Schmitt edges (docs/output.md)
 //! A probe has two thresholds `low < high`. The level is **high** once the
 //! signal reaches `high` (v ≥ high) and stays so until it reaches `low`
 //! (v ≤ low), and the other way round: noise around one threshold does not
@@ -256,7 +256,7 @@ pub struct CurrentAnalysis {
 }
 
 /// Everything the analysis says about one probe. The first seven fields
-/// are the contract of `interfaces.md` §3, in its order; absent values are
+/// are the contract of docs/output.md, in its order; absent values are
 /// `null` in JSON, never omitted.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ProbeAnalysis {

@@ -2,12 +2,12 @@
 //!
 //! This is the engine's result and the contract every later stage reads
 //! (waveform, reports, checks). Field names match the JSON of
-//! `interfaces.md` §3. All values are SI; times are measured from t = 0,
+//! docs/output.md. All values are SI; times are measured from t = 0,
 //! the instant the closing force is applied.
 
 use serde::Serialize;
 
-/// How a chatter sequence ended (model.md §4).
+/// How a chatter sequence ended (docs/model.md §4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Outcome {

@@ -233,7 +233,7 @@ pub struct CheckArgs {
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum RunFormat {
-    /// The run JSON of interfaces.md §3, for scripts.
+    /// The run JSON of docs/output.md, for scripts.
     Json,
     /// A summary for people.
     Table,
@@ -302,7 +302,7 @@ pub enum RawFormat {
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum BounceFormat {
-    /// The JSON of interfaces.md §3, for scripts.
+    /// The JSON of docs/output.md, for scripts.
     Json,
     /// One row per impact, for spreadsheets.
     Csv,

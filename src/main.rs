@@ -11,7 +11,7 @@ use clap::Parser;
 /// Exit code for a `check` whose limits did not all hold.
 const EXIT_CHECK_FAILED: u8 = 1;
 
-/// Exit code for bad input or a failure to run (interfaces.md §2).
+/// Exit code for bad input or a failure to run (docs/output.md).
 const EXIT_FAILURE: u8 = 2;
 
 fn main() -> ExitCode {

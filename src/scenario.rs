@@ -1,5 +1,5 @@
 //! The scenario file: one TOML file that describes a relay, its contact
-//! surface and, optionally, the circuit it switches (`interfaces.md` §1).
+//! surface and, optionally, the circuit it switches (docs/scenario.md).
 //! Every command starts here.
 //!
 //! Loading has three steps, and every error names the file, the line when
@@ -41,7 +41,7 @@ const DEFAULT_SCENARIO_ORIGIN: &str =
 /// so that `run` with no scenario works wherever the binary is.
 pub const DEFAULT_NETLIST: &str = include_str!("../netlists/mcu_input.cir");
 
-/// `[mechanics]`: the moving contact (model.md §1). SI units.
+/// `[mechanics]`: the moving contact (docs/model.md §1). SI units.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MechanicsSection {
@@ -66,7 +66,7 @@ pub struct MechanicsSection {
     pub preload: f64,
 }
 
-/// `[coil]`: the magnetic drive of model.md §7, instead of a step force.
+/// `[coil]`: the magnetic drive of docs/model.md §7, instead of a step force.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CoilSection {
@@ -133,7 +133,7 @@ impl fmt::Display for SurfaceLaw {
     }
 }
 
-/// `[surface]` as written: one law and the keys it needs (model.md §2).
+/// `[surface]` as written: one law and the keys it needs (docs/model.md §2).
 /// The keys are all optional here because which ones are required depends
 /// on `law`; validation checks them and [`Scenario::surface`] gives the
 /// resolved law.
@@ -155,7 +155,7 @@ pub struct SurfaceSection {
     pub reference_velocity: Option<f64>,
 }
 
-/// `[contact]`: the contact as a resistor (model.md §5).
+/// `[contact]`: the contact as a resistor (docs/model.md §5).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ContactSection {
@@ -170,7 +170,7 @@ pub struct ContactSection {
     pub holm: Option<HolmSection>,
 }
 
-/// `[contact.holm]`: R = r_film + r_ref·(f_ref/F)^exponent (model.md §5).
+/// `[contact.holm]`: R = r_film + r_ref·(f_ref/F)^exponent (docs/model.md §5).
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct HolmSection {
@@ -490,7 +490,7 @@ pub enum ScenarioError {
         takes: &'static str,
     },
     #[error(
-        "{}: a coil-driven relay ([coil], model.md §7) is simulated only with its driver \
+        "{}: a coil-driven relay ([coil], docs/model.md §7) is simulated only with its driver \
          circuit, by `run` (the coil coupled to the netlist); for the mechanics alone \
          replace [coil] with `mechanics.force`, the closing force in N",
         path.display()
@@ -883,7 +883,7 @@ fn key_help(key: &str) -> &'static str {
             "the [coil] section needs resistance, turns, pole_area, air_gap, iron_gap"
         }
         k if k.starts_with("probe") => "each [[probe]] needs signal, low and high",
-        _ => "see interfaces.md §1 for the keys of each section",
+        _ => "see docs/scenario.md for the keys of each section",
     }
 }
 
@@ -1189,7 +1189,7 @@ impl Check<'_> {
             stiffness > 0.0,
             "must be > 0: the surface stiffness k, in N/mⁿ",
         )?;
-        // n = 1 is the paper's linear surface spring (model.md §2c).
+        // n = 1 is the paper's linear surface spring (docs/model.md §2c).
         let exponent = s.exponent.unwrap_or(1.0);
         self.number(
             &format!("{section}.exponent"),

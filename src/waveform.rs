@@ -1,4 +1,4 @@
-//! The contact as a time-varying conductance (model.md §5): the chatter
+//! The contact as a time-varying conductance (docs/model.md §5): the chatter
 //! sequence becomes a piecewise-linear list of (time, conductance) points
 //! that the netlist stage emits as an ngspice `PWL` source.
 //!
@@ -41,7 +41,7 @@
 //!
 //! # Force-dependent closed resistance (Holm)
 //! By default a closed contact has the constant resistance `r_closed`.
-//! With a [`Holm`] law (model.md §5) it follows the contact force F: the
+//! With a [`Holm`] law (docs/model.md §5) it follows the contact force F: the
 //! constriction resistance of the contact spots falls as the force presses
 //! them wider, R = R_film + R_ref·(F_ref/F)^m, with m = 1/2 for plastic and
 //! 1/3 for elastic spots (Holm, *Electric Contacts*), clamped to `r_open`

@@ -1,7 +1,7 @@
-//! The coupled coil–armature solvers (issue 6) against the reference case
-//! of model.md §7, closed forms, the limits in which they must become the
+//! The coupled coil–armature solvers against the reference case
+//! of docs/model.md §7, closed forms, the limits in which they must become the
 //! step-force engine, and conservation of energy. Each expected value is
-//! computed here from its formula or taken from model.md, independently of
+//! computed here from its formula or taken from docs/model.md, independently of
 //! the solvers.
 
 use chatterspice::coil::{Coil, CoilError, Source, simulate_direct, simulate_forced};
@@ -12,7 +12,7 @@ fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs().max(f64::MIN_POSITIVE)
 }
 
-/// The reference relay of model.md §7: 5 V onto a 70 Ω, 3000-turn coil.
+/// The reference relay of docs/model.md §7: 5 V onto a 70 Ω, 3000-turn coil.
 fn coil() -> Coil {
     Coil {
         resistance: 70.0,
@@ -74,7 +74,7 @@ fn reference_case_of_model_md() {
     assert!(rounds_to(make * 1e3, 3.8137, 1e-4), "first make {make}");
     let v = ev.make_velocity.unwrap();
     assert!(rounds_to(v, 0.3205, 1e-4), "make velocity {v}");
-    // model.md: "the coil current dipped to 12.8 mA (it would be ~38 mA
+    // docs/model.md: "the coil current dipped to 12.8 mA (it would be ~38 mA
     // with the armature held)". The current at the make is 12.887 mA, so
     // its "12.8" is truncated, not rounded.
     let i_make = ev.current_at_make.unwrap();
@@ -500,7 +500,7 @@ fn assert_same(a: &Chatter, b: &Chatter, time_tol: f64, tol: f64) {
     assert_eq!(a.intervals.len(), b.intervals.len());
 }
 
-/// The dimensionless relay of model.md §3 (m = s = 1, F = 1).
+/// The dimensionless relay of docs/model.md §3 (m = s = 1, F = 1).
 fn unit_relay(zeta: f64, k0: f64) -> Mechanics {
     Mechanics {
         mass: 1.0,
@@ -523,7 +523,7 @@ fn long() -> Settings {
 
 #[test]
 fn a_constant_force_reproduces_the_engine_kelvin_voigt() {
-    // model.md §3's reference sequence: 18 contacts, stuck.
+    // docs/model.md §3's reference sequence: 18 contacts, stuck.
     let m = unit_relay(0.05, 0.9);
     let s = Surface::KelvinVoigt {
         stiffness: 100.0,

@@ -1,6 +1,6 @@
 //! The coil in an ngspice circuit, coupled to the mechanics by waveform
 //! relaxation, against the direct solver of the same equations (no
-//! ngspice) on model.md §7's reference case.
+//! ngspice) on docs/model.md §7's reference case.
 //!
 //! Tests that need ngspice skip with a note when it is missing, and fail
 //! when `REQUIRE_NGSPICE=1` (CI sets it).

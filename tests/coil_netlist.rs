@@ -13,7 +13,7 @@ use chatterspice::rawfile::Vector;
 use chatterspice::scenario::CoilSection;
 use chatterspice::spice::{RunRequest, Runner};
 
-/// The coil of model.md §7's reference case.
+/// The coil of docs/model.md §7's reference case.
 const COIL: CoilSection = CoilSection {
     resistance: 70.0,
     turns: 3000,

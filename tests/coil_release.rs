@@ -1,6 +1,6 @@
 //! The release of a coil-driven relay in its driver circuit: the two
 //! example drivers, a plain flyback diode and a diode + zener clamp, run
-//! coupled over the whole cycle (issue 6).
+//! coupled over the whole cycle.
 //!
 //! Tests that need ngspice skip with a note when it is missing, and fail
 //! when `REQUIRE_NGSPICE=1` (CI sets it).

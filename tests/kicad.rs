@@ -58,7 +58,10 @@ fn the_exported_netlist_runs_as_the_walkthrough_says() {
     let scenario_path = example("relay.toml");
     let scenario = Scenario::load(&scenario_path).unwrap();
     let (long, all) = visible_openings(&scenario);
-    assert!(long > 0 && long < all, "{long} of {all}: the filter must matter");
+    assert!(
+        long > 0 && long < all,
+        "{long} of {all}: the filter must matter"
+    );
 
     let out = Command::cargo_bin("chatterspice")
         .unwrap()

@@ -1,4 +1,4 @@
-//! The engine against closed forms (model.md §3) and the paper's
+//! The engine against closed forms (docs/model.md §3) and the paper's
 //! conclusions 1–4. Each expected value is computed here from its formula,
 //! independently of the engine.
 
@@ -188,7 +188,7 @@ fn never_closes_reports_the_shortfall_and_ends_open_between_f_and_the_peak() {
     assert_eq!(c.bounce_count, c.impacts.len());
 }
 
-/// The release test of model.md §3, written from its formula: with
+/// The release test of docs/model.md §3, written from its formula: with
 /// y(τ) = e^(−στ)[−d cos ωτ + ((v − σd)/ω) sin ωτ], the contact releases iff
 /// the first swing y1 satisfies y1·exp(−πσ/ω) > d.
 fn releases_by_formula(v: f64, d: f64, beta: f64, sigma: f64) -> bool {

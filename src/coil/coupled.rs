@@ -7,7 +7,7 @@
 //! following its chatter, reads the coil's flux linkage ψ(t) back, and
 //! runs the mechanics under the magnetic pull it makes,
 //! F_m = ψ²/(2 μ0 N² A) ([`Coil::force_from_flux`]), which depends on the
-//! flux alone and not on where the armature is ([`simulate_forced_path`]).
+//! flux alone and not on where the armature is ([`super::simulate_forced_path`]).
 //! The new path goes into the next circuit run, after the coil and the
 //! mechanics have been settled against that run's coil voltage with no
 //! ngspice ([`super::accelerate`], unless `accelerate` is off): the same

@@ -2,9 +2,9 @@
 //! falls: pull-in and make-side chatter, the contact held closed, the
 //! release when the drive weakens, the return stroke and the bounce of
 //! the armature on its rest stop (the normally-closed contact), and so on
-//! for as many pulses as the drive gives (model.md §7, issue 6).
+//! for as many pulses as the drive gives (docs/model.md §7).
 //!
-//! [`super::sequence`] simulates one closing and ends when the contact has
+//! The closing engine (`coil::sequence`) simulates one closing and ends when the contact has
 //! stuck, on the understanding that the drive does not weaken afterwards.
 //! Here nothing ends before `t_end`: a stuck contact stays in its contact
 //! phase and releases by the same rule that ends every contact (the

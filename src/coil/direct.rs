@@ -1,9 +1,9 @@
 //! The direct solver: a coil switched onto an ideal voltage source at
-//! t = 0, with no circuit simulator (issue 6: the cross-check of the
+//! t = 0, with no circuit simulator (the cross-check of the
 //! coupled ngspice runs).
 //!
 //! One ODE in the flux linkage ψ, the position x and the velocity ẋ
-//! (model.md §7), with `R` the coil resistance plus any series resistance
+//! (docs/model.md §7), with `R` the coil resistance plus any series resistance
 //! and `a = g_a + l_eq`, `k = μ0 N² A`:
 //!
 //! ```text
@@ -165,7 +165,7 @@ impl CoilRun {
 
 /// Switch `coil` onto `source` at t = 0 with the armature of `mechanics`
 /// (whose `force` is ignored: the coil makes it) at rest on its stop, and
-/// simulate the closing to an ending of model.md §4.
+/// simulate the closing to an ending of docs/model.md §4.
 pub fn simulate_direct(
     coil: &Coil,
     source: &Source,

@@ -1,5 +1,5 @@
 //! The coil drives the contact: the relay's magnetic pull and its two-way
-//! coupling with the armature (model.md §7, issue 6).
+//! coupling with the armature (docs/model.md §7).
 //!
 //! The step force of [`crate::mechanics`] is really the pull of a coil.
 //! The magnetic circuit is the standard single-air-gap model (as in
@@ -25,7 +25,7 @@
 //! - [`direct`]: a coil switched onto an ideal voltage source, solved as
 //!   one ODE in (ψ, x, ẋ) with no circuit simulator: the independent
 //!   cross-check of the coupled ngspice runs, and the reference case of
-//!   model.md §7.
+//!   docs/model.md §7.
 //! - [`forced`]: the mechanics under a drive force that varies in time and
 //!   position, `F(t, x)`: what the waveform-relaxation coupling with
 //!   ngspice feeds with `F_m(i(t), x)`.
@@ -60,7 +60,7 @@ use crate::scenario::CoilSection;
 /// H/m, the vacuum permeability (CODATA 2018; 4π·10⁻⁷ to 6e-10).
 pub const MU0: f64 = 1.256_637_062_12e-6;
 
-/// The relay coil and its magnetic circuit (model.md §7). SI units.
+/// The relay coil and its magnetic circuit (docs/model.md §7). SI units.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Coil {
     /// Ω, the coil's DC resistance `R_c`.

@@ -654,7 +654,7 @@ impl<D: Drive> Sequence<'_, D> {
             };
             // The opening this flight made after a release: below
             // resolution, the contact is taken as closed from the last
-            // contact on (model.md §4).
+            // contact on (docs/model.md §4).
             if let (Some(t_rel), Some(last)) = (released, self.rec.impacts.last_mut()) {
                 let gap_opened = g - lowest;
                 last.max_gap_after = Some(gap_opened);

@@ -1,6 +1,6 @@
 //! The event-driven chatter engine.
 //!
-//! A closing alternates two phases until one of the endings of model.md §4:
+//! A closing alternates two phases until one of the endings of docs/model.md §4:
 //!
 //! 1. **flight** (contact open): closed-form [`LinearPiece`]; the next
 //!    impact is its first upward crossing of the gap, or there is none;
@@ -29,7 +29,7 @@ use super::{Mechanics, MechanicsError, Settings, Surface};
 use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome, bounces};
 
 /// Simulate one closing: the chatter sequence from t = 0 to an ending of
-/// model.md §4. Parameters are validated first; an invalid one is an
+/// docs/model.md §4. Parameters are validated first; an invalid one is an
 /// error naming its scenario key.
 pub fn simulate(
     mechanics: &Mechanics,
@@ -564,7 +564,7 @@ impl Law {
 }
 
 /// The critical (sticking) impact speed v_c (m/s): impacts slower than
-/// this never release (model.md §3, paper §3.5). Zero when the contact
+/// this never release (docs/model.md §3, paper §3.5). Zero when the contact
 /// always releases (k0 ≥ 1, or a rigid surface with e > 0); infinite for a
 /// rigid surface with e = 0 and overtravel. Found by bisection on "does
 /// this impact release", to `rel_tol` relative.

@@ -1,5 +1,5 @@
 //! The contact force over time, for the force-dependent (Holm) contact
-//! resistance of the waveform stage (model.md §5).
+//! resistance of the waveform stage (docs/model.md §5).
 //!
 //! The engine reports each contact's peak and minimum force; the waveform
 //! needs the force at arbitrary instants inside the closures. Each contact

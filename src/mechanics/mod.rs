@@ -3,7 +3,7 @@
 //! The moving contact is a damped one-degree-of-freedom oscillator
 //! `m ẍ + r ẋ + s x = f − p` pushed toward a fixed contact at `x = g`
 //! (Uchikoshi, Azuma & Kikuchi, "Rebound characteristics of the equivalent
-//! stiffness surface", 1973; `shared/spec/model.md`). What happens at
+//! stiffness surface", 1973; docs/model.md). What happens at
 //! `x ≥ g` is the surface law ([`Surface`]).
 //!
 //! The engine is event-driven. Between events the motion is one of:
@@ -39,7 +39,7 @@ pub use surface::Surface;
 
 use thiserror::Error;
 
-/// The moving contact and its drive (model.md §1). SI units.
+/// The moving contact and its drive (docs/model.md §1). SI units.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Mechanics {
     /// kg, effective moving mass `m`.
@@ -61,7 +61,7 @@ pub struct Mechanics {
     pub preload: f64,
 }
 
-/// When to stop and what is too small to matter (model.md §4).
+/// When to stop and what is too small to matter (docs/model.md §4).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Settings {
     /// s, the simulated horizon.
@@ -84,7 +84,7 @@ impl Default for Settings {
     }
 }
 
-/// The paper's dimensionless groups (model.md §1–2).
+/// The paper's dimensionless groups (docs/model.md §1–2).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Dimensionless {
     /// rad/s, ωn = √(s/m); dimensionless time is τ = ωn t.

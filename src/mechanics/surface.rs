@@ -1,5 +1,5 @@
 //! Surface laws: what the fixed contact does once it is touched
-//! (model.md §2). Let δ = x − g ≥ 0 be the penetration and Fc the force of
+//! (docs/model.md §2). Let δ = x − g ≥ 0 be the penetration and Fc the force of
 //! the fixed contact on the moving one (positive pushes it back).
 
 /// The fixed contact's surface law.

@@ -1,5 +1,5 @@
 //! The coil include: `.subckt COIL a b`, the relay coil as the user's
-//! driver sees it (model.md §7). The winding resistance R_c is in series
+//! driver sees it (docs/model.md §7). The winding resistance R_c is in series
 //! with a flux linkage ψ = L(x)·i whose inductance follows the armature,
 //! L(x) = μ0 N² A / (g_a − x + l_eq).
 //!

@@ -1,6 +1,6 @@
 //! The impacts as CSV: one row per impact, for spreadsheets and plots.
 //!
-//! The header is the impact field names of the JSON (`interfaces.md` §3),
+//! The header is the impact field names of the JSON (docs/output.md),
 //! in the same order; an absent value (the release of the final, stuck
 //! contact) is an empty cell. Only the impacts are here: the summary
 //! (outcome, settle time) and the open/closed `intervals` are in the JSON.

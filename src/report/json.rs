@@ -1,4 +1,4 @@
-//! The bounce result as JSON: the contract of `interfaces.md` §3.
+//! The bounce result as JSON: the contract of docs/output.md.
 //!
 //! The contract's fields come first and in its order (`outcome`,
 //! `first_impact`, `settle_time`, `bounce_count`, `impacts`, `intervals`),
@@ -36,7 +36,7 @@ impl<'a> BounceJson<'a> {
     }
 }
 
-/// [`Dimensionless`] under the names of model.md §1–3.
+/// [`Dimensionless`] under the names of docs/model.md §1–3.
 #[derive(Debug, Serialize)]
 struct DimensionlessJson {
     omega_n: f64,

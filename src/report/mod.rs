@@ -2,7 +2,7 @@
 //!
 //! One small module per format, each a pure function from the result to a
 //! `String`:
-//! - [`json`]: the contract of `interfaces.md` §3, for scripts;
+//! - [`json`]: the contract of docs/output.md, for scripts;
 //! - [`csv`]: one row per impact, for spreadsheets and plotting;
 //! - [`table`]: a summary and an aligned impact table, for a person at a
 //!   terminal, in engineering units;
