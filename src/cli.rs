@@ -16,6 +16,7 @@ use std::time::Duration;
 
 mod calibrate;
 
+use chatterspice::chatter::Chatter;
 use chatterspice::check;
 use chatterspice::coil::CouplingOptions;
 use chatterspice::mechanics::Dimensionless;
@@ -109,6 +110,11 @@ pub struct BounceArgs {
     /// Replace FILE if it already exists.
     #[arg(long, requires = "output")]
     pub force: bool,
+
+    /// Report a measured chatter sequence instead of simulating one: a CSV
+    /// `time,state` with one row per state change (open/closed or 0/1).
+    #[arg(long, value_name = "CSV")]
+    pub measured: Option<PathBuf>,
 }
 
 #[derive(Debug, Args)]
@@ -322,6 +328,13 @@ impl From<BounceFormat> for Format {
 
 fn bounce(args: &BounceArgs) -> Result<()> {
     refuse_existing(args.output.as_deref(), args.force)?;
+    if let Some(csv) = &args.measured {
+        let text = std::fs::read_to_string(csv)
+            .with_context(|| format!("{}: cannot read the measured chatter", csv.display()))?;
+        let chatter = Chatter::from_intervals(read_state_csv(&text, csv)?);
+        let text = report::render(args.format.into(), &chatter, None);
+        return emit(&text, args.output.as_deref(), args.force);
+    }
     let scenario = load_scenario(args.scenario.as_deref())?;
     let mechanics = scenario.mechanics()?;
     let surface = scenario.surface();

@@ -393,3 +393,43 @@ fn usage_errors_exit_2_and_help_exits_0() {
         .success()
         .stdout(predicate::str::contains("--format"));
 }
+
+#[test]
+fn bounce_reports_a_measured_chatter_sequence() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("scope.csv");
+    // Two openings after the first make, then closed for good.
+    let (make, settle) = (1.0e-3, 1.5e-3);
+    std::fs::write(
+        &csv,
+        format!("time,state\n0,open\n{make},closed\n1.1e-3,open\n1.2e-3,closed\n1.3e-3,open\n{settle},closed\n5e-3,closed\n"),
+    )
+    .unwrap();
+    let out = Command::cargo_bin("chatterspice")
+        .unwrap()
+        .args(["bounce", "--format", "json", "--measured"])
+        .arg(&csv)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["bounce_count"], 2);
+    assert_eq!(v["first_impact"].as_f64().unwrap(), make);
+    assert_eq!(v["settle_time"].as_f64().unwrap(), settle);
+
+    // A broken row is exit 2 naming the file and the line.
+    std::fs::write(&csv, "time,state\n0,open\nnope,closed\n").unwrap();
+    let out = Command::cargo_bin("chatterspice")
+        .unwrap()
+        .args(["bounce", "--measured"])
+        .arg(&csv)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("scope.csv") && err.contains('3'), "{err}");
+}
