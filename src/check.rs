@@ -28,7 +28,7 @@ use serde::Serialize;
 use thiserror::Error;
 
 use crate::analysis::ProbeAnalysis;
-use crate::chatter::Chatter;
+use crate::chatter::{Chatter, Interval};
 use crate::coil::Operation;
 use crate::mechanics::{MechanicsError, simulate};
 use crate::pipeline::{self, RunError, RunOptions, RunResult};
@@ -421,6 +421,36 @@ pub fn run_with(
         return Ok((evaluate(scenario, &result), Evidence::Run(Box::new(result))));
     }
     relay_only(scenario)
+}
+
+/// Check `scenario` against a measured chatter sequence (a scope record)
+/// instead of its mechanics: the `[limits]` on the record alone, and, when
+/// a probe has a limit and a `runner` is given, the record switching the
+/// circuit through it (without a runner the probe limits are not looked at).
+pub fn measured(
+    scenario: &Scenario,
+    intervals: Vec<Interval>,
+    runner: Option<&dyn Runner>,
+    options: &RunOptions,
+) -> Result<(Verdict, Evidence), CheckError> {
+    let probe_limits = scenario.probes.iter().any(Probe::has_limits);
+    if scenario.limits.is_none() && !probe_limits {
+        return Err(CheckError::NoLimits {
+            path: scenario.origin.clone(),
+        });
+    }
+    if let (true, Some(runner)) = (probe_limits, runner) {
+        let result =
+            pipeline::run_measured(scenario, intervals, runner, options).map_err(Box::new)?;
+        return Ok((evaluate(scenario, &result), Evidence::Run(Box::new(result))));
+    }
+    let chatter = Chatter::from_intervals(intervals);
+    let checks = scenario
+        .limits
+        .as_ref()
+        .map(|l| relay_checks(l, &chatter, &[]))
+        .unwrap_or_default();
+    Ok((Verdict::new(checks), Evidence::Mechanics(chatter)))
 }
 
 /// The `[limits]` of `scenario` on the mechanics alone, without ngspice;

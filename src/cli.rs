@@ -235,6 +235,11 @@ pub struct CheckArgs {
 
     #[command(flatten)]
     pub simulator: SimulatorArgs,
+
+    /// Check a measured chatter sequence instead of the mechanics: a CSV
+    /// `time,state` with one row per state change (open/closed or 0/1).
+    #[arg(long, value_name = "CSV")]
+    pub measured: Option<PathBuf>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -407,7 +412,18 @@ fn check(args: &CheckArgs) -> Result<Status> {
     let scenario = load_scenario(args.scenario.as_deref())?;
     let needs_ngspice = scenario.coil.is_some() || scenario.probes.iter().any(|p| p.has_limits());
     let options = args.simulator.run_options();
-    let (verdict, evidence) = if needs_ngspice {
+    let (verdict, evidence) = if let Some(csv) = &args.measured {
+        let text = std::fs::read_to_string(csv)
+            .with_context(|| format!("{}: cannot read the measured chatter", csv.display()))?;
+        let intervals = read_state_csv(&text, csv)?;
+        let probe_limits = scenario.probes.iter().any(|p| p.has_limits());
+        if probe_limits {
+            let ngspice = Ngspice::locate(args.simulator.ngspice.as_deref())?;
+            check::measured(&scenario, intervals, Some(&ngspice), &options)?
+        } else {
+            check::measured(&scenario, intervals, None, &options)?
+        }
+    } else if needs_ngspice {
         let ngspice = Ngspice::locate(args.simulator.ngspice.as_deref())?;
         check::run_with(&scenario, &ngspice, &options)?
     } else {

@@ -193,3 +193,46 @@ fn a_coil_driven_relay_is_checked_through_its_driver() {
     assert!(make > 1e-3, "{make}");
     assert!(v["run"]["coupling"].as_array().unwrap().len() >= 2);
 }
+
+/// `check --measured`: the limits are held against the record, not the
+/// model; a bare pull-up sees one edge per state change of the record.
+#[test]
+fn a_measured_record_is_checked_instead_of_the_mechanics() {
+    let _ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    // The model bounces 5 times; the record only once.
+    let path = scenario(dir.path(), "max_edges = 3", "max_bounces = 1");
+    let csv = dir.path().join("scope.csv");
+    std::fs::write(
+        &csv,
+        "time,state\n0,open\n1e-3,closed\n1.1e-3,open\n1.2e-3,closed\n5e-3,closed\n",
+    )
+    .unwrap();
+    let with = |csv: &Path, code: i32| -> Value {
+        let out = chatterspice()
+            .args([
+                "check",
+                path.to_str().unwrap(),
+                "--format",
+                "json",
+                "--measured",
+            ])
+            .arg(csv)
+            .assert()
+            .code(code);
+        serde_json::from_slice(&out.get_output().stdout).unwrap()
+    };
+    let v = with(&csv, 0);
+    assert_eq!(v["passed"], true, "{v}");
+    // Without the record the model's 5 bounces fail both limits.
+    let v = check_json(&path, 1);
+    assert_eq!(v["passed"], false, "{v}");
+    // A record with two openings fails them too.
+    std::fs::write(
+        &csv,
+        "time,state\n0,open\n1e-3,closed\n1.1e-3,open\n1.2e-3,closed\n1.3e-3,open\n1.4e-3,closed\n5e-3,closed\n",
+    )
+    .unwrap();
+    let v = with(&csv, 1);
+    assert_eq!(v["passed"], false, "{v}");
+}
