@@ -409,18 +409,24 @@ pub fn run_with(
     runner: &dyn Runner,
     options: &RunOptions,
 ) -> Result<(Verdict, Evidence), CheckError> {
-    let probe_limits = scenario.probes.iter().any(Probe::has_limits);
-    if scenario.limits.is_none() && !probe_limits {
-        return Err(CheckError::NoLimits {
-            path: scenario.origin.clone(),
-        });
-    }
+    let probe_limits = limits_to_hold(scenario)?;
     // A coil-driven relay moves only in its driver circuit.
     if probe_limits || scenario.coil.is_some() {
         let result = pipeline::run(scenario, runner, options).map_err(Box::new)?;
         return Ok((evaluate(scenario, &result), Evidence::Run(Box::new(result))));
     }
     relay_only(scenario)
+}
+
+/// Whether a probe has a limit; an error when nothing at all is limited.
+fn limits_to_hold(scenario: &Scenario) -> Result<bool, CheckError> {
+    let probe_limits = scenario.probes.iter().any(Probe::has_limits);
+    if scenario.limits.is_none() && !probe_limits {
+        return Err(CheckError::NoLimits {
+            path: scenario.origin.clone(),
+        });
+    }
+    Ok(probe_limits)
 }
 
 /// Check `scenario` against a measured chatter sequence (a scope record)
@@ -433,12 +439,7 @@ pub fn measured(
     runner: Option<&dyn Runner>,
     options: &RunOptions,
 ) -> Result<(Verdict, Evidence), CheckError> {
-    let probe_limits = scenario.probes.iter().any(Probe::has_limits);
-    if scenario.limits.is_none() && !probe_limits {
-        return Err(CheckError::NoLimits {
-            path: scenario.origin.clone(),
-        });
-    }
+    let probe_limits = limits_to_hold(scenario)?;
     if let (true, Some(runner)) = (probe_limits, runner) {
         let result =
             pipeline::run_measured(scenario, intervals, runner, options).map_err(Box::new)?;

@@ -334,9 +334,7 @@ impl From<BounceFormat> for Format {
 fn bounce(args: &BounceArgs) -> Result<()> {
     refuse_existing(args.output.as_deref(), args.force)?;
     if let Some(csv) = &args.measured {
-        let text = std::fs::read_to_string(csv)
-            .with_context(|| format!("{}: cannot read the measured chatter", csv.display()))?;
-        let chatter = Chatter::from_intervals(read_state_csv(&text, csv)?);
+        let chatter = Chatter::from_intervals(read_measured(csv)?);
         let text = report::render(args.format.into(), &chatter, None);
         return emit(&text, args.output.as_deref(), args.force);
     }
@@ -366,12 +364,7 @@ fn run(args: &RunArgs) -> Result<()> {
         ..args.simulator.run_options()
     };
     let mut result = match &args.measured {
-        Some(csv) => {
-            let text = std::fs::read_to_string(csv)
-                .with_context(|| format!("{}: cannot read the measured chatter", csv.display()))?;
-            let intervals = read_state_csv(&text, csv)?;
-            pipeline::run_measured(&scenario, intervals, &ngspice, &options)?
-        }
+        Some(csv) => pipeline::run_measured(&scenario, read_measured(csv)?, &ngspice, &options)?,
         None => pipeline::run(&scenario, &ngspice, &options)?,
     };
     // Shown relative to where the user is, when it is below it.
@@ -413,9 +406,7 @@ fn check(args: &CheckArgs) -> Result<Status> {
     let needs_ngspice = scenario.coil.is_some() || scenario.probes.iter().any(|p| p.has_limits());
     let options = args.simulator.run_options();
     let (verdict, evidence) = if let Some(csv) = &args.measured {
-        let text = std::fs::read_to_string(csv)
-            .with_context(|| format!("{}: cannot read the measured chatter", csv.display()))?;
-        let intervals = read_state_csv(&text, csv)?;
+        let intervals = read_measured(csv)?;
         let probe_limits = scenario.probes.iter().any(|p| p.has_limits());
         if probe_limits {
             let ngspice = Ngspice::locate(args.simulator.ngspice.as_deref())?;
@@ -444,6 +435,13 @@ fn check(args: &CheckArgs) -> Result<Status> {
     } else {
         Status::CheckFailed
     })
+}
+
+/// A measured chatter record (`--measured CSV`): its open/closed intervals.
+fn read_measured(csv: &Path) -> Result<Vec<chatterspice::chatter::Interval>> {
+    let text = std::fs::read_to_string(csv)
+        .with_context(|| format!("{}: cannot read the measured chatter", csv.display()))?;
+    Ok(read_state_csv(&text, csv)?)
 }
 
 /// A PNG drawn without a font has no text: say how to get one.
