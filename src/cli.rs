@@ -387,10 +387,8 @@ fn run(args: &RunArgs) -> Result<()> {
         RunFormat::Json => report::json::render_run(&result, dimensionless.as_ref()),
         RunFormat::Table => report::table::render_run(&result),
     };
-    if args.format == RunFormat::Json {
-        for warning in &result.warnings {
-            eprintln!("warning: {warning}");
-        }
+    for warning in &result.warnings {
+        eprintln!("warning: {warning}");
     }
     if let Some(dir) = &args.out {
         let files = report::bundle::run_files(&result, dimensionless.as_ref())

@@ -411,3 +411,46 @@ fn a_coupling_that_does_not_converge_in_the_passes_allowed_is_exit_2() {
         .code(2)
         .stderr(predicate::str::contains("--coupling-tolerance"));
 }
+
+/// Warnings (here: a `.control` block left out) go to stderr in every
+/// format, so that a table or JSON on stdout stays clean.
+#[test]
+fn warnings_go_to_stderr_not_into_the_table() {
+    let _ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    let netlist = dir.path().join("interactive.cir");
+    std::fs::write(
+        &netlist,
+        "written for interactive use\nV1 vdd 0 DC 3.3\nR1 vdd in 10k\nX1 in 0 CONTACT\n.tran 1u 5m\n.control\nrun\nplot v(in)\n.endc\n.end\n",
+    )
+    .unwrap();
+    let cut = chatterspice::scenario::DEFAULT_SCENARIO_TOML
+        .find("[circuit]")
+        .unwrap();
+    let scenario = dir.path().join("relay.toml");
+    std::fs::write(
+        &scenario,
+        format!(
+            "{}[circuit]\nnetlist = {:?}\n\n[[probe]]\nsignal = \"v(in)\"\nlow = 0.99\nhigh = 2.31\n",
+            &chatterspice::scenario::DEFAULT_SCENARIO_TOML[..cut],
+            netlist.display().to_string()
+        ),
+    )
+    .unwrap();
+    for format in ["table", "json"] {
+        let out = chatterspice()
+            .args(["run", "--format", format])
+            .arg(&scenario)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!stdout.contains("warning:"), "{format}: {stdout}");
+        assert!(stderr.contains(".control"), "{format}: {stderr}");
+    }
+}

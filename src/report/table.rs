@@ -236,9 +236,7 @@ pub fn render_run(run: &RunResult) -> String {
             out.push_str(&align(&rows, 1));
         }
     }
-    for warning in &run.warnings {
-        let _ = writeln!(out, "warning: {warning}");
-    }
+    // Warnings are not part of the table: the CLI prints them on stderr.
     out
 }
 
