@@ -34,7 +34,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     }
 
     println!(
-        "| driver | first make | operate | bounces | release | NC make | NC bounces | NC bounce time | iterations |"
+        "| driver | operate | closed for good | bounces | release | NC make | NC bounces | NC bounce time | iterations |"
     );
     println!("|---|---|---|---|---|---|---|---|---|");
     let ms = |t: Option<f64>| t.map_or_else(|| "-".to_owned(), |t| format!("{:.3} ms", t * 1e3));
@@ -42,8 +42,8 @@ fn main() -> Result<(), Box<dyn Error>> {
         for op in &run.operations {
             println!(
                 "| {label} | {} | {} | {} | {} | {} | {} | {} | {} |",
-                ms(op.first_make_time),
                 ms(op.operate_time),
+                ms(op.settle_time),
                 op.stroke.bounces,
                 ms(op.release_time),
                 ms(op.nc_make_time),

@@ -425,7 +425,9 @@ fn check(args: &CheckArgs) -> Result<Status> {
         .map(|m| Dimensionless::of(&m, &scenario.surface()));
     let text = match args.format {
         RunFormat::Json => report::json::render_check(&verdict, &evidence, dimensionless.as_ref()),
-        RunFormat::Table => report::table::render_check(&verdict, evidence.chatter()),
+        RunFormat::Table => {
+            report::table::render_check(&verdict, evidence.chatter(), evidence.operations())
+        }
     };
     emit(&text, None, false)?;
     Ok(if verdict.passed {

@@ -327,10 +327,14 @@ pub struct LimitsSection {
     pub max_bounce_time: Option<f64>,
     /// Most bounces (openings after the first impact).
     pub max_bounces: Option<u64>,
-    /// s, the settle time: from the force step to closed for good.
+    /// s, the operate time as datasheets define it: from the coil being
+    /// energized (or the force step) to the first make, bounce excluded.
     pub max_operate_time: Option<f64>,
-    /// s, the first impact (first make).
+    /// s, the same figure as `max_operate_time` (its older name).
     pub max_first_make: Option<f64>,
+    /// s, from the coil being energized (or the force step) to closed for
+    /// good: operate plus bounce time.
+    pub max_settle_time: Option<f64>,
     /// s, coil off → the NO contact's break, in every operation (a
     /// coil-driven relay only).
     pub max_release_time: Option<f64>,
@@ -1431,17 +1435,22 @@ impl Check<'_> {
             (
                 "limits.max_bounce_time",
                 l.max_bounce_time,
-                "the longest bounce time allowed (settle − first impact), in s",
+                "the longest bounce time allowed (first make → closed for good), in s",
             ),
             (
                 "limits.max_operate_time",
                 l.max_operate_time,
-                "the latest settle time allowed, in s",
+                "the longest operate time allowed (coil on → first make), in s",
             ),
             (
                 "limits.max_first_make",
                 l.max_first_make,
-                "the latest first impact allowed, in s",
+                "the longest operate time allowed (coil on → first make), in s",
+            ),
+            (
+                "limits.max_settle_time",
+                l.max_settle_time,
+                "the longest time allowed from coil on to closed for good, in s",
             ),
             (
                 "limits.max_release_time",

@@ -50,7 +50,7 @@ pub use direct::{
     CoilEvents, CoilRun, CoilState, EnergyBalance, PullInDip, Source, simulate_direct,
 };
 pub use forced::{simulate_cycle, simulate_forced, simulate_forced_path};
-pub use timing::{Operation, Switching, operations};
+pub use timing::{Closing, Operation, Switching, operations};
 
 use thiserror::Error;
 

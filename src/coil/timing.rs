@@ -1,9 +1,11 @@
 //! Relay timing as datasheets state it, from the strokes of a simulated
 //! cycle and the instants the driver switched the coil on and off.
 //!
-//! - **operate time**: coil on → the NO contact closed for good (its last
-//!   make), bounce included; **first make**: coil on → its first touch;
-//! - **bounce time**: first make → last make;
+//! - **operate time**: coil on → the NO contact's first make (bounce
+//!   excluded, as IEC 61810-1 defines it); `first_make_time` is the same
+//!   figure under its older name;
+//! - **bounce time**: first make → last make (closed for good);
+//! - **settle time**: coil on → closed for good, operate plus bounce;
 //! - **release time**: coil off → the NO contact breaks for good;
 //! - **NC make** and **NC bounce time**: coil off → the armature's first
 //!   touch of its rest stop (the normally-closed contact), and from there
@@ -20,6 +22,7 @@
 use serde::Serialize;
 
 use super::cycle::Stroke;
+use crate::chatter::Chatter;
 
 /// The instants the coil was switched, in s.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
@@ -102,18 +105,69 @@ pub struct Operation {
     pub coil_off: Option<f64>,
     #[serde(flatten)]
     pub stroke: Stroke,
-    /// s, coil on → first make.
-    pub first_make_time: Option<f64>,
-    /// s, coil on → last make (closed for good).
+    /// s, coil on → first make: the operate time.
     pub operate_time: Option<f64>,
+    /// s, the same as `operate_time` (its older name).
+    pub first_make_time: Option<f64>,
     /// s, first make → last make.
     pub bounce_time: Option<f64>,
+    /// s, coil on → last make (closed for good).
+    pub settle_time: Option<f64>,
     /// s, coil off → the NO contact's break.
     pub release_time: Option<f64>,
     /// s, coil off → the first touch of the rest stop (NC make).
     pub nc_make_time: Option<f64>,
     /// s, first → last touch of the rest stop.
     pub nc_bounce_time: Option<f64>,
+}
+
+/// A closing's times as datasheets define them, from t = 0 of the
+/// operation: the moment the coil was energized or, without a coil, the
+/// force step (t = 0 of the simulation).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Closing {
+    /// s, the operation's t = 0 in simulation time.
+    pub origin: f64,
+    /// s, t = 0 → first make (bounce excluded).
+    pub operate_time: Option<f64>,
+    /// s, first make → closed for good.
+    pub bounce_time: Option<f64>,
+    /// s, t = 0 → closed for good.
+    pub settle_time: Option<f64>,
+}
+
+impl Closing {
+    /// The first closing of `chatter`, timed from the first operation's
+    /// coil-on when there is one, else from t = 0.
+    pub fn first(chatter: &Chatter, operations: &[Operation]) -> Closing {
+        let origin = operations.first().and_then(|op| op.coil_on).unwrap_or(0.0);
+        Closing {
+            origin,
+            operate_time: chatter.first_impact.map(|t| t - origin),
+            bounce_time: chatter
+                .first_impact
+                .zip(chatter.settle_time)
+                .map(|(first, settle)| settle - first),
+            settle_time: chatter.settle_time.map(|t| t - origin),
+        }
+    }
+
+    /// Every closing: one per operation of a coil-driven relay (each from
+    /// its own coil-on), or the chatter's one from t = 0.
+    pub fn all(chatter: &Chatter, operations: &[Operation]) -> Vec<Closing> {
+        if operations.is_empty() {
+            return vec![Closing::first(chatter, operations)];
+        }
+        operations
+            .iter()
+            .map(|op| Closing {
+                origin: op.coil_on.unwrap_or(op.stroke.lift_off),
+                operate_time: op.operate_time,
+                bounce_time: op.bounce_time,
+                settle_time: op.settle_time,
+            })
+            .collect()
+    }
 }
 
 /// Pair every stroke with the coil switching around it.
@@ -140,9 +194,10 @@ pub fn operations(strokes: &[Stroke], switching: &Switching) -> Vec<Operation> {
             Operation {
                 coil_on,
                 coil_off,
+                operate_time: since(coil_on, stroke.first_make),
                 first_make_time: since(coil_on, stroke.first_make),
-                operate_time: since(coil_on, stroke.last_make),
                 bounce_time: stroke.bounce_time(),
+                settle_time: since(coil_on, stroke.last_make),
                 release_time: since(coil_off, stroke.break_time),
                 nc_make_time: since(coil_off, stroke.back_make),
                 nc_bounce_time: stroke.back_bounce_time(),
@@ -211,8 +266,9 @@ mod tests {
             .try_into()
             .unwrap();
         let close = |a: Option<f64>, b: f64| (a.unwrap() - b).abs() < 1e-15;
+        assert!(close(op.operate_time, 3.9e-3));
         assert!(close(op.first_make_time, 3.9e-3));
-        assert!(close(op.operate_time, 4.9e-3));
+        assert!(close(op.settle_time, 4.9e-3));
         assert!(close(op.bounce_time, 1e-3));
         assert!(close(op.release_time, 1e-3));
         assert!(close(op.nc_make_time, 3e-3));

@@ -12,8 +12,8 @@ use serde::Serialize;
 use crate::analysis::{Comparison, ProbeAnalysis};
 use crate::chatter::Chatter;
 use crate::check::{Evidence, Verdict};
-use crate::coil::Operation;
 use crate::coil::coupled::Iteration;
+use crate::coil::{Closing, Operation};
 use crate::mechanics::Dimensionless;
 use crate::pipeline::{RunResult, Simulation};
 
@@ -93,6 +93,9 @@ pub struct RunJson<'a> {
     /// Each closing and release of a coil-driven relay, with its timing.
     #[serde(skip_serializing_if = "<[_]>::is_empty")]
     operations: &'a [Operation],
+    /// The first closing's operate, bounce and settle time, from the
+    /// coil being energized (or the force step).
+    timing: Closing,
 }
 
 /// One probe: the contract's fields (flattened from the analysis), then
@@ -163,6 +166,7 @@ impl<'a> RunJson<'a> {
             warnings: &run.warnings,
             coupling: run.coupling.as_deref(),
             operations: &run.operations,
+            timing: Closing::first(&run.chatter, &run.operations),
         }
     }
 }
@@ -175,6 +179,8 @@ pub struct CheckJson<'a> {
     #[serde(flatten)]
     verdict: &'a Verdict,
     bounce: BounceJson<'a>,
+    /// The first closing's times, from the coil being energized.
+    timing: Closing,
     run: Option<RunJson<'a>>,
 }
 
@@ -187,6 +193,7 @@ pub fn render_check(
     let doc = CheckJson {
         verdict,
         bounce: BounceJson::new(evidence.chatter(), dimensionless),
+        timing: Closing::first(evidence.chatter(), evidence.operations()),
         run: match evidence {
             Evidence::Run(run) => Some(RunJson::new(run, dimensionless)),
             Evidence::Mechanics(_) => None,

@@ -12,7 +12,7 @@ use super::units::engineering;
 use crate::analysis::ProbeAnalysis;
 use crate::chatter::{Chatter, Impact, Outcome};
 use crate::check::{Bound, Verdict, quantity};
-use crate::coil::Operation;
+use crate::coil::{Closing, Operation};
 use crate::pipeline::RunResult;
 
 /// Summary and impact table, `\n`-terminated.
@@ -79,16 +79,18 @@ pub fn render(chatter: &Chatter) -> String {
 pub fn render_run(run: &RunResult) -> String {
     let mut out = String::new();
     let c = &run.chatter;
-    let relay = match (c.first_impact, c.settle_time) {
-        (Some(first), Some(settle)) => format!(
-            "{} bounce{}, {} ({}); first make {}, settled {} (bounce time {})",
+    let closing = Closing::first(c, &run.operations);
+    let relay = match (closing.operate_time, closing.settle_time) {
+        (Some(operate), Some(settle)) => format!(
+            "{} bounce{}, {} ({}); operate {}, bounce time {}, closed for good {}{}",
             c.bounce_count,
             if c.bounce_count == 1 { "" } else { "s" },
             c.outcome,
             explain(c.outcome),
-            ms(Some(first)),
+            ms(Some(operate)),
+            ms(Some(settle - operate)),
             ms(Some(settle)),
-            ms(Some(settle - first)),
+            from_coil_on(&closing),
         ),
         _ => format!(
             "{} ({}), {} bounces",
@@ -242,7 +244,7 @@ pub fn render_run(run: &RunResult) -> String {
 
 /// A check for a person: the verdict, the relay in one line, then one row
 /// per limit with its margin, failures marked.
-pub fn render_check(verdict: &Verdict, chatter: &Chatter) -> String {
+pub fn render_check(verdict: &Verdict, chatter: &Chatter, operations: &[Operation]) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
@@ -251,13 +253,16 @@ pub fn render_check(verdict: &Verdict, chatter: &Chatter) -> String {
         verdict.failed,
         verdict.checks.len()
     );
+    let closing = Closing::first(chatter, operations);
     let _ = writeln!(
         out,
-        "relay: {}, {} bounces, first make {}, settled {}",
+        "relay: {}, {} bounces, operate {}, bounce time {}, closed for good {}{}",
         chatter.outcome,
         chatter.bounce_count,
-        ms(chatter.first_impact),
-        ms(chatter.settle_time)
+        ms(closing.operate_time),
+        ms(closing.bounce_time),
+        ms(closing.settle_time),
+        from_coil_on(&closing),
     );
     out.push('\n');
     let mut rows =
@@ -397,6 +402,15 @@ fn sig(value: Option<f64>, unit: &str) -> String {
     format!("{v:.decimals$}{unit}")
 }
 
+/// Where the times of a closing count from, when not t = 0.
+fn from_coil_on(closing: &Closing) -> String {
+    if closing.origin == 0.0 {
+        String::new()
+    } else {
+        format!(" (from coil on at {})", ms(Some(closing.origin)))
+    }
+}
+
 /// One operation of a coil-driven relay: what the coil did and how the
 /// contacts answered, times from the coil's switching.
 fn operation_line(number: usize, op: &Operation) -> String {
@@ -406,11 +420,11 @@ fn operation_line(number: usize, op: &Operation) -> String {
     if s.first_make.is_some() {
         let _ = write!(
             line,
-            ", first make +{}, operate +{} ({} bounces in {})",
-            time(op.first_make_time),
+            ", operate +{}, {} bounces in {}, closed for good +{}",
             time(op.operate_time),
             s.bounces,
-            time(op.bounce_time)
+            time(op.bounce_time),
+            time(op.settle_time)
         );
     } else {
         line.push_str(", never makes");

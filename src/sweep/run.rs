@@ -22,7 +22,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc;
 
 use crate::chatter::Chatter;
-use crate::coil::Operation;
+use crate::coil::{Closing, Operation};
 use crate::mechanics::simulate;
 use crate::pipeline::{self, RunOptions, RunResult};
 use crate::scenario::Scenario;
@@ -278,6 +278,10 @@ impl<'a, 'r> Worker<'a, 'r> {
             match pipeline::run(scenario, runner, &self.options.run) {
                 Ok(result) => {
                     record_chatter(&mut record, &result.chatter);
+                    // Closing times count from the coil being energized.
+                    let origin = Closing::first(&result.chatter, &result.operations).origin;
+                    record.first_impact = record.first_impact.map(|t| t - origin);
+                    record.settle_time = record.settle_time.map(|t| t - origin);
                     let worst = |get: fn(&Operation) -> Option<f64>| {
                         result.operations.iter().filter_map(get).reduce(f64::max)
                     };

@@ -1,8 +1,9 @@
 //! `sweep.csv`: one row per sample, and the merge of shards' CSVs.
 //!
 //! Columns: `index`, each varied key (its name, e.g. `mechanics.mass`, in
-//! sorted order), `outcome`, `bounce_count`, `first_impact`,
-//! `settle_time`, `bounce_time` (s, settle − first impact); for a
+//! sorted order), `outcome`, `bounce_count`, `first_impact` (s, the
+//! operate time: coil on or force step → first make), `settle_time` (s, coil on or force step → closed for good),
+//! `bounce_time` (s, first make → closed for good); for a
 //! coil-driven relay `release_time` and `nc_bounce_time` (s, the longest
 //! of its operations: coil off → break, and the bounce on the rest stop);
 //! then per probe
