@@ -294,16 +294,19 @@ fn run_chatter(
 
     let signals: Vec<&str> = scenario.probes.iter().map(|p| p.signal.as_str()).collect();
     let end = chatter_end(&chatter) + model.edge_time;
-    let deck = netlist::prepare_deck(&DeckRequest {
-        netlist_text: &netlist_text,
-        netlist_path: &netlist_path,
-        include_file_name: INCLUDE_FILE,
-        subckt: &circuit.subckt,
-        coil: None,
-        probes: &signals,
-        chatter_end: end,
-        stop_at_least: end * STOP_MARGIN,
-    })?;
+    let deck = netlist::prepare_deck_with_params(
+        &DeckRequest {
+            netlist_text: &netlist_text,
+            netlist_path: &netlist_path,
+            include_file_name: INCLUDE_FILE,
+            subckt: &circuit.subckt,
+            coil: None,
+            probes: &signals,
+            chatter_end: end,
+            stop_at_least: end * STOP_MARGIN,
+        },
+        &circuit.param_list(),
+    )?;
 
     let ideal_include = match (options.compare_ideal, chatter.first_impact) {
         (true, Some(first_impact)) => {

@@ -257,6 +257,17 @@ pub struct CircuitSection {
     /// contact (the armature on its rest stop), for a changeover relay
     /// whose NC side switches part of the circuit. `None`: there is none.
     pub nc_subckt: Option<String>,
+    /// `[circuit.params]`: values for the netlist's own `.param` names,
+    /// set in the run deck (the netlist file is never edited).
+    #[serde(default)]
+    pub params: BTreeMap<String, f64>,
+}
+
+impl CircuitSection {
+    /// The `[circuit.params]` as (name, value) pairs, sorted by name.
+    pub fn param_list(&self) -> Vec<(&str, f64)> {
+        self.params.iter().map(|(k, v)| (k.as_str(), *v)).collect()
+    }
 }
 
 fn default_subckt() -> String {
@@ -1379,6 +1390,20 @@ impl Check<'_> {
                 });
             }
         }
+        for (name, &value) in &c.params {
+            let key = format!("{PARAMS_PREFIX}{name}");
+            if !valid_param_name(name) {
+                return Err(self.invalid(
+                    &key,
+                    value,
+                    format!(
+                        "`{name}` is not a SPICE parameter name: a letter or `_`, then \
+                         letters, digits or `_`, as in the netlist's `.param`"
+                    ),
+                ));
+            }
+            self.number(&key, value, true, "")?;
+        }
         Ok(())
     }
 
@@ -1666,7 +1691,7 @@ pub const NUMBER_KEYS: &[&str] = &[
 /// Every number key, for messages.
 fn number_keys_described() -> String {
     let mut known = NUMBER_KEYS.join(", ");
-    known.push_str(", probe[N].low, probe[N].high");
+    known.push_str(", probe[N].low, probe[N].high, circuit.params.NAME");
     known
 }
 
@@ -1752,6 +1777,18 @@ macro_rules! number_field {
     }};
 }
 
+/// Number keys under this prefix name a `.param` of the netlist.
+const PARAMS_PREFIX: &str = "circuit.params.";
+
+/// A SPICE parameter name: a letter or `_`, then letters, digits, `_`.
+fn valid_param_name(name: &str) -> bool {
+    let mut chars = name.chars();
+    chars
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+}
+
 /// `probe[N].low` → (N, true), `probe[N].high` → (N, false).
 fn probe_key(key: &str) -> Option<(usize, bool)> {
     let rest = key.strip_prefix("probe[")?;
@@ -1769,12 +1806,34 @@ impl Scenario {
     /// `probe[N].low`/`.high`); `None` for an optional key the file does
     /// not give (e.g. `surface.restitution` of a Kelvin–Voigt surface).
     pub fn number(&self, key: &str) -> Result<Option<f64>, ScenarioError> {
+        if let Some(name) = key.strip_prefix(PARAMS_PREFIX) {
+            return self.circuit_param(key, name);
+        }
         match number_field!(self, key, &) {
             Field::Plain(v) => Ok(Some(*v)),
             Field::Optional(v) => Ok(*v),
             Field::NoSection(section) => Err(self.no_section(key, section)),
             Field::Unknown => Err(self.unknown_number(key, "")),
         }
+    }
+
+    /// `circuit.params.NAME`: the scenario's value, else the netlist's own
+    /// plain-number `.param NAME=value` (`None` when it gives an
+    /// expression, or the netlist cannot be read yet).
+    fn circuit_param(&self, key: &str, name: &str) -> Result<Option<f64>, ScenarioError> {
+        let Some(circuit) = &self.circuit else {
+            return Err(self.no_section(key, "[circuit]"));
+        };
+        if !valid_param_name(name) {
+            return Err(self.unknown_number(key, ""));
+        }
+        if let Some(v) = circuit.params.get(name) {
+            return Ok(Some(*v));
+        }
+        Ok(match self.netlist() {
+            Some(Ok((_, text))) => crate::netlist::param_value(&text, name),
+            _ => None,
+        })
     }
 
     /// Set number `key` (see [`Scenario::number`]) and validate the
@@ -1793,6 +1852,22 @@ impl Scenario {
         let mut old: Vec<(&str, Option<f64>)> = Vec::with_capacity(values.len());
         let mut failure = None;
         for &(key, value) in values {
+            if let Some(name) = key.strip_prefix(PARAMS_PREFIX) {
+                match self.circuit.as_mut() {
+                    Some(c) if valid_param_name(name) => {
+                        old.push((key, c.params.insert(name.to_owned(), value)));
+                        continue;
+                    }
+                    Some(_) => {
+                        failure = Some(self.unknown_number(key, ""));
+                        break;
+                    }
+                    None => {
+                        failure = Some(self.no_section(key, "[circuit]"));
+                        break;
+                    }
+                }
+            }
             match number_field!(&mut *self, key, &mut) {
                 Field::Plain(v) => old.push((key, Some(std::mem::replace(v, value)))),
                 Field::Optional(v) => old.push((key, v.replace(value))),
@@ -1819,6 +1894,14 @@ impl Scenario {
             }
             Err(e) => {
                 for &(key, value) in old.iter().rev() {
+                    if let Some(name) = key.strip_prefix(PARAMS_PREFIX) {
+                        let params = &mut self.circuit.as_mut().expect("set above").params;
+                        match value {
+                            Some(v) => params.insert(name.to_owned(), v),
+                            None => params.remove(name),
+                        };
+                        continue;
+                    }
                     match number_field!(&mut *self, key, &mut) {
                         Field::Plain(v) => *v = value.expect("a plain number had a value"),
                         Field::Optional(v) => *v = value,

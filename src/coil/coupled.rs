@@ -311,16 +311,19 @@ pub fn run_coupled(
                 .push_str(&nc_include(&back, &model, nc, &origin)?);
         }
         let end = chatter.intervals.last().map_or(0.0, |iv| iv.start);
-        let deck = netlist::prepare_deck(&DeckRequest {
-            netlist_text: &netlist_text,
-            netlist_path: &netlist_path,
-            include_file_name: CONTACT_FILE,
-            subckt: &circuit.subckt,
-            coil: Some((COIL_FILE, &circuit.coil_subckt)),
-            probes: &signals,
-            chatter_end: end,
-            stop_at_least: end,
-        })?;
+        let deck = netlist::prepare_deck_with_params(
+            &DeckRequest {
+                netlist_text: &netlist_text,
+                netlist_path: &netlist_path,
+                include_file_name: CONTACT_FILE,
+                subckt: &circuit.subckt,
+                coil: Some((COIL_FILE, &circuit.coil_subckt)),
+                probes: &signals,
+                chatter_end: end,
+                stop_at_least: end,
+            },
+            &circuit.param_list(),
+        )?;
         let mut includes = vec![
             (CONTACT_FILE.to_owned(), contact.text),
             (

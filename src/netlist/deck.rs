@@ -217,6 +217,19 @@ enum Fate {
 
 /// Build the run deck around the user's netlist (see the module overview).
 pub fn prepare_deck(req: &DeckRequest<'_>) -> Result<Deck, NetlistError> {
+    prepare_deck_with_params(req, &[])
+}
+
+/// [`prepare_deck`], with values for the netlist's own `.param` names
+/// (`[circuit.params]`): each must be defined by a top-level `.param` of
+/// the netlist or of a file it includes, and is set again at the end of
+/// the deck. ngspice lets the last definition win everywhere, expressions
+/// that use the name included (measured with ngspice 39), so the user's
+/// file stays as it is.
+pub fn prepare_deck_with_params(
+    req: &DeckRequest<'_>,
+    params: &[(&str, f64)],
+) -> Result<Deck, NetlistError> {
     let netlist = req.netlist_path.to_path_buf();
     let base = req
         .netlist_path
@@ -293,6 +306,9 @@ pub fn prepare_deck(req: &DeckRequest<'_>) -> Result<Deck, NetlistError> {
     let mut has_save = false;
     let mut tran: Option<Tran> = None;
     let mut includes: Vec<(usize, PathBuf)> = Vec::new();
+    // `.subckt` nesting: a `.param` inside one is local to it.
+    let mut depth = 0usize;
+    let mut defined: HashSet<String> = HashSet::new();
     for card in &cards {
         let keyword = card.keyword();
         match keyword.as_str() {
@@ -303,7 +319,12 @@ pub fn prepare_deck(req: &DeckRequest<'_>) -> Result<Deck, NetlistError> {
                 }
             }
             ".save" => has_save = true,
+            ".param" if depth == 0 => {
+                defined.extend(param_names(&card.text));
+            }
+            ".ends" => depth = depth.saturating_sub(1),
             ".subckt" => {
+                depth += 1;
                 let name = card.text.split_whitespace().nth(1).unwrap_or("");
                 if name.eq_ignore_ascii_case(req.subckt) {
                     return Err(NetlistError::SubcktConflict {
@@ -369,6 +390,27 @@ pub fn prepare_deck(req: &DeckRequest<'_>) -> Result<Deck, NetlistError> {
         }
     }
 
+    if !params.is_empty() {
+        let mut seen = HashSet::new();
+        for (_, path) in &includes {
+            include_params(path, 1, &mut seen, &mut defined);
+        }
+        if let Some((name, _)) = params
+            .iter()
+            .find(|(name, _)| !defined.contains(&name.to_ascii_lowercase()))
+        {
+            return Err(NetlistError::UnknownParam {
+                netlist,
+                name: (*name).to_owned(),
+                defined: {
+                    let mut names: Vec<&str> = defined.iter().map(String::as_str).collect();
+                    names.sort_unstable();
+                    names.join(", ")
+                },
+            });
+        }
+    }
+
     let Some(tran) = tran else {
         return Err(NetlistError::NoTran {
             netlist,
@@ -424,6 +466,12 @@ pub fn prepare_deck(req: &DeckRequest<'_>) -> Result<Deck, NetlistError> {
             Fate::Replace(new) => emit(new, Some(index + 1)),
         }
     }
+    if !params.is_empty() {
+        emit("* chatterspice: the scenario's [circuit.params]", None);
+        for (name, value) in params {
+            emit(&format!(".param {name}={}", format_time(*value)), None);
+        }
+    }
     if has_save && !save_lines.is_empty() {
         emit("* chatterspice: the probes", None);
         emit(&format!(".save {}", save_lines.join(" ")), None);
@@ -435,6 +483,98 @@ pub fn prepare_deck(req: &DeckRequest<'_>) -> Result<Deck, NetlistError> {
         warnings,
         tran,
     })
+}
+
+/// The value the netlist's own top-level `.param name=value` gives `name`
+/// (the last such definition), when that value is a plain number
+/// (`8.2n`, `{47e-9}`); `None` for an expression or no definition.
+pub fn param_value(netlist_text: &str, name: &str) -> Option<f64> {
+    let lines = physical_lines(netlist_text);
+    let mut live = vec![true; lines.len()];
+    if let Some(title) = live.first_mut() {
+        *title = false;
+    }
+    let mut nesting = 0usize;
+    let mut found = None;
+    for card in cards(&lines, &live) {
+        match card.keyword().as_str() {
+            ".subckt" => nesting += 1,
+            ".ends" => nesting = nesting.saturating_sub(1),
+            ".param" if nesting == 0 => {
+                let body = card.text.trim_start().get(".param".len()..).unwrap_or("");
+                // `a = 1 b={2}`: split at each `=`, the name is the last
+                // word before it, the value the first word after it.
+                let parts: Vec<&str> = body.split('=').collect();
+                for k in 0..parts.len().saturating_sub(1) {
+                    let before = parts[k].split_whitespace().last().unwrap_or("");
+                    if before.eq_ignore_ascii_case(name) {
+                        let after = parts[k + 1].split_whitespace().next().unwrap_or("");
+                        let plain = after.trim_start_matches('{').trim_end_matches('}');
+                        found = parse_number(plain);
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    found
+}
+
+/// The names a `.param` card assigns (`.param a=1 b = {a*2}`), lower
+/// case: each word before an `=`.
+fn param_names(card: &str) -> Vec<String> {
+    let mut names = Vec::new();
+    let mut rest = card.trim_start().get(".param".len()..).unwrap_or("");
+    while let Some(eq) = rest.find('=') {
+        let before = rest[..eq].trim_end();
+        let name = before
+            .rsplit(|c: char| c.is_whitespace() || c == '}' || c == ',')
+            .next()
+            .unwrap_or("");
+        if !name.is_empty() && name.chars().all(|c| c.is_alphanumeric() || c == '_') {
+            names.push(name.to_ascii_lowercase());
+        }
+        rest = &rest[eq + 1..];
+    }
+    names
+}
+
+/// Adds the top-level `.param` names of included file `path` (and of the
+/// files it includes) to `defined`. Unreadable files add nothing: the
+/// instance search reports them.
+fn include_params(
+    path: &Path,
+    depth: usize,
+    seen: &mut HashSet<PathBuf>,
+    defined: &mut HashSet<String>,
+) {
+    if depth > MAX_INCLUDE_DEPTH || !seen.insert(path.to_path_buf()) {
+        return;
+    }
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return;
+    };
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let lines = physical_lines(&text);
+    // An included file has no title line: every line is live.
+    let live = vec![true; lines.len()];
+    let mut nesting = 0usize;
+    for card in cards(&lines, &live) {
+        match card.keyword().as_str() {
+            ".subckt" => nesting += 1,
+            ".ends" => nesting = nesting.saturating_sub(1),
+            ".param" if nesting == 0 => defined.extend(param_names(&card.text)),
+            ".include" | ".inc" | ".lib" => {
+                let rest = card.text.trim_start();
+                let rest = rest.split_once(char::is_whitespace).map_or("", |(_, r)| r);
+                let (written, _) = split_path(rest.trim());
+                if !written.is_empty() {
+                    include_params(&resolve(written, &base), depth + 1, seen, defined);
+                }
+            }
+            _ => {}
+        }
+    }
 }
 
 /// `t` rounded up to two significant digits (1.4779e-3 → 1.5e-3): a stop
@@ -757,6 +897,37 @@ fn quote_if_needed(name: &str) -> String {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn param_values_and_names_are_read_off_top_level_param_cards() {
+        let text = "title\n.param cf=8.2n rf = 1k\n+ tau={rf*cf}\n.subckt f a b\n.param cf=1\n\
+                    .ends\n.param gain={2.5}\n";
+        assert_eq!(param_value(text, "cf"), Some(8.2e-9));
+        assert_eq!(param_value(text, "RF"), Some(1e3));
+        assert_eq!(param_value(text, "gain"), Some(2.5));
+        // An expression has no plain value; an unknown name none at all.
+        assert_eq!(param_value(text, "tau"), None);
+        assert_eq!(param_value(text, "x"), None);
+        assert_eq!(
+            param_names(".param cf=8.2n rf = 1k tau={rf*cf}"),
+            ["cf", "rf", "tau"]
+        );
+    }
+
+    #[test]
+    fn params_are_set_at_the_end_and_must_exist() {
+        let text = "t\n.param cf=8.2n\nX1 a 0 CONTACT\nC1 a 0 {cf}\n.tran 1u 10m\n.end\n";
+        let deck = prepare_deck_with_params(&req(text, &[]), &[("cf", 4.7e-8)]).unwrap();
+        let own = deck.text.find(".param cf=8.2n").unwrap();
+        let ours = deck.text.find(".param cf=4.7e-8").unwrap();
+        assert!(own < ours && ours < deck.text.find(".end").unwrap());
+        let err = prepare_deck_with_params(&req(text, &[]), &[("cx", 1.0)]).unwrap_err();
+        let msg = err.to_string();
+        assert!(
+            msg.contains("circuit.params.cx") && msg.contains("defines: cf"),
+            "{msg}"
+        );
+    }
+
     #[test]
     fn suggested_stop_times_are_rounded_up_to_two_digits() {
         assert_eq!(super::round_up_2(1.4779929920509072e-3), 1.5e-3);

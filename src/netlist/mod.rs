@@ -30,7 +30,10 @@ pub use contact::{
     ContactElement, ContactInclude, DEFAULT_POINTS_PER_SOURCE, EVENT_RAMP_ABOVE_POINTS,
     check_subckt_name, contact_include, contact_include_split,
 };
-pub use deck::{Deck, DeckRequest, DeckWarning, Tran, instances_of, prepare_deck, save_names};
+pub use deck::{
+    Deck, DeckRequest, DeckWarning, Tran, instances_of, param_value, prepare_deck,
+    prepare_deck_with_params, save_names,
+};
 pub use number::parse_number;
 
 /// Errors of this stage. Netlist problems name the file and the 1-based
@@ -76,6 +79,21 @@ pub enum NetlistError {
         netlist.display()
     )]
     NoCoilInstance { netlist: PathBuf, subckt: String },
+    #[error(
+        "{}: `circuit.params.{name}`: the netlist defines no top-level `.param {name}` (in the \
+         file or the files it includes) for the scenario to override{}",
+        netlist.display(),
+        if defined.is_empty() {
+            format!("; it defines no .param at all: add `.param {name}=<value>` and use `{{{name}}}`")
+        } else {
+            format!("; it defines: {defined}")
+        }
+    )]
+    UnknownParam {
+        netlist: PathBuf,
+        name: String,
+        defined: String,
+    },
     #[error(
         "{}: line {line}: the netlist defines its own `.subckt {subckt}`, which clashes with the \
          generated contact: remove that definition (chatterspice provides it) or name the \
