@@ -616,7 +616,8 @@ pub struct SweepArgs {
     pub seed: Option<u64>,
 
     /// Samples run at once [default: one per core]. With ngspice, each
-    /// sample is one ngspice process.
+    /// sample is one ngspice process: J is the most ngspice processes at
+    /// once.
     #[arg(short = 'j', long, value_name = "J")]
     pub jobs: Option<NonZeroUsize>,
 
@@ -639,6 +640,12 @@ pub struct SweepArgs {
     /// Replace files that already exist in DIR.
     #[arg(long)]
     pub force: bool,
+
+    /// Also run each sample with an ideal contact, adding each probe's
+    /// `<signal>.ideal_edges` column: two ngspice runs per sample, one
+    /// after the other, so it takes twice as long.
+    #[arg(long, conflicts_with = "mechanics_only")]
+    pub ideal: bool,
 
     #[command(flatten)]
     pub simulator: SimulatorArgs,
@@ -728,7 +735,13 @@ fn sweep(args: &SweepArgs) -> Result<Status> {
         options.jobs = jobs;
     }
     options.shard = args.shard.unwrap_or(Shard::WHOLE);
-    options.run = args.simulator.run_options();
+    // A sample is one ngspice process (two with --ideal, in turn), so
+    // --jobs is the number of ngspice processes at once.
+    options.run = RunOptions {
+        compare_ideal: args.ideal,
+        ideal_alongside: false,
+        ..args.simulator.run_options()
+    };
 
     std::fs::create_dir_all(&dir)
         .with_context(|| format!("{}: cannot create the output directory", dir.display()))?;

@@ -56,6 +56,10 @@ pub struct RunOptions {
     pub element: Option<ContactElement>,
     /// Also run the ideal contact and compare (needs a first impact).
     pub compare_ideal: bool,
+    /// Run the ideal contact's ngspice at the same time as the bounced
+    /// one (two processes), rather than after it. A sweep, which already
+    /// runs one sample per job, turns this off.
+    pub ideal_alongside: bool,
     /// For a coil-driven relay: how the coupling iterates (its `timeout`
     /// is replaced by the one above).
     pub coupling: CouplingOptions,
@@ -68,6 +72,7 @@ impl Default for RunOptions {
             keep_workdir: false,
             element: None,
             compare_ideal: true,
+            ideal_alongside: true,
             coupling: CouplingOptions::default(),
         }
     }
@@ -329,14 +334,19 @@ fn run_chatter(
     };
     let bounced_request = request(&include);
     let ideal_request = ideal_include.as_ref().map(request);
-    let (bounced, ideal) = std::thread::scope(|scope| {
-        let ideal = ideal_request
-            .as_ref()
-            .map(|req| scope.spawn(move || runner.run(req)));
+    let (bounced, ideal) = if options.ideal_alongside {
+        std::thread::scope(|scope| {
+            let ideal = ideal_request
+                .as_ref()
+                .map(|req| scope.spawn(move || runner.run(req)));
+            let bounced = runner.run(&bounced_request);
+            let ideal = ideal.map(|handle| handle.join().expect("the ideal run does not panic"));
+            (bounced, ideal)
+        })
+    } else {
         let bounced = runner.run(&bounced_request);
-        let ideal = ideal.map(|handle| handle.join().expect("the ideal run does not panic"));
-        (bounced, ideal)
-    });
+        (bounced, ideal_request.as_ref().map(|req| runner.run(req)))
+    };
     let simulation = simulation_of("bounced", bounced, &netlist_path, &deck)?;
     let ideal = ideal
         .map(|result| simulation_of("ideal", result, &netlist_path, &deck))

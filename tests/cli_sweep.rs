@@ -519,3 +519,60 @@ fn a_coil_driven_relay_sweeps_its_release_through_the_circuit() {
         .code(2)
         .stderr(predicate::str::contains("--mechanics-only"));
 }
+
+/// `--jobs J` bounds the ngspice processes running at once, with and
+/// without `--ideal`: a wrapper around ngspice records how many of its
+/// kind are running each time one starts.
+#[test]
+fn jobs_bound_the_ngspice_processes_at_once() {
+    let _ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    let running = dir.path().join("running");
+    std::fs::create_dir(&running).unwrap();
+    let log = dir.path().join("counts.log");
+    let wrapper = dir.path().join("ngspice-counting.sh");
+    std::fs::write(
+        &wrapper,
+        format!(
+            "#!/bin/sh\ntouch '{r}'/$$\nls '{r}' | wc -l >> '{log}'\nsleep 0.05\n\
+             ngspice \"$@\"\nrc=$?\nrm -f '{r}'/$$\nexit $rc\n",
+            r = running.display(),
+            log = log.display()
+        ),
+    )
+    .unwrap();
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(&wrapper, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let s = scenario(dir.path(), VARY);
+    for (jobs, ideal, most) in [("1", true, 1), ("2", false, 2), ("2", true, 2)] {
+        std::fs::write(&log, "").unwrap();
+        let out = dir.path().join(format!("out-{jobs}-{ideal}"));
+        let mut cmd = chatterspice();
+        cmd.arg("sweep")
+            .arg(&s)
+            .args(["--samples", "4", "--jobs", jobs, "--ngspice"])
+            .arg(&wrapper)
+            .arg("--out")
+            .arg(&out);
+        if ideal {
+            cmd.arg("--ideal");
+        }
+        cmd.assert().success();
+        let counts: Vec<usize> = std::fs::read_to_string(&log)
+            .unwrap()
+            .lines()
+            .map(|l| l.trim().parse().unwrap())
+            .collect();
+        // The version check, then one run per sample (two with --ideal).
+        let runs = if ideal { 8 } else { 4 };
+        assert!(counts.len() > runs, "{counts:?}");
+        let peak = counts.iter().copied().max().unwrap();
+        assert!(
+            peak <= most,
+            "--jobs {jobs} --ideal {ideal}: {peak} at once"
+        );
+        let header = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+        let header = header.lines().next().unwrap().to_owned();
+        assert_eq!(header.contains("v(in).ideal_edges"), ideal, "{header}");
+    }
+}

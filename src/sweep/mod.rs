@@ -158,6 +158,8 @@ pub struct ProbeRecord {
     pub edges: usize,
     /// max |value| over the run, in the probe's unit (V or A).
     pub peak: f64,
+    /// Schmitt edges with an ideal contact, when that ran too.
+    pub ideal_edges: Option<usize>,
 }
 
 /// What one sample gave: a row of `sweep.csv`.

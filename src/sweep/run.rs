@@ -12,8 +12,11 @@
 //! are written.
 //!
 //! With ngspice a sample is one ngspice process: a sweep reads the bounced
-//! run's probes only, so it does not run the ideal contact that `run`
-//! compares with, and `jobs` is the number of ngspice processes at once.
+//! run's probes only, so by default it does not run the ideal contact
+//! that `run` compares with. When asked to (`RunOptions::compare_ideal`,
+//! the CLI's `--ideal`), a sample runs its two ngspice processes one after
+//! the other, so that `jobs` stays the number of ngspice processes at
+//! once either way.
 
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -73,6 +76,7 @@ impl SweepOptions<'_> {
             shard: Shard::WHOLE,
             run: RunOptions {
                 compare_ideal: false,
+                ideal_alongside: false,
                 ..RunOptions::default()
             },
         }
@@ -141,7 +145,8 @@ pub fn run(
             scenario.probes.iter().map(|p| p.signal.clone()).collect()
         }
     };
-    let header = table::header(sampler.keys(), &signals, coil);
+    let ideal = options.run.compare_ideal && matches!(options.mode, Mode::Circuit(_));
+    let header = table::header(sampler.keys(), &signals, coil, ideal);
     let probes = signals.len();
     out.write_all(&header)
         .and_then(|()| out.flush())
@@ -172,7 +177,7 @@ pub fn run(
                     let records: Vec<Record> = positions
                         .map(|p| worker.evaluate(options.shard.sample(p)))
                         .collect();
-                    let rows = table::rows(&records, sampler.keys().len(), probes, coil);
+                    let rows = table::rows(&records, sampler.keys().len(), probes, coil, ideal);
                     if tx.send((c, rows, records)).is_err() {
                         break;
                     }
@@ -346,6 +351,7 @@ fn record_probes(record: &mut Record, result: &RunResult) {
         .map(|p| ProbeRecord {
             edges: p.analysis.edges,
             peak: p.analysis.max.abs().max(p.analysis.min.abs()),
+            ideal_edges: p.ideal.as_ref().map(|i| i.edges),
         })
         .collect();
 }

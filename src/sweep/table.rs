@@ -41,8 +41,9 @@ pub const OUTCOME_COLUMNS: [&str; 5] = [
 pub const RELEASE_COLUMNS: [&str; 2] = ["release_time", "nc_bounce_time"];
 
 /// The header line for `keys` and probe `signals`, with the release
-/// columns for a coil-driven relay.
-pub fn header(keys: &[String], signals: &[String], coil: bool) -> Vec<u8> {
+/// columns for a coil-driven relay and, when the ideal contact ran too,
+/// each probe's `<signal>.ideal_edges`.
+pub fn header(keys: &[String], signals: &[String], coil: bool, ideal: bool) -> Vec<u8> {
     let mut w = Writer::from_writer(Vec::new());
     let mut names: Vec<String> = vec!["index".to_owned()];
     names.extend(keys.iter().cloned());
@@ -53,6 +54,9 @@ pub fn header(keys: &[String], signals: &[String], coil: bool) -> Vec<u8> {
     for s in signals {
         names.push(format!("{s}.edges"));
         names.push(format!("{s}.peak"));
+        if ideal {
+            names.push(format!("{s}.ideal_edges"));
+        }
     }
     names.push("verdict".to_owned());
     names.push("failed_limits".to_owned());
@@ -65,7 +69,7 @@ pub fn header(keys: &[String], signals: &[String], coil: bool) -> Vec<u8> {
 /// probes, each `\n`-terminated. A record without values or probes (a
 /// sample that failed before them) has empty cells there, so every row
 /// has the header's width.
-pub fn rows(records: &[Record], keys: usize, probes: usize, coil: bool) -> Vec<u8> {
+pub fn rows(records: &[Record], keys: usize, probes: usize, coil: bool, ideal: bool) -> Vec<u8> {
     let mut w = Writer::from_writer(Vec::with_capacity(records.len() * 96));
     let mut cell = String::new();
     let mut number = |w: &mut Writer<Vec<u8>>, value: Option<f64>| {
@@ -98,6 +102,13 @@ pub fn rows(records: &[Record], keys: usize, probes: usize, coil: bool) -> Vec<u
             w.write_field(p.map_or_else(String::new, |p| p.edges.to_string()))
                 .expect("writing to memory");
             number(&mut w, p.map(|p| p.peak));
+            if ideal {
+                w.write_field(
+                    p.and_then(|p| p.ideal_edges)
+                        .map_or_else(String::new, |n| n.to_string()),
+                )
+                .expect("writing to memory");
+            }
         }
         w.write_field(r.verdict.as_str())
             .expect("writing to memory");
@@ -447,6 +458,7 @@ mod tests {
             probes: vec![ProbeRecord {
                 edges: 5,
                 peak: 3.3,
+                ideal_edges: None,
             }],
             verdict: Verdict::Pass,
             failed_limits: vec![],
@@ -457,7 +469,7 @@ mod tests {
     #[test]
     fn rows_match_the_header_and_quote_what_needs_it() {
         let keys = vec!["mechanics.mass".to_owned(), "surface.damping".to_owned()];
-        let h = header(&keys, &["v(a,b)".to_owned()], false);
+        let h = header(&keys, &["v(a,b)".to_owned()], false, false);
         assert_eq!(
             String::from_utf8(h).unwrap(),
             "index,mechanics.mass,surface.damping,outcome,bounce_count,first_impact,settle_time,\
@@ -470,13 +482,13 @@ mod tests {
         failed.verdict = Verdict::Error;
         failed.error = Some("ngspice failed: timeout, 60 s".to_owned());
         failed.probes = vec![];
-        let text = String::from_utf8(rows(&[record(0)], 2, 1, false)).unwrap();
+        let text = String::from_utf8(rows(&[record(0)], 2, 1, false, false)).unwrap();
         assert_eq!(
             text,
             "0,0.00015,0.25,stuck,3,0.001,0.002,0.001,5,3.3,pass,,\n"
         );
         failed.values.clear();
-        let text = String::from_utf8(rows(&[failed], 2, 1, false)).unwrap();
+        let text = String::from_utf8(rows(&[failed], 2, 1, false, false)).unwrap();
         assert_eq!(
             text,
             "1,,,,,0.001,0.002,0.001,,,error,,\"ngspice failed: timeout, 60 s\"\n"
@@ -484,7 +496,7 @@ mod tests {
     }
 
     fn csv_of(indices: &[u64]) -> Vec<u8> {
-        let mut out = header(&["k".to_owned()], &[], false);
+        let mut out = header(&["k".to_owned()], &[], false, false);
         let records: Vec<Record> = indices
             .iter()
             .map(|&i| Record {
@@ -493,7 +505,7 @@ mod tests {
                 ..record(i)
             })
             .collect();
-        out.extend(rows(&records, 1, 0, false));
+        out.extend(rows(&records, 1, 0, false, false));
         out
     }
 
@@ -515,7 +527,7 @@ mod tests {
         let report = merge(gap, &mut Vec::new(), None, true).unwrap();
         assert_eq!(report.missing, vec![1, 2]);
 
-        let other = header(&["j".to_owned()], &[], false);
+        let other = header(&["j".to_owned()], &[], false, false);
         let err = merge(
             vec![
                 ("a".into(), Cursor::new(csv_of(&[0]))),
