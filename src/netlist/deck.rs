@@ -137,11 +137,23 @@ pub enum DeckWarning {
         netlist: PathBuf,
         text: String,
     },
+    InterpRemoved {
+        netlist: PathBuf,
+        line: usize,
+    },
 }
 
 impl fmt::Display for DeckWarning {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
+            DeckWarning::InterpRemoved { netlist, line } => write!(
+                f,
+                "{}: line {line}: `interp` is left out of the run's `.options`: ngspice 39 \
+                 writes an interpolated raw file whose time stamps run slow wherever its time \
+                 step exceeds the `.tran` step (and more points than it declares), so the \
+                 analysis would be wrong; the run keeps every point ngspice computes instead",
+                netlist.display()
+            ),
             DeckWarning::ControlRemoved {
                 netlist,
                 first,
@@ -319,6 +331,23 @@ pub fn prepare_deck_with_params(
                 }
             }
             ".save" => has_save = true,
+            ".options" | ".option" | ".opt" => {
+                let words: Vec<&str> = card.text.split_whitespace().collect();
+                let is_interp = |w: &&str| w.eq_ignore_ascii_case("interp");
+                if words.iter().any(is_interp) {
+                    let kept: Vec<&str> = words.into_iter().filter(|w| !is_interp(w)).collect();
+                    let text = if kept.len() > 1 {
+                        kept.join(" ")
+                    } else {
+                        "* chatterspice: `.options interp` left out".to_owned()
+                    };
+                    replace(&mut fates, card, text);
+                    warnings.push(DeckWarning::InterpRemoved {
+                        netlist: netlist.clone(),
+                        line: card.line(),
+                    });
+                }
+            }
             ".param" if depth == 0 => {
                 defined.extend(param_names(&card.text));
             }

@@ -20,6 +20,13 @@
 //!   analysis ends, so a killed run leaves `0` there and the data cut at an
 //!   arbitrary byte. The point count is derived from the data, read up to
 //!   the last whole point, and a [`RawWarning`] says so;
+//! - `.options interp` in ngspice 39: more points than `No. Points:`
+//!   declares (read, up to the next plot's header, with a warning), and
+//!   with UIC the data started over several times, the variables and
+//!   `Binary:` written again after an all-zero point (the last start's
+//!   points are kept, with a warning). Its time stamps also run slow
+//!   where the simulator's step exceeds the `.tran` step, which no reader
+//!   can undo: `run` leaves `interp` out of the deck;
 //! - ngspice 39 leaves garbage in the imaginary part of the AC frequency
 //!   axis, so a complex plot's `frequency` scale is stored as real;
 //! - LTspice's dialect (UTF-16 header, `f32` values, `FastAccess` layout) is
@@ -149,6 +156,30 @@ pub enum RawWarning {
         /// Byte offset where the incomplete point (if any) starts.
         offset: usize,
     },
+    /// ngspice 39 with `.options interp` can start a plot's data over: it
+    /// writes the variables and `Binary:` again after a point or so. The
+    /// points before the last restart are dropped (they are all-zero
+    /// points of an abandoned start).
+    Restarted {
+        /// Index of the plot in the file.
+        plot: usize,
+        /// How many times the data started over.
+        restarts: usize,
+        /// Points dropped before the last restart.
+        dropped: usize,
+    },
+    /// A plot held whole points past its `No. Points:` with no plot header
+    /// after them: ngspice 39 writes these with `.options interp`
+    /// (repeated time stamps included). They belong to the plot and are
+    /// read.
+    ExtraPoints {
+        /// Index of the plot in the file.
+        plot: usize,
+        /// `No. Points:` as written.
+        declared: usize,
+        /// Whole points read, more than declared.
+        read: usize,
+    },
 }
 
 impl fmt::Display for RawWarning {
@@ -174,6 +205,25 @@ impl fmt::Display for RawWarning {
                     )
                 }
             }
+            RawWarning::Restarted {
+                plot,
+                restarts,
+                dropped,
+            } => write!(
+                f,
+                "plot {plot}: the data starts over {restarts} time(s) (ngspice re-declares the \
+                 variables and `Binary:` with `.options interp`); the {dropped} point(s) before \
+                 the last start were dropped"
+            ),
+            RawWarning::ExtraPoints {
+                plot,
+                declared,
+                read,
+            } => write!(
+                f,
+                "plot {plot}: header says {declared} points but the data holds {read} whole points \
+                 (ngspice writes more than it declares with `.options interp`); all {read} are read"
+            ),
         }
     }
 }
@@ -741,11 +791,82 @@ fn next_is_header(rest: &[u8]) -> bool {
     starts(b"Title:") || starts(b"Plotname:") || starts(b"Date:")
 }
 
+/// Where a plot's binary data really are, walked point by point.
+#[derive(Debug, Default)]
+struct Sections {
+    /// Bytes before the last start of the data (dropped points and the
+    /// re-declarations).
+    skip: usize,
+    /// Whole points after it, up to the next plot's header or the end.
+    points: usize,
+    /// Bytes of a partial point after them (only at the end of the file).
+    tail: usize,
+    restarts: usize,
+    dropped: usize,
+}
+
+/// Walks `rest` (a plot's binary data, `row` bytes a point) one point at a
+/// time: a re-declaration of `vars` and `Binary:` at a point boundary
+/// starts the data over; the next plot's header or the end of the file
+/// ends them.
+fn sections(rest: &[u8], row: usize, vars: &[Variable]) -> Sections {
+    let mut s = Sections::default();
+    let mut at = 0;
+    loop {
+        let here = &rest[at..];
+        if here.is_empty() || next_is_header(here) {
+            break;
+        }
+        if here[0] == b'\t' {
+            if let Some(len) = redeclaration(here, vars) {
+                s.restarts += 1;
+                s.dropped += s.points;
+                s.points = 0;
+                at += len;
+                s.skip = at;
+                continue;
+            }
+        }
+        if here.len() < row {
+            s.tail = here.len();
+            break;
+        }
+        s.points += 1;
+        at += row;
+    }
+    s
+}
+
+/// The length of a re-declaration of `vars` (`\t0\ttime\ttime` ... then
+/// `Binary:`) at the start of `bytes`, if there is one.
+fn redeclaration(bytes: &[u8], vars: &[Variable]) -> Option<usize> {
+    let mut pos = 0;
+    for v in vars {
+        let line_len = bytes
+            .get(pos..)?
+            .iter()
+            .take(4096)
+            .position(|&b| b == b'\n')?;
+        let line = &bytes[pos..pos + line_len];
+        let mut words = line
+            .split(|b| b.is_ascii_whitespace())
+            .filter(|w| !w.is_empty());
+        if !words.next()?.iter().all(u8::is_ascii_digit) || words.next()? != v.name.as_bytes() {
+            return None;
+        }
+        pos += line_len + 1;
+    }
+    bytes
+        .get(pos..)?
+        .starts_with(b"Binary:\n")
+        .then_some(pos + b"Binary:\n".len())
+}
+
 fn read_binary(
     cur: &mut Cursor<'_>,
     header: Header,
     index: usize,
-) -> Result<(Plot, Option<RawWarning>), RawError> {
+) -> Result<(Plot, Vec<RawWarning>), RawError> {
     let Header {
         mut plot,
         nvars,
@@ -766,18 +887,54 @@ fn read_binary(
         // before its first point): nothing to read, nothing lost.
         plot.columns = empty_columns(&plot);
         cur.line = None;
-        return Ok((plot, None));
+        return Ok((plot, Vec::new()));
     }
 
+    // A file whose data do not end where the header says, at the end of
+    // the file or at the next plot's header, went through `.options
+    // interp`: walk it point by point (restarts, extra points).
+    let irregular = uniform
+        && !open_ended
+        && row > 0
+        && declared
+            .checked_mul(row)
+            .is_some_and(|end| rest.len() > end && !next_is_header(&rest[end..]));
+    let sections = if irregular {
+        // Less than a whole point past the declared ones, and no restart:
+        // not ngspice's doing; the garbage is reported where it starts.
+        Some(sections(rest, row, &plot.variables))
+            .filter(|s| s.restarts > 0 || s.points > declared)
+            .unwrap_or_default()
+    } else {
+        Sections::default()
+    };
+    let irregular = irregular && sections.points > 0;
+    let sections = if irregular {
+        sections
+    } else {
+        Sections::default()
+    };
+    let extra = sections.points.saturating_sub(declared);
+    let (skip, tail) = (sections.skip, sections.tail);
+    let mut warnings = Vec::new();
+    if sections.restarts > 0 {
+        warnings.push(RawWarning::Restarted {
+            plot: index,
+            restarts: sections.restarts,
+            dropped: sections.dropped,
+        });
+    }
     let (read, used) = if uniform {
         // Whole points the bytes hold, whatever the header claims.
         let whole = if open_ended {
             rest.len() / row
+        } else if irregular {
+            sections.points
         } else {
             declared.min(rest.len() / row)
         };
-        let data = &rest[..whole * row];
-        let lens: Vec<usize> = if open_ended {
+        let data = &rest[skip..skip + whole * row];
+        let lens: Vec<usize> = if open_ended || extra > 0 {
             vec![whole; nvars]
         } else {
             lengths.iter().map(|&l| l.min(whole)).collect()
@@ -827,27 +984,32 @@ fn read_binary(
             cols
         };
         plot.columns = columns;
-        (whole, whole * row)
+        (whole, skip + whole * row)
     } else {
         let (columns, read, used) = read_binary_unpadded(rest, &plot, &lengths, width);
         plot.columns = columns;
         (read, used)
     };
-    cur.pos = start + used;
+    cur.pos = start + used + tail;
     cur.line = None;
 
-    if open_ended || read < declared {
-        let warning = RawWarning::Truncated {
+    if extra > 0 {
+        warnings.push(RawWarning::ExtraPoints {
+            plot: index,
+            declared,
+            read,
+        });
+    } else if open_ended || read < declared {
+        warnings.push(RawWarning::Truncated {
             plot: index,
             declared,
             read,
             offset: cur.pos,
-        };
+        });
         // Only the last plot of a file can be cut: the rest is the partial point.
         cur.pos = cur.bytes.len();
-        return Ok((plot, Some(warning)));
     }
-    Ok((plot, None))
+    Ok((plot, warnings))
 }
 
 fn empty_columns(plot: &Plot) -> Vec<Column> {
@@ -1019,7 +1181,7 @@ fn read_ascii(
     cur: &mut Cursor<'_>,
     header: Header,
     index: usize,
-) -> Result<(Plot, Option<RawWarning>), RawError> {
+) -> Result<(Plot, Vec<RawWarning>), RawError> {
     let Header {
         mut plot,
         nvars,
@@ -1049,9 +1211,20 @@ fn read_ascii(
     let mut read = 0usize;
     let mut cut_at = None;
     let mut tokens = Tokens { cur };
+    let mut extra = false;
     'points: loop {
         if !open_ended && read >= declared {
-            break;
+            // More points than declared (`.options interp`): go on while
+            // what follows is a point index, not the next plot's header.
+            tokens.skip_ws();
+            if padded
+                && lengths.iter().all(|&l| l == declared)
+                && tokens.peek().is_some_and(|b| b.is_ascii_digit())
+            {
+                extra = true;
+            } else {
+                break;
+            }
         }
         tokens.skip_ws();
         let point_start = tokens.cur.at();
@@ -1082,7 +1255,7 @@ fn read_ascii(
         }
         // Values go straight into the columns; a cut point is rolled back.
         for (j, col) in columns.iter_mut().enumerate() {
-            let present = open_ended || read < lengths[j];
+            let present = open_ended || extra || read < lengths[j];
             if !present && !padded {
                 continue;
             }
@@ -1124,6 +1297,17 @@ fn read_ascii(
         read += 1;
     }
     plot.columns = columns;
+    if extra && read > declared {
+        let warning = RawWarning::ExtraPoints {
+            plot: index,
+            declared,
+            read,
+        };
+        if cut_at.is_some() {
+            cur.pos = cur.bytes.len();
+        }
+        return Ok((plot, vec![warning]));
+    }
     let warning = match cut_at {
         Some(offset) if open_ended || read < declared => Some(RawWarning::Truncated {
             plot: index,
@@ -1136,7 +1320,7 @@ fn read_ascii(
     if warning.is_some() {
         cur.pos = cur.bytes.len();
     }
-    Ok((plot, warning))
+    Ok((plot, warning.into_iter().collect()))
 }
 
 fn truncate(c: &mut Column, len: usize) {
