@@ -288,6 +288,43 @@ pub struct ProbeAnalysis {
     pub transitions: Vec<Edge>,
     /// For a current probe: peak and charge; `None` otherwise.
     pub current: Option<CurrentAnalysis>,
+    /// For a current probe: the pulses, each a departure from the
+    /// starting level (and usually its return: two edges). `glitches` of a
+    /// current counts the pulses after the first. `None` for a voltage.
+    pub pulses: Option<usize>,
+}
+
+impl ProbeAnalysis {
+    /// When the signal crossed neither threshold it would have to (no
+    /// edge, and its whole range on one side of a threshold): a sentence
+    /// saying so, with its range, for a warning. Such a probe reports 0
+    /// edges however much the signal moved.
+    pub fn threshold_warning(&self) -> Option<String> {
+        if self.edges > 0 {
+            return None;
+        }
+        let unit = self.kind.unit();
+        let e = |v: f64| crate::report::units::engineering(v, unit);
+        let (which, value) = if self.max < self.high && self.min > self.low {
+            ("either threshold", None)
+        } else if self.max < self.high {
+            ("its `high` threshold", Some(self.high))
+        } else if self.min > self.low {
+            ("its `low` threshold", Some(self.low))
+        } else {
+            return None;
+        };
+        Some(format!(
+            "{}: no edge: the signal never crosses {which}{} (low {}, high {}); its range is {} to \
+             {}: check the probe's thresholds and units",
+            self.signal,
+            value.map_or_else(String::new, |v| format!(" at {}", e(v))),
+            e(self.low),
+            e(self.high),
+            e(self.min),
+            e(self.max),
+        ))
+    }
 }
 
 /// What the bounce added to a probe, compared with a run of the same
@@ -433,10 +470,16 @@ pub fn analyze_samples(
         _ => None,
     };
     let edges = &schmitt.edges;
+    // A current pulse is two edges (it rises and falls): count pulses.
+    let pulses = (kind == ProbeKind::Current).then(|| edges.len().div_ceil(2));
     Ok(ProbeAnalysis {
         signal: probe.signal.clone(),
         edges: edges.len(),
-        glitches: edges.len().saturating_sub(1),
+        glitches: match pulses {
+            Some(p) => p.saturating_sub(1),
+            None => edges.len().saturating_sub(1),
+        },
+        pulses,
         first_edge: edges.first().map(|e| e.time),
         last_edge: edges.last().map(|e| e.time),
         min,
@@ -988,7 +1031,9 @@ mod tests {
         let b = analyze_samples(&p, kind, &t, &bounced, &[(1e-4, 1e-3)]).unwrap();
         assert_eq!((i.edges, b.edges), (1, 5));
         let c = compare(&b, &i).unwrap();
-        assert_eq!((c.extra_edges, c.extra_glitches), (4, 4));
+        // Current glitches are pulses after the first: 3 pulses against 1.
+        assert_eq!((b.pulses, i.pulses), (Some(3), Some(1)));
+        assert_eq!((c.extra_edges, c.extra_glitches), (4, 2));
         assert!(c.same_final_state);
         let delay = c.settle_delay.unwrap();
         assert!((delay - 2e-4).abs() < 1e-6 + 1e-12, "{delay}");

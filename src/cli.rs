@@ -15,6 +15,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::time::Duration;
 
 mod calibrate;
+mod raw;
 
 use chatterspice::chatter::Chatter;
 use chatterspice::check;
@@ -22,7 +23,6 @@ use chatterspice::coil::CouplingOptions;
 use chatterspice::mechanics::Dimensionless;
 use chatterspice::netlist::{self, ContactElement};
 use chatterspice::pipeline::{self, RunOptions};
-use chatterspice::rawfile::{RawFile, export};
 use chatterspice::report::{self, Format};
 use chatterspice::scenario::Scenario;
 use chatterspice::simulate;
@@ -51,7 +51,7 @@ pub enum Command {
     /// exit 0 when all hold, 1 when any fails, 2 on bad input.
     Check(CheckArgs),
     /// Print a SPICE raw file: one plot as CSV, or a JSON summary of every plot.
-    Raw(RawArgs),
+    Raw(raw::RawArgs),
     /// Run the scenario many times with the numbers of its [sweep] varied
     /// (Monte Carlo or a grid): sweep.csv, summary.json, sweep.svg, sweep.png.
     Sweep(SweepArgs),
@@ -82,7 +82,7 @@ impl Command {
             Command::Bounce(args) => done(bounce(args)),
             Command::Pwl(args) => done(pwl(args)),
             Command::Check(args) => check(args),
-            Command::Raw(args) => done(raw(args)),
+            Command::Raw(args) => done(raw::raw(args)),
             Command::Sweep(args) => sweep(args),
             Command::Merge(args) => done(merge(args)),
             Command::Fit(args) => done(calibrate::fit(args)),
@@ -289,26 +289,6 @@ fn parse_timeout(text: &str) -> Result<f64, String> {
 
 fn parse_element(text: &str) -> Result<ContactElement, String> {
     text.parse::<ContactElement>().map_err(|e| e.to_string())
-}
-
-#[derive(Debug, Args)]
-pub struct RawArgs {
-    /// The raw file (ngspice binary or ASCII).
-    pub file: PathBuf,
-    /// Plot to print as CSV, numbered from 0 in file order [default: the last].
-    #[arg(long)]
-    pub plot: Option<usize>,
-    /// Output format.
-    #[arg(long, value_enum, default_value_t = RawFormat::Csv)]
-    pub format: RawFormat,
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum RawFormat {
-    /// One plot: a header of vector names, one row per point.
-    Csv,
-    /// A summary of every plot: name, flags, variables, points.
-    Json,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -574,29 +554,6 @@ fn emit(text: &str, output: Option<&Path>, force: bool) -> Result<()> {
                 result => result.context("cannot write to standard output"),
             }
         }
-    }
-}
-
-fn raw(args: &RawArgs) -> Result<()> {
-    let raw = RawFile::read(&args.file)?;
-    for w in &raw.warnings {
-        eprintln!("warning: {}: {w}", args.file.display());
-    }
-    // Checked for JSON too, so a wrong index is never silently ignored.
-    let selected = export::select_plot(&raw, args.plot)
-        .with_context(|| format!("in {}", args.file.display()))?;
-    let mut out = io::BufWriter::new(io::stdout().lock());
-    let written = match args.format {
-        RawFormat::Csv => export::plot_csv(selected, &mut out),
-        RawFormat::Json => out
-            .write_all(export::summary_json(&raw).as_bytes())
-            .map_err(export::ExportError::Write),
-    }
-    .and_then(|()| out.flush().map_err(export::ExportError::Write));
-    match written {
-        // The reader stopped early (`| head`): not our failure.
-        Err(e) if e.is_broken_pipe() => Ok(()),
-        result => Ok(result?),
     }
 }
 

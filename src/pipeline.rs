@@ -361,6 +361,7 @@ fn run_chatter(
 
     let mut warnings: Vec<String> = deck.warnings.iter().map(ToString::to_string).collect();
     warnings.extend(simulation.warnings.iter().cloned());
+    warnings.extend(probes.iter().filter_map(|p| p.analysis.threshold_warning()));
     Ok(RunResult {
         coupling: None,
         operations: Vec::new(),

@@ -51,7 +51,7 @@ fn csv_of_the_last_plot_by_default_with_exact_values() {
 fn plot_index_selects_the_operating_point() {
     let csv = stdout_of(&[data("divider_op_tran.raw").to_str().unwrap(), "--plot", "0"]);
     assert_eq!(csv.lines().count(), 2);
-    assert!(csv.lines().nth(1).unwrap().starts_with("4e0,1e0,"), "{csv}");
+    assert!(csv.lines().nth(1).unwrap().starts_with("4.0,1.0,"), "{csv}");
 }
 
 #[test]
@@ -61,7 +61,7 @@ fn complex_vectors_become_re_and_im_columns() {
         csv.lines().next(),
         Some("frequency,v(in).re,v(in).im,v(out).re,v(out).im,i(v1).re,i(v1).im")
     );
-    assert!(csv.lines().nth(1).unwrap().starts_with("1e1,1e0,0e0,"));
+    assert!(csv.lines().nth(1).unwrap().starts_with("10.0,1.0,0.0,"));
 }
 
 #[test]
@@ -128,4 +128,154 @@ fn bad_input_exits_2_with_a_clear_message() {
         .args(["--format", "xml"])
         .assert()
         .code(2);
+}
+
+/// Every plot of every stored ngspice file gives the same CSV through the
+/// streaming path as through the whole-file reader.
+#[test]
+fn streamed_csv_equals_the_whole_file_csv() {
+    for name in [
+        "rc_tran.raw",
+        "rc_tran_ascii.raw",
+        "rc_tran_ngspice44.raw",
+        "rc_ac.raw",
+        "divider_op_tran.raw",
+        "control_write_ac_binary.raw",
+        "killed_binary.raw",
+    ] {
+        let raw = RawFile::read(data(name)).unwrap();
+        for index in 0..raw.plots.len() {
+            let mut expected = Vec::new();
+            chatterspice::rawfile::export::plot_csv(&raw.plots[index], &mut expected).unwrap();
+            let mut streamed = Vec::new();
+            let result =
+                chatterspice::rawfile::stream_csv(&data(name), Some(index), &mut streamed).unwrap();
+            if result.is_some() {
+                assert_eq!(
+                    String::from_utf8(streamed).unwrap(),
+                    String::from_utf8(expected.clone()).unwrap(),
+                    "{name} plot {index}"
+                );
+            }
+            let index = index.to_string();
+            let cli = stdout_of(&[data(name).to_str().unwrap(), "--plot", &index]);
+            assert_eq!(cli.as_bytes(), expected, "{name} plot {index}");
+        }
+    }
+    // The batch files stream (the ASCII one falls back to the full reader).
+    let mut sink = Vec::new();
+    assert!(
+        chatterspice::rawfile::stream_csv(&data("rc_tran.raw"), None, &mut sink)
+            .unwrap()
+            .is_some()
+    );
+    assert!(
+        chatterspice::rawfile::stream_csv(&data("rc_tran_ascii.raw"), None, &mut sink)
+            .unwrap()
+            .is_none()
+    );
+}
+
+#[test]
+fn devices_and_pipes_are_refused_not_read_forever() {
+    for device in ["/dev/zero", "/dev/urandom"] {
+        for format in ["csv", "json"] {
+            raw_cmd()
+                .args([device, "--format", format])
+                .timeout(std::time::Duration::from_secs(10))
+                .assert()
+                .code(2)
+                .stderr(predicate::str::contains("not a regular file"));
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    raw_cmd()
+        .arg(dir.path())
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("not a regular file"));
+}
+
+/// v(out) of the RC (1 kΩ, 1 µF) rises as 1 − e^(−t/τ): with thresholds
+/// 0.3 / 0.7 it has one rising edge, where it crosses 0.7 at
+/// τ·ln(1/0.3) (≈ 1.204 ms; the stored run samples every 50 µs, and the
+/// crossing is interpolated between samples).
+#[test]
+fn signal_analysis_of_any_raw_file() {
+    let file = data("rc_tran.raw");
+    let out = raw_cmd()
+        .arg(&file)
+        .args(["--signal", "v(out)", "--signal", "v(in)", "--low", "0.3"])
+        .args([
+            "--low", "0.2", "--high", "0.7", "--high", "0.8", "--format", "json",
+        ])
+        .assert()
+        .success();
+    let v: serde_json::Value = serde_json::from_slice(&out.get_output().stdout).unwrap();
+    let probes = v["probes"].as_array().unwrap();
+    assert_eq!(probes.len(), 2);
+    let out_probe = &probes[0];
+    assert_eq!(out_probe["signal"], "v(out)");
+    assert_eq!(out_probe["edges"], 1);
+    assert_eq!(out_probe["glitches"], 0);
+    let t = out_probe["first_edge"].as_f64().unwrap();
+    let expected = 1e-3 * (1.0f64 / 0.3).ln();
+    assert!((t - expected).abs() < 5e-6, "{t} vs {expected}");
+    assert_eq!(out_probe["low"], 0.3);
+    assert_eq!(probes[1]["signal"], "v(in)");
+    assert_eq!(probes[1]["high"], 0.8);
+    assert_eq!(probes[1]["edges"], 1);
+    // The table names the probe and its edges.
+    raw_cmd()
+        .arg(&file)
+        .args(["--signal", "v(out)", "--low", "0.3", "--high", "0.7"])
+        .assert()
+        .success()
+        .stdout(predicate::str::is_match(r"v\(out\)\s+1\s+0\s+1\.20\d\d ms").unwrap());
+}
+
+#[test]
+fn a_threshold_never_crossed_is_a_warning_with_the_range() {
+    raw_cmd()
+        .arg(data("rc_tran.raw"))
+        .args(["--signal", "v(out)", "--low", "2", "--high", "3"])
+        .assert()
+        .success()
+        .stderr(
+            predicate::str::contains("v(out): no edge")
+                .and(predicate::str::contains("range is"))
+                .and(predicate::str::contains("high")),
+        );
+}
+
+#[test]
+fn signal_analysis_errors_exit_2_naming_what_to_fix() {
+    let file = data("rc_tran.raw");
+    raw_cmd()
+        .arg(&file)
+        .args(["--signal", "v(out)"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("--low and --high"));
+    raw_cmd()
+        .arg(&file)
+        .args(["--signal", "v(nowhere)", "--low", "0.3", "--high", "0.7"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("v(nowhere)").and(predicate::str::contains("v(out)")));
+    raw_cmd()
+        .arg(&file)
+        .args(["--signal", "v(out)", "--low", "0.7", "--high", "0.3"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("low < high"));
+    raw_cmd()
+        .arg(&file)
+        .args([
+            "--signal", "v(out)", "--signal", "v(in)", "--low", "1", "--low", "2",
+        ])
+        .args(["--low", "3", "--high", "4"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("3 values of --low for 2 --signal"));
 }

@@ -3,12 +3,12 @@
 //!
 //! CSV: the header row is the vector names; a complex vector becomes two
 //! columns `NAME.re`, `NAME.im` (the AC frequency axis stays one real
-//! column). Values use Rust's `{:e}` formatting: the shortest string that
-//! reads back to the identical `f64` (`1e-3`, `1.5e0`, `0e0`), so output is
-//! byte-identical across runs and platforms and loses nothing. A vector
-//! shorter than the plot (`unpadded`) leaves its cells empty.
+//! column). Values are written by `ryu`: the shortest string that reads
+//! back to the identical `f64` (`0.001`, `1.5`, `0.0`, `1e-7`), so output
+//! is byte-identical across runs and platforms and loses nothing. A
+//! vector shorter than the plot (`unpadded`) leaves its cells empty. Large
+//! binary files are streamed ([`super::stream_csv`]) with the same bytes.
 
-use std::fmt::Write as _;
 use std::io::Write;
 
 use serde::Serialize;
@@ -25,6 +25,8 @@ pub enum ExportError {
     Write(#[from] std::io::Error),
     #[error("cannot write the CSV output: {0}")]
     Csv(#[from] csv::Error),
+    #[error(transparent)]
+    Raw(#[from] super::RawError),
 }
 
 impl ExportError {
@@ -37,7 +39,7 @@ impl ExportError {
                 csv::ErrorKind::Io(e) => Some(e),
                 _ => None,
             },
-            ExportError::NoSuchPlot { .. } => None,
+            ExportError::NoSuchPlot { .. } | ExportError::Raw(_) => None,
         };
         io.is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe)
     }
@@ -54,7 +56,7 @@ pub fn select_plot(raw: &RawFile, index: Option<usize>) -> Result<&Plot, ExportE
 
 /// The CSV cell text of a value (see the module doc).
 pub fn format_value(x: f64) -> String {
-    format!("{x:e}")
+    ryu::Buffer::new().format(x).to_owned()
 }
 
 /// Writes `plot` as CSV.
@@ -76,14 +78,10 @@ pub fn plot_csv<W: Write>(plot: &Plot, out: W) -> Result<(), ExportError> {
     w.write_record(&header)?;
 
     let mut record = csv::ByteRecord::new();
-    let mut cell = String::new();
-    let mut push = |record: &mut csv::ByteRecord, x: Option<f64>| {
-        cell.clear();
-        if let Some(x) = x {
-            // Writing into a String cannot fail.
-            let _ = write!(cell, "{x:e}");
-        }
-        record.push_field(cell.as_bytes());
+    let mut digits = ryu::Buffer::new();
+    let mut push = |record: &mut csv::ByteRecord, x: Option<f64>| match x {
+        Some(x) => record.push_field(digits.format(x).as_bytes()),
+        None => record.push_field(b""),
     };
     for i in 0..plot.points() {
         record.clear();
@@ -207,7 +205,7 @@ mod tests {
         plot_csv(&raw.plots[0], &mut out).unwrap();
         assert_eq!(
             String::from_utf8(out).unwrap(),
-            "frequency,v(out).re,v(out).im\n1e2,5e-1,-2.5e-1\n1e3,1e-1,-2e-1\n"
+            "frequency,v(out).re,v(out).im\n100.0,0.5,-0.25\n1000.0,0.1,-0.2\n"
         );
     }
 

@@ -38,11 +38,18 @@
 //! `Vec` per vector, so memory is the size of the data.
 
 pub mod export;
+mod stream;
+
+pub use stream::stream_csv;
 
 use std::fmt;
 use std::path::{Path, PathBuf};
 
 use thiserror::Error;
+
+/// The largest raw file [`RawFile::read`] loads into memory: 4 GiB. The
+/// values take about as much memory as the file.
+pub const MAX_LOADED_BYTES: u64 = 4 << 30;
 
 /// A complex value of an AC (or other complex) plot.
 pub type Complex64 = nalgebra::Complex<f64>;
@@ -254,11 +261,23 @@ pub enum RawError {
         #[source]
         source: std::io::Error,
     },
-    #[error("{path}: {source}")]
-    InFile {
+    /// `error` in the file at `path`. Not a `source`: the message already
+    /// holds it, and a cause line would repeat it.
+    #[error("{path}: {error}")]
+    InFile { path: PathBuf, error: Box<RawError> },
+    #[error(
+        "{path}: not a regular file: a raw file is read from disk (a device or a pipe could \
+         feed it without end)"
+    )]
+    NotAFile { path: PathBuf },
+    #[error(
+        "{path}: {size} bytes is more than the {limit} bytes this reader loads at once; \
+         `chatterspice raw FILE --format csv` streams binary files of any size"
+    )]
+    TooLarge {
         path: PathBuf,
-        #[source]
-        source: Box<RawError>,
+        size: u64,
+        limit: u64,
     },
     #[error("empty raw file: no plot header found")]
     Empty,
@@ -302,16 +321,32 @@ pub enum RawError {
 }
 
 impl RawFile {
-    /// Reads and parses a raw file; errors name the path.
+    /// Reads and parses a raw file; errors name the path. Only regular
+    /// files of at most [`MAX_LOADED_BYTES`] are read (a device such as
+    /// `/dev/zero` would never end).
     pub fn read(path: impl AsRef<Path>) -> Result<RawFile, RawError> {
         let path = path.as_ref();
-        let bytes = std::fs::read(path).map_err(|source| RawError::Io {
+        let io = |source| RawError::Io {
             path: path.to_path_buf(),
             source,
-        })?;
-        RawFile::parse(&bytes).map_err(|source| RawError::InFile {
+        };
+        let meta = std::fs::metadata(path).map_err(io)?;
+        if !meta.is_file() {
+            return Err(RawError::NotAFile {
+                path: path.to_path_buf(),
+            });
+        }
+        if meta.len() > MAX_LOADED_BYTES {
+            return Err(RawError::TooLarge {
+                path: path.to_path_buf(),
+                size: meta.len(),
+                limit: MAX_LOADED_BYTES,
+            });
+        }
+        let bytes = std::fs::read(path).map_err(io)?;
+        RawFile::parse(&bytes).map_err(|error| RawError::InFile {
             path: path.to_path_buf(),
-            source: Box::new(source),
+            error: Box::new(error),
         })
     }
 

@@ -217,9 +217,12 @@ pub fn render_run(run: &RunResult) -> String {
             }
         }
         if let Some(current) = &a.current {
+            let pulses = a.pulses.unwrap_or(0);
             let _ = writeln!(
                 out,
-                "  peak {} at {}, charge {} ({} while closed)",
+                "  {pulses} pulse{} (2 edges each; glitches count the pulses after the first), \
+                 peak {} at {}, charge {} ({} while closed)",
+                if pulses == 1 { "" } else { "s" },
                 engineering(current.peak, "A"),
                 ms(Some(current.peak_time)),
                 engineering(current.charge, "C"),
@@ -239,6 +242,43 @@ pub fn render_run(run: &RunResult) -> String {
         }
     }
     // Warnings are not part of the table: the CLI prints them on stderr.
+    out
+}
+
+/// Probe analyses alone (`raw --signal`): the probe table of `run`, and
+/// the pulses of current probes.
+pub fn render_probes(probes: &[ProbeAnalysis]) -> String {
+    let mut rows = vec![
+        [
+            "probe",
+            "edges",
+            "glitches",
+            "first edge",
+            "last edge",
+            "shortest pulse",
+            "min",
+            "max",
+        ]
+        .map(String::from),
+    ];
+    for a in probes {
+        rows.push(probe_row(&a.signal, a));
+    }
+    let mut out = align(&rows, 1);
+    for a in probes {
+        if let (Some(pulses), Some(current)) = (a.pulses, &a.current) {
+            let _ = writeln!(
+                out,
+                "{}: {pulses} pulse{} (2 edges each; glitches count the pulses after the \
+                 first), peak {} at {}, charge {}",
+                a.signal,
+                if pulses == 1 { "" } else { "s" },
+                engineering(current.peak, "A"),
+                ms(Some(current.peak_time)),
+                engineering(current.charge, "C"),
+            );
+        }
+    }
     out
 }
 
