@@ -1072,15 +1072,30 @@ impl Check<'_> {
                 "mechanics.force",
                 "give the step closing force in N, or a [coil] section that produces it",
             )),
-            (Some(force), None) => self.number(
-                "mechanics.force",
-                force,
-                force > m.preload,
-                format!(
-                    "must exceed `mechanics.preload` = {:?} N, or the armature never leaves its rest stop",
-                    m.preload
-                ),
-            ),
+            (Some(force), None) => {
+                self.number(
+                    "mechanics.force",
+                    force,
+                    force >= 0.0,
+                    "must be ≥ 0: the step closing force, in N",
+                )?;
+                // The preload holds the armature only while it rests on its
+                // stop: one that starts off it, or moving toward the
+                // contact, flies whatever the force (a free impact).
+                let at_rest = m.initial_position <= 0.0 && m.initial_velocity <= 0.0;
+                self.number(
+                    "mechanics.force",
+                    force,
+                    force > m.preload || !at_rest,
+                    format!(
+                        "must exceed `mechanics.preload` = {:?} N for an armature that starts at \
+                         rest on its stop, or it never leaves it; for a free impact start it \
+                         off the stop (`mechanics.initial_position` > 0) or moving toward the \
+                         contact (`mechanics.initial_velocity` > 0)",
+                        m.preload
+                    ),
+                )
+            }
             (None, Some(c)) => self.coil(c, m.gap),
         }
     }
