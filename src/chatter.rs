@@ -23,6 +23,9 @@ pub enum Outcome {
     EndsOpen,
     /// Still chattering at `t_end`.
     EndOfTime,
+    /// Still chattering after [`crate::mechanics::MAX_EVENTS`] impacts: the
+    /// sequence is cut there (an undamped or perfectly elastic model).
+    EventLimit,
 }
 
 impl Outcome {
@@ -34,6 +37,7 @@ impl Outcome {
             Outcome::NeverCloses => "never_closes",
             Outcome::EndsOpen => "ends_open",
             Outcome::EndOfTime => "end_of_time",
+            Outcome::EventLimit => "event_limit",
         }
     }
 

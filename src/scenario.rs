@@ -952,6 +952,27 @@ impl Check<'_> {
         }
     }
 
+    /// The range of numbers a relay model can mean (see [`ENVELOPE`]):
+    /// beyond it the numbers overflow or the simulation never ends.
+    fn envelope(&self, key: &str, value: Option<f64>) -> Result<(), ScenarioError> {
+        let Some(value) = value else { return Ok(()) };
+        let Some(&(_, lo, hi, unit)) = ENVELOPE.iter().find(|(k, ..)| key.ends_with(k)) else {
+            return Ok(());
+        };
+        // Non-finite values get the key's own "must be finite" message.
+        if !value.is_finite() || (lo..=hi).contains(&value) {
+            return Ok(());
+        }
+        Err(self.invalid(
+            key,
+            value,
+            format!(
+                "must lie within [{lo:e}, {hi:e}] {unit}: outside that no relay is modelled, and \
+                 the simulation's numbers would overflow or never end"
+            ),
+        ))
+    }
+
     fn not_empty(&self, key: &str, value: &str, help: &'static str) -> Result<(), ScenarioError> {
         if value.trim().is_empty() {
             return Err(ScenarioError::Empty {
@@ -1055,7 +1076,20 @@ impl Check<'_> {
             m.preload,
             m.preload >= 0.0,
             "must be ≥ 0: the return spring holds the armature on its rest stop",
-        )
+        )?;
+        for (key, value) in [
+            ("mechanics.mass", Some(m.mass)),
+            ("mechanics.stiffness", Some(m.stiffness)),
+            ("mechanics.damping", Some(m.damping)),
+            ("mechanics.force", m.force),
+            ("mechanics.gap", Some(m.gap)),
+            ("mechanics.initial_position", Some(m.initial_position)),
+            ("mechanics.initial_velocity", Some(m.initial_velocity)),
+            ("mechanics.preload", Some(m.preload)),
+        ] {
+            self.envelope(key, value)?;
+        }
+        Ok(())
     }
 
     /// Exactly one of a step force and a coil.
@@ -1138,6 +1172,19 @@ impl Check<'_> {
     }
 
     fn surface(&self, section: &str, s: &SurfaceSection) -> Result<Surface, ScenarioError> {
+        let law = self.surface_law(section, s)?;
+        for (name, value) in [
+            ("stiffness", s.stiffness),
+            ("damping", s.damping),
+            ("chi", s.chi),
+            ("reference_velocity", s.reference_velocity),
+        ] {
+            self.envelope(&format!("{section}.{name}"), value)?;
+        }
+        Ok(law)
+    }
+
+    fn surface_law(&self, section: &str, s: &SurfaceSection) -> Result<Surface, ScenarioError> {
         let law = s.law;
         let given = [
             ("stiffness", s.stiffness),
@@ -1370,7 +1417,15 @@ impl Check<'_> {
             s.min_gap,
             s.min_gap >= 0.0,
             "must be ≥ 0: the smallest opening worth resolving, in m",
-        )
+        )?;
+        for (key, value) in [
+            ("simulation.t_end", s.t_end),
+            ("simulation.min_open_time", s.min_open_time),
+            ("simulation.min_gap", s.min_gap),
+        ] {
+            self.envelope(key, Some(value))?;
+        }
+        Ok(())
     }
 
     fn circuit(&self, c: &CircuitSection) -> Result<(), ScenarioError> {
@@ -1791,6 +1846,28 @@ macro_rules! number_field {
         }
     }};
 }
+
+/// The widest range of each number that still describes a relay, far
+/// beyond any real one, so that every simulation stays finite and ends:
+/// (key or key suffix, lowest, highest, unit). The other rules (> 0,
+/// below the gap, ...) apply on top.
+pub const ENVELOPE: &[(&str, f64, f64, &str)] = &[
+    ("mechanics.mass", 0.0, 1e3, "kg"),
+    ("mechanics.stiffness", 0.0, 1e12, "N/m"),
+    ("mechanics.damping", 0.0, 1e9, "N·s/m"),
+    ("mechanics.force", -1e9, 1e9, "N"),
+    ("mechanics.gap", 0.0, 1.0, "m"),
+    ("mechanics.initial_position", -1.0, 1.0, "m"),
+    ("mechanics.initial_velocity", -1e4, 1e4, "m/s"),
+    ("mechanics.preload", 0.0, 1e9, "N"),
+    (".stiffness", 1e-6, 1e20, "N/m or N/mⁿ"),
+    (".damping", 0.0, 1e12, "N·s/m"),
+    (".chi", 0.0, 1e6, "s/m"),
+    (".reference_velocity", 0.0, 1e4, "m/s"),
+    ("simulation.t_end", 0.0, 1e6, "s"),
+    ("simulation.min_open_time", 0.0, 1.0, "s"),
+    ("simulation.min_gap", 0.0, 1.0, "m"),
+];
 
 /// Number keys under this prefix name a `.param` of the netlist.
 const PARAMS_PREFIX: &str = "circuit.params.";

@@ -576,3 +576,35 @@ fn jobs_bound_the_ngspice_processes_at_once() {
         assert_eq!(header.contains("v(in).ideal_edges"), ideal, "{header}");
     }
 }
+
+/// A sweep too big to finish is refused before it starts, naming what
+/// made it so.
+#[test]
+fn a_sweep_of_a_billion_samples_is_refused_up_front() {
+    let dir = tempfile::tempdir().unwrap();
+    let grid = "[sweep.grid]\n\"mechanics.mass\" = { from = 1e-4, to = 3e-4, steps = 40000 }\n\
+                \"surface.damping\" = { from = 1.0, to = 3.0, steps = 25000 }";
+    let s = scenario(dir.path(), grid);
+    chatterspice()
+        .arg("sweep")
+        .arg(&s)
+        .args(["--mechanics-only", "--out"])
+        .arg(dir.path().join("out"))
+        .timeout(std::time::Duration::from_secs(10))
+        .assert()
+        .code(2)
+        .stderr(
+            predicate::str::contains("1000000000 samples")
+                .and(predicate::str::contains("[sweep.grid]")),
+        );
+    let s = scenario(dir.path(), VARY);
+    chatterspice()
+        .arg("sweep")
+        .arg(&s)
+        .args(["--mechanics-only", "--samples", "1000000000", "--out"])
+        .arg(dir.path().join("out2"))
+        .timeout(std::time::Duration::from_secs(10))
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("--samples"));
+}

@@ -131,6 +131,14 @@ fn random_relays_give_consistent_sequences() {
                 )
             }
             Outcome::EndOfTime => assert!(c.settle_time.is_none(), "{ctx}"),
+            Outcome::EventLimit => {
+                assert!(c.settle_time.is_none(), "{ctx}");
+                assert_eq!(
+                    c.impacts.len(),
+                    chatterspice::mechanics::MAX_EVENTS,
+                    "{ctx}"
+                );
+            }
         }
         let openings = c
             .intervals

@@ -445,6 +445,12 @@ impl<D: Drive> Sim<'_, D> {
         let g = self.model.g();
         let mut t = 0.0;
         loop {
+            let events = self.rec.make.impacts.len() + self.rec.back.impacts.len();
+            if events >= crate::mechanics::MAX_EVENTS {
+                return Err(
+                    crate::mechanics::MechanicsError::TooManyEvents { time: t, events }.into(),
+                );
+            }
             let (event, te, mut ye) = self.phase(phase, t, y)?;
             let rec = &mut self.rec;
             if rec.path.last().is_none_or(|&(tp, _)| te > tp) {

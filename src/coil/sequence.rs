@@ -681,6 +681,13 @@ impl<D: Drive> Sequence<'_, D> {
                 }
             }
             let v_hit = y_hit[1];
+            if self.rec.impacts.len() >= crate::mechanics::MAX_EVENTS {
+                return Err(crate::mechanics::MechanicsError::TooManyEvents {
+                    time: t_hit,
+                    events: self.rec.impacts.len(),
+                }
+                .into());
+            }
             self.rec.intervals.push(Interval {
                 state: ContactState::Open,
                 start: open_since,

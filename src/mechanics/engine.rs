@@ -208,6 +208,9 @@ impl<'a> Engine<'a> {
         let (mut t, mut x, mut v) = (0.0, m.initial_position, m.initial_velocity);
         let mut open_since = 0.0;
         loop {
+            if self.impacts.len() >= super::MAX_EVENTS {
+                return Ok(self.finish_open(Outcome::EventLimit, open_since, None));
+            }
             // Flight from (t, x, v).
             let piece = self.flight(x, v);
             let hit = piece.crossing(g, true);
@@ -344,7 +347,8 @@ impl<'a> Engine<'a> {
         Chatter {
             outcome,
             first_impact: self.impacts.first().map(|i| i.impact_time),
-            settle_time: (outcome != Outcome::EndOfTime).then_some(since),
+            settle_time: (outcome != Outcome::EndOfTime && outcome != Outcome::EventLimit)
+                .then_some(since),
             bounce_count,
             impacts: self.impacts,
             intervals,

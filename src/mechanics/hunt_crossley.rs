@@ -189,7 +189,15 @@ impl HcContact {
         // negative. The largest step-end force also counts, as a guard.
         let mut peak_force: f64 = 0.0;
         let mut peak_found = false;
+        let mut steps = 0usize;
         loop {
+            steps += 1;
+            if steps > super::MAX_CONTACT_STEPS {
+                return Err(MechanicsError::ContactTooLong {
+                    time: solver.y()[2],
+                    steps: super::MAX_CONTACT_STEPS,
+                });
+            }
             let step = match solver.step(f64::INFINITY) {
                 Ok(step) => step,
                 // Report the physical time, not the fictitious one.

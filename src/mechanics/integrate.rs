@@ -69,6 +69,12 @@ where
 /// shrunk it to rounding level before getting there.
 #[inline(always)]
 pub(crate) fn trial_step(h: f64, t: f64, t_stop: f64) -> Result<(f64, bool), MechanicsError> {
+    // A step that is not a positive finite number (the state overflowed,
+    // or an open-ended integration was handed one) would repeat forever:
+    // `min` drops a NaN, and 0.1 × ∞ is ∞.
+    if !(h.is_finite() && h > 0.0 && t.is_finite()) {
+        return Err(MechanicsError::StepSizeTooSmall { time: t, step: h });
+    }
     let mut h = h.min(t_stop - t);
     let last = h >= t_stop - t;
     if last {

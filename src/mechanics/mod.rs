@@ -163,4 +163,26 @@ pub enum MechanicsError {
          check `surface.stiffness` and `surface.chi`"
     )]
     StepSizeTooSmall { time: f64, step: f64 },
+    #[error(
+        "one contact took more than {steps} integration steps (t = {time} s) without ending: \
+         the surface law's time scale is far from the armature's — check `surface.stiffness`, \
+         `surface.chi` and `mechanics.force`"
+    )]
+    ContactTooLong { time: f64, steps: usize },
+    #[error(
+        "more than {events} impacts by t = {time} s: the armature would chatter without end \
+         (restitution near 1, or no damping); add damping, or raise \
+         `simulation.min_open_time` / `simulation.min_gap` to end it as resolved"
+    )]
+    TooManyEvents { time: f64, events: usize },
 }
+
+/// The most impacts one simulation records. A real relay makes tens; an
+/// undamped or perfectly elastic model makes them without end, and a
+/// sequence stops here with outcome `event_limit` (about 70 MB of
+/// results at the cap).
+pub const MAX_EVENTS: usize = 100_000;
+
+/// The most integration steps one contact of a nonlinear surface takes
+/// before it is given up as unphysical.
+pub const MAX_CONTACT_STEPS: usize = 2_000_000;

@@ -370,6 +370,7 @@ fn explain(outcome: Outcome) -> &'static str {
         Outcome::NeverCloses => "the contacts never touch",
         Outcome::EndsOpen => "touched, but the contact ends open",
         Outcome::EndOfTime => "still bouncing at the end of the simulation",
+        Outcome::EventLimit => "still bouncing after 100 000 impacts: the model has no losses",
     }
 }
 

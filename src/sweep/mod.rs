@@ -67,6 +67,17 @@ pub enum SweepError {
     SamplesWithGrid { path: PathBuf, samples: u64 },
     #[error("{}: a sweep needs at least one sample; give --samples 1 or more", path.display())]
     NoSamples { path: PathBuf },
+    #[error(
+        "{}: {count} samples ({what}) is more than the {limit} one sweep runs; \
+         use fewer, or run the study as several sweeps",
+        path.display(),
+        limit = sample::MAX_SAMPLES
+    )]
+    TooManySamples {
+        path: PathBuf,
+        count: u64,
+        what: &'static str,
+    },
     #[error("{}: `{key}` has no value in the scenario to vary around; set it", path.display())]
     NoNominal { path: PathBuf, key: String },
     #[error(
