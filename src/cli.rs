@@ -189,6 +189,11 @@ pub struct SimulatorArgs {
 }
 
 impl SimulatorArgs {
+    /// `--timeout`, which covers the version check too.
+    fn timeout(&self) -> Duration {
+        Duration::from_secs_f64(self.timeout)
+    }
+
     /// The run options these arguments set; the rest default.
     fn run_options(&self) -> RunOptions {
         RunOptions {
@@ -337,7 +342,8 @@ fn run(args: &RunArgs) -> Result<()> {
         refuse_existing_bundle(dir, args.force)?;
     }
     let scenario = load_scenario(args.scenario.as_deref())?;
-    let ngspice = Ngspice::locate(args.simulator.ngspice.as_deref())?;
+    let ngspice =
+        Ngspice::locate_within(args.simulator.ngspice.as_deref(), args.simulator.timeout())?;
     let options = RunOptions {
         keep_workdir: args.keep_workdir,
         compare_ideal: !args.no_ideal,
@@ -387,13 +393,17 @@ fn check(args: &CheckArgs) -> Result<Status> {
         let intervals = read_measured(csv)?;
         let probe_limits = scenario.probes.iter().any(|p| p.has_limits());
         if probe_limits {
-            let ngspice = Ngspice::locate(args.simulator.ngspice.as_deref())?;
+            let ngspice = Ngspice::locate_within(
+                args.simulator.ngspice.as_deref(),
+                args.simulator.timeout(),
+            )?;
             check::measured(&scenario, intervals, Some(&ngspice), &options)?
         } else {
             check::measured(&scenario, intervals, None, &options)?
         }
     } else if needs_ngspice {
-        let ngspice = Ngspice::locate(args.simulator.ngspice.as_deref())?;
+        let ngspice =
+            Ngspice::locate_within(args.simulator.ngspice.as_deref(), args.simulator.timeout())?;
         check::run_with(&scenario, &ngspice, &options)?
     } else {
         // The relay's limits alone: no circuit, no ngspice needed.
@@ -419,6 +429,7 @@ fn check(args: &CheckArgs) -> Result<Status> {
 
 /// A measured chatter record (`--measured CSV`): its open/closed intervals.
 fn read_measured(csv: &Path) -> Result<Vec<chatterspice::chatter::Interval>> {
+    report::protect_input(csv);
     let text = std::fs::read_to_string(csv)
         .with_context(|| format!("{}: cannot read the measured chatter", csv.display()))?;
     Ok(read_state_csv(&text, csv)?)
@@ -437,9 +448,6 @@ fn warn_if_no_fonts() {
 /// Fail before any work if `--out DIR` already holds a file the run
 /// would write.
 fn refuse_existing_bundle(dir: &Path, force: bool) -> Result<()> {
-    if force {
-        return Ok(());
-    }
     let names = [
         "report.json",
         "waveforms.csv",
@@ -448,6 +456,16 @@ fn refuse_existing_bundle(dir: &Path, force: bool) -> Result<()> {
         "plot.svg",
         "plot.png",
     ];
+    if let Some(input) = names
+        .iter()
+        .map(|n| dir.join(n))
+        .find(|p| report::is_input(p))
+    {
+        return Err(report::WriteError::IsInput { path: input }.into());
+    }
+    if force {
+        return Ok(());
+    }
     if let Some(existing) = names.iter().map(|n| dir.join(n)).find(|p| p.exists()) {
         bail!(
             "{}: already exists; pass --force to overwrite the files in {}, or choose another --out",
@@ -511,6 +529,18 @@ fn pwl(args: &PwlArgs) -> Result<()> {
 
 /// The named scenario file, stdin for `-`, or the built-in default.
 fn load_scenario(path: Option<&Path>) -> Result<Scenario> {
+    let scenario = read_scenario(path)?;
+    // Outputs never replace what the run reads.
+    if let Some(p) = path.filter(|p| *p != Path::new("-")) {
+        report::protect_input(p);
+    }
+    if let Some(circuit) = &scenario.circuit {
+        report::protect_input(&circuit.netlist);
+    }
+    Ok(scenario)
+}
+
+fn read_scenario(path: Option<&Path>) -> Result<Scenario> {
     match path {
         None => Ok(Scenario::builtin_default()),
         Some(p) if p == Path::new("-") => {
@@ -531,6 +561,12 @@ fn refuse_existing(output: Option<&Path>, force: bool) -> Result<()> {
     let Some(path) = output else {
         return Ok(());
     };
+    if report::is_input(path) {
+        return Err(report::WriteError::IsInput {
+            path: path.to_owned(),
+        }
+        .into());
+    }
     if !force && path.symlink_metadata().is_ok() {
         bail!(
             "{}: already exists; pass --force to overwrite it, or choose another file",
@@ -682,7 +718,10 @@ fn sweep(args: &SweepArgs) -> Result<Status> {
     let ngspice = if args.mechanics_only {
         None
     } else {
-        Some(Ngspice::locate(args.simulator.ngspice.as_deref())?)
+        Some(Ngspice::locate_within(
+            args.simulator.ngspice.as_deref(),
+            args.simulator.timeout(),
+        )?)
     };
     let mut options = SweepOptions::new(match &ngspice {
         Some(n) => Mode::Circuit(n),

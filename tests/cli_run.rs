@@ -454,3 +454,128 @@ fn warnings_go_to_stderr_not_into_the_table() {
         assert!(stderr.contains(".control"), "{format}: {stderr}");
     }
 }
+
+/// `--force` overwrites earlier outputs, never an input: not the scenario
+/// (`pwl -o`), not a netlist kept in the output directory (`run --out`).
+#[test]
+fn force_never_overwrites_an_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    std::fs::copy(
+        root.join("netlists/mcu_input.cir"),
+        dir.path().join("netlist.cir"),
+    )
+    .unwrap();
+    let scenario = chatterspice::scenario::DEFAULT_SCENARIO_TOML
+        .replace("../netlists/mcu_input.cir", "netlist.cir");
+    let path = dir.path().join("relay.toml");
+    std::fs::write(&path, &scenario).unwrap();
+    let netlist = std::fs::read(dir.path().join("netlist.cir")).unwrap();
+    Command::cargo_bin("chatterspice")
+        .unwrap()
+        .args([
+            "pwl",
+            path.to_str().unwrap(),
+            "-o",
+            path.to_str().unwrap(),
+            "--force",
+        ])
+        .assert()
+        .code(2)
+        .stderr(predicates::str::contains("input"));
+    // The same file by another name.
+    let other = dir.path().join(".").join("relay.toml");
+    Command::cargo_bin("chatterspice")
+        .unwrap()
+        .current_dir(dir.path())
+        .args([
+            "pwl",
+            "relay.toml",
+            "-o",
+            other.to_str().unwrap(),
+            "--force",
+        ])
+        .assert()
+        .code(2);
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), scenario);
+    Command::cargo_bin("chatterspice")
+        .unwrap()
+        .args(["run", path.to_str().unwrap(), "--force", "--out"])
+        .arg(dir.path())
+        .assert()
+        .code(2)
+        .stderr(predicates::str::contains("netlist.cir"));
+    assert_eq!(
+        std::fs::read(dir.path().join("netlist.cir")).unwrap(),
+        netlist
+    );
+}
+
+fn script(dir: &std::path::Path, name: &str, body: &str) -> std::path::PathBuf {
+    use std::os::unix::fs::PermissionsExt;
+    let path = dir.join(name);
+    std::fs::write(&path, format!("#!/bin/sh\n{body}")).unwrap();
+    std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).unwrap();
+    path
+}
+
+/// `--timeout` covers the version check, and a wrapper that does not
+/// `exec` ngspice is killed with everything it started.
+#[test]
+fn the_timeout_covers_the_version_check_and_kills_the_wrapper_s_children() {
+    let dir = tempfile::tempdir().unwrap();
+    let hangs = script(dir.path(), "hangs.sh", "sleep 30\n");
+    let started = std::time::Instant::now();
+    Command::cargo_bin("chatterspice")
+        .unwrap()
+        .args(["run", "--timeout", "1", "--ngspice"])
+        .arg(&hangs)
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("did not finish within"));
+    assert!(started.elapsed().as_secs() < 15, "{:?}", started.elapsed());
+
+    // Answers the version check, then hangs in a child of its own.
+    let _ng = ngspice_or_skip!();
+    let pids = dir.path().join("pids");
+    let body = format!(
+        "if [ \"$1\" = -v ]; then exec ngspice -v; fi\nsleep 60 &\necho $! >> '{}'\nwait\n",
+        pids.display()
+    );
+    let wrapper = script(dir.path(), "wrapper.sh", &body);
+    Command::cargo_bin("chatterspice")
+        .unwrap()
+        .args(["run", "--no-ideal", "--timeout", "2", "--ngspice"])
+        .arg(&wrapper)
+        .assert()
+        .code(2);
+    let pid = std::fs::read_to_string(&pids).unwrap();
+    // Gone, or a zombie waiting for init to reap it: not running.
+    let stat = std::fs::read_to_string(format!("/proc/{}/stat", pid.trim())).unwrap_or_default();
+    let state = stat
+        .rsplit(')')
+        .next()
+        .unwrap_or("")
+        .split_whitespace()
+        .next();
+    assert!(
+        matches!(state, None | Some("Z") | Some("X")),
+        "the wrapper's child {} outlived the timeout: {stat}",
+        pid.trim()
+    );
+}
+
+/// A relative `--ngspice ./x.sh` is the current directory's, not the work
+/// directory's.
+#[test]
+fn a_relative_ngspice_path_is_the_current_directory_s() {
+    let _ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    script(dir.path(), "my-ngspice.sh", "exec ngspice \"$@\"\n");
+    Command::cargo_bin("chatterspice")
+        .unwrap()
+        .current_dir(dir.path())
+        .args(["run", "--no-ideal", "--ngspice", "./my-ngspice.sh"])
+        .assert()
+        .success();
+}

@@ -52,12 +52,54 @@ pub fn render(format: Format, chatter: &Chatter, dimensionless: Option<&Dimensio
 pub enum WriteError {
     #[error("{}: already exists; it was left untouched", path.display())]
     Exists { path: PathBuf },
+    #[error(
+        "{}: this is an input of the run (the scenario, its netlist or a record); \
+         --force overwrites earlier outputs, never inputs: choose another output",
+        path.display()
+    )]
+    IsInput { path: PathBuf },
     #[error("{}: cannot write the report", path.display())]
     Io {
         path: PathBuf,
         #[source]
         source: std::io::Error,
     },
+}
+
+/// The files this process read as inputs; [`write_new_file`] refuses to
+/// write over any of them, even when told to overwrite.
+static INPUTS: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+/// Mark `path` as an input: no report is ever written over it.
+pub fn protect_input(path: &Path) {
+    if let Some(id) = identity(path) {
+        INPUTS.lock().unwrap_or_else(|e| e.into_inner()).push(id);
+    }
+}
+
+/// Whether `path` names a file marked with [`protect_input`] (by another
+/// name too: through `..`, a symbolic link or a relative path).
+pub fn is_input(path: &Path) -> bool {
+    identity(path).is_some_and(|id| {
+        INPUTS
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .contains(&id)
+    })
+}
+
+/// The canonical path of `path`, or of its directory joined with its name
+/// when the file does not exist yet.
+fn identity(path: &Path) -> Option<PathBuf> {
+    if let Ok(p) = path.canonicalize() {
+        return Some(p);
+    }
+    let name = path.file_name()?;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    dir.canonicalize().ok().map(|d| d.join(name))
 }
 
 /// Write several report files into `dir`, creating it if needed. Unless
@@ -74,6 +116,13 @@ pub fn write_bundle(
         path: dir.to_owned(),
         source,
     })?;
+    if let Some(path) = files
+        .iter()
+        .map(|(name, _)| dir.join(name))
+        .find(|p| is_input(p))
+    {
+        return Err(WriteError::IsInput { path });
+    }
     if !overwrite {
         if let Some(path) = files
             .iter()
@@ -99,6 +148,11 @@ pub fn write_new_file(path: &Path, contents: &[u8], overwrite: bool) -> Result<(
         path: path.to_owned(),
         source,
     };
+    if is_input(path) {
+        return Err(WriteError::IsInput {
+            path: path.to_owned(),
+        });
+    }
     // Checked up front too, so that an existing file is reported as such
     // even where the temporary file could not be created.
     if !overwrite && path.symlink_metadata().is_ok() {

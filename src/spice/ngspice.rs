@@ -44,6 +44,15 @@ impl Ngspice {
     /// Finds ngspice: `explicit`, else `$CHATTERSPICE_NGSPICE`, else `PATH`;
     /// then asks it for its version.
     pub fn locate(explicit: Option<&Path>) -> Result<Ngspice, SpiceError> {
+        Ngspice::locate_within(explicit, VERSION_TIMEOUT)
+    }
+
+    /// [`Ngspice::locate`], its version check killed after `timeout` (a
+    /// wrapper script that hangs fails here, not after minutes).
+    pub fn locate_within(
+        explicit: Option<&Path>,
+        timeout: Duration,
+    ) -> Result<Ngspice, SpiceError> {
         let requested = match explicit {
             Some(p) => p.to_path_buf(),
             None => match std::env::var_os(ENV_VAR) {
@@ -52,7 +61,7 @@ impl Ngspice {
             },
         };
         let program = resolve(&requested)?;
-        let version = probe_version(&program)?;
+        let version = probe_version(&program, timeout)?;
         Ok(Ngspice {
             program,
             version,
@@ -82,11 +91,14 @@ impl Ngspice {
 }
 
 /// A bare name is looked up on `PATH` here, so "not found" is decided (and
-/// reported) before any work directory exists.
+/// reported) before any work directory exists. A relative path (`./x.sh`)
+/// is made absolute against the current directory: runs start ngspice in
+/// a work directory of their own.
 fn resolve(program: &Path) -> Result<PathBuf, SpiceError> {
     if program.components().count() > 1 || program.is_absolute() {
-        return if program.is_file() {
-            Ok(program.to_path_buf())
+        let absolute = std::path::absolute(program).unwrap_or_else(|_| program.to_path_buf());
+        return if absolute.is_file() {
+            Ok(absolute)
         } else {
             Err(SpiceError::NotFound {
                 program: program.to_path_buf(),
@@ -104,14 +116,29 @@ fn resolve(program: &Path) -> Result<PathBuf, SpiceError> {
         })
 }
 
-fn probe_version(program: &Path) -> Result<Option<String>, SpiceError> {
+/// How long [`Ngspice::locate`] waits for `ngspice -v`.
+pub const VERSION_TIMEOUT: Duration = Duration::from_secs(20);
+
+fn probe_version(program: &Path, timeout: Duration) -> Result<Option<String>, SpiceError> {
     let mut cmd = Command::new(program);
     cmd.arg("-v");
-    let finished =
-        run_child(cmd, Duration::from_secs(20)).map_err(|source| SpiceError::NotFound {
+    let finished = run_child(cmd, timeout).map_err(|source| SpiceError::NotFound {
+        program: program.to_path_buf(),
+        source,
+    })?;
+    if finished.status.is_none() {
+        return Err(SpiceError::NotFound {
             program: program.to_path_buf(),
-            source,
-        })?;
+            source: io::Error::new(
+                io::ErrorKind::TimedOut,
+                format!(
+                    "`{} -v` did not finish within {:.3} s (--timeout) and was killed",
+                    program.display(),
+                    timeout.as_secs_f64()
+                ),
+            ),
+        });
+    }
     Ok(parse_version(&finished.log))
 }
 
@@ -281,6 +308,10 @@ pub(crate) fn run_child(mut cmd: Command, timeout: Duration) -> io::Result<Finis
     cmd.stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
+    // Its own process group, so that the deadline kills whatever it
+    // started too (a wrapper script that does not `exec` ngspice).
+    #[cfg(unix)]
+    std::os::unix::process::CommandExt::process_group(&mut cmd, 0);
     let started = Instant::now();
     let mut child = cmd.spawn()?;
     let (tx, rx) = mpsc::channel::<Option<String>>();
@@ -343,6 +374,15 @@ pub(crate) fn run_child(mut cmd: Command, timeout: Duration) -> io::Result<Finis
 }
 
 fn kill_and_reap(child: &mut Child) -> io::Result<()> {
+    // The whole group: the child leads it (see `run_child`).
+    #[cfg(unix)]
+    if let Ok(pid) = i32::try_from(child.id()) {
+        // SAFETY: kill(2) with a negative pid signals that process group;
+        // it reads no memory of ours.
+        unsafe {
+            libc::kill(-pid, libc::SIGKILL);
+        }
+    }
     match child.kill() {
         Ok(()) => {}
         // Exited between try_wait and kill: still reap below.
