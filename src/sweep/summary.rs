@@ -6,9 +6,9 @@
 //! the rows themselves), in index order; [`Collected::summary`] reduces
 //! them. Quantiles are nearest-rank: the p-quantile of n sorted values is
 //! the value at rank ⌈p·n⌉, so it is always one of the samples. The worst
-//! sample, among those that ran, is the one with the highest
-//! (failed a limit, did not end closed, edges over all probes, bounce
-//! time), the lowest index on a tie.
+//! sample is the one with the highest (could not run, failed a limit, did
+//! not end closed, edges over all probes, bounce time), the lowest index
+//! on a tie: a sample that errored outranks any that ran.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -37,6 +37,8 @@ pub struct Collected {
     pub bounce_time: Vec<Option<f64>>,
     /// s
     pub settle_time: Vec<Option<f64>>,
+    /// s, a coil-driven relay's longest release time.
+    pub release_time: Vec<Option<f64>>,
     /// `[probe][sample]`
     pub edges: Vec<Vec<Option<u32>>>,
     /// `[probe][sample]`, max |value|.
@@ -69,6 +71,7 @@ impl Collected {
             .push(r.bounce_count.map(|n| u32::try_from(n).unwrap_or(u32::MAX)));
         self.bounce_time.push(r.bounce_time);
         self.settle_time.push(r.settle_time);
+        self.release_time.push(r.release_time);
         for (p, (edges, peak)) in self.edges.iter_mut().zip(&mut self.peak).enumerate() {
             let probe = r.probes.get(p);
             edges.push(probe.map(|x| u32::try_from(x.edges).unwrap_or(u32::MAX)));
@@ -163,6 +166,7 @@ impl Collected {
             ),
             bounce_time: Distribution::of(self.bounce_time.iter().flatten().copied()),
             settle_time: Distribution::of(self.settle_time.iter().flatten().copied()),
+            release_time: Distribution::of(self.release_time.iter().flatten().copied()),
             probes,
             worst,
             first_errors: self
@@ -176,7 +180,7 @@ impl Collected {
         })
     }
 
-    /// The position of the worst sample that ran (see the module overview).
+    /// The position of the worst sample (see the module overview).
     fn worst(&self) -> Option<usize> {
         let key = |i: usize| {
             let edges: u64 = self
@@ -185,22 +189,20 @@ impl Collected {
                 .map(|e| u64::from(e[i].unwrap_or(0)))
                 .sum();
             (
+                self.verdict[i] == Verdict::Error,
                 self.verdict[i] == Verdict::Fail,
                 !self.outcome[i].is_some_and(Outcome::is_closed),
                 edges,
                 self.bounce_time[i].unwrap_or(0.0),
             )
         };
-        let mut best: Option<(usize, (bool, bool, u64, f64))> = None;
+        let mut best: Option<(usize, (bool, bool, bool, u64, f64))> = None;
         for i in 0..self.len() {
-            if self.verdict[i] == Verdict::Error {
-                continue;
-            }
             let k = key(i);
             let better = best.as_ref().is_none_or(|(_, b)| {
-                (k.0, k.1, k.2)
-                    .cmp(&(b.0, b.1, b.2))
-                    .then(k.3.total_cmp(&b.3))
+                (k.0, k.1, k.2, k.3)
+                    .cmp(&(b.0, b.1, b.2, b.3))
+                    .then(k.4.total_cmp(&b.4))
                     == std::cmp::Ordering::Greater
             });
             if better {
@@ -307,6 +309,8 @@ pub struct Summary {
     pub bounce_time: Option<Distribution>,
     /// s
     pub settle_time: Option<Distribution>,
+    /// s, coil off → the NO contact opens (a coil-driven relay only).
+    pub release_time: Option<Distribution>,
     pub probes: Vec<ProbeSummary>,
     pub worst: Option<Worst>,
     /// The first few errors.
@@ -351,34 +355,44 @@ impl Summary {
         for (key, f) in &self.limits {
             let _ = writeln!(
                 out,
-                "  {key}: failed by {} ({:.1} %)",
+                "  {key}: {} sample{} failed it ({:.1} %)",
                 f.failing,
+                if f.failing == 1 { "" } else { "s" },
                 100.0 * f.fraction
             );
         }
+        let mut rows: Vec<(String, &Option<Distribution>, &str)> = vec![
+            ("bounces".to_owned(), &self.bounce_count, ""),
+            ("bounce time".to_owned(), &self.bounce_time, "s"),
+            ("settle time".to_owned(), &self.settle_time, "s"),
+            ("release time".to_owned(), &self.release_time, "s"),
+        ];
+        for p in &self.probes {
+            rows.push((format!("{} edges", p.signal), &p.edges, ""));
+            rows.push((format!("{} peak", p.signal), &p.peak, ""));
+        }
+        rows.retain(|(_, d, _)| d.is_some());
+        // The name column fits the longest probe name.
+        let width = rows
+            .iter()
+            .map(|(n, ..)| n.chars().count() + 2)
+            .fold(16, usize::max);
         let _ = writeln!(
             out,
-            "\n{:<16}{:>12}{:>12}{:>12}{:>12}",
+            "\n{:<width$}{:>12}{:>12}{:>12}{:>12}",
             "", "min", "median", "p95", "max"
         );
-        let mut row = |name: &str, d: &Option<Distribution>, unit: &str| {
+        for (name, d, unit) in &rows {
             if let Some(d) = d {
                 let _ = writeln!(
                     out,
-                    "{name:<16}{:>12}{:>12}{:>12}{:>12}",
+                    "{name:<width$}{:>12}{:>12}{:>12}{:>12}",
                     eng(d.min, unit),
                     eng(d.median, unit),
                     eng(d.p95, unit),
                     eng(d.max, unit)
                 );
             }
-        };
-        row("bounces", &self.bounce_count, "");
-        row("bounce time", &self.bounce_time, "s");
-        row("settle time", &self.settle_time, "s");
-        for p in &self.probes {
-            row(&format!("{} edges", p.signal), &p.edges, "");
-            row(&format!("{} peak", p.signal), &p.peak, "");
         }
         if let Some(w) = &self.worst {
             let values = w
