@@ -22,6 +22,10 @@ use super::sample::Sampler;
 use super::verdict::Verdict;
 use super::{Record, SweepError};
 
+/// How bad a sample is, compared field by field: (could not run, failed a
+/// limit, did not end closed, edges, bounce time).
+type Badness = (bool, bool, bool, u64, f64);
+
 /// How many error messages the summary quotes.
 const QUOTED_ERRORS: usize = 5;
 
@@ -196,7 +200,7 @@ impl Collected {
                 self.bounce_time[i].unwrap_or(0.0),
             )
         };
-        let mut best: Option<(usize, (bool, bool, bool, u64, f64))> = None;
+        let mut best: Option<(usize, Badness)> = None;
         for i in 0..self.len() {
             let k = key(i);
             let better = best.as_ref().is_none_or(|(_, b)| {
