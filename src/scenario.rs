@@ -528,10 +528,15 @@ pub enum ScenarioError {
         problem: String,
     },
     #[error(
-        "{}: cannot read the netlist named by `circuit.netlist` in {} \
-         (relative paths are relative to the scenario file)",
+        "{}: cannot read the netlist named by `circuit.netlist` in {} ({})",
         path.display(),
-        scenario.display()
+        scenario.display(),
+        if scenario.as_os_str() == "<stdin>" {
+            "the scenario came from standard input, so a relative path is relative to the \
+             working directory"
+        } else {
+            "relative paths are relative to the scenario file"
+        }
     )]
     NetlistRead {
         path: PathBuf,
@@ -579,13 +584,24 @@ impl Scenario {
         let tree = DeTable::parse(text).map_err(|source| {
             let start = source.span().map_or(0, |s| s.start);
             let (line, column) = line_column(text, start);
+            let mut message = source.message().trim_end().to_owned();
+            if message == "duplicate key" {
+                // Name the key, and the line that set it first.
+                let name = source
+                    .span()
+                    .and_then(|s| text.get(s))
+                    .unwrap_or("")
+                    .trim()
+                    .to_owned();
+                message = duplicate_message(text, &name, line);
+            }
             ScenarioError::Syntax {
                 at: Location {
                     path: origin.to_owned(),
                     line: Some(line),
                 },
                 column,
-                message: source.message().trim_end().to_owned(),
+                message,
                 source: Box::new(source),
             }
         })?;
@@ -869,10 +885,71 @@ impl<'t> KeyIndex<'t> {
         ScenarioError::BadValue {
             at,
             key: here,
-            message,
+            message: plain_type_error(&message),
             source,
         }
     }
+}
+
+/// "duplicate key" said with the key's name and where it was first set:
+/// the earlier line that starts with the same key (or table header).
+fn duplicate_message(text: &str, name: &str, line: usize) -> String {
+    if name.is_empty() {
+        return "duplicate key: a key or table is given twice".to_owned();
+    }
+    let header = format!("[{name}]");
+    let first = text.lines().take(line.saturating_sub(1)).position(|l| {
+        let l = l.trim_start();
+        l.starts_with(&header)
+            || l.strip_prefix(name)
+                .is_some_and(|rest| rest.trim_start().starts_with('='))
+    });
+    let table = text
+        .lines()
+        .nth(line.saturating_sub(1))
+        .is_some_and(|l| l.trim_start().starts_with('['));
+    let what = if table {
+        format!("the table `[{name}]` appears twice")
+    } else {
+        format!("duplicate key `{name}`: it is set twice in the same table")
+    };
+    match first {
+        Some(n) => format!("{what} (first on line {}); keep one", n + 1),
+        None => format!("{what}; keep one"),
+    }
+}
+
+/// serde's "invalid type: string \"x\", expected f64" in a user's words.
+fn plain_type_error(message: &str) -> String {
+    let Some(rest) = message.strip_prefix("invalid type: ") else {
+        return message.to_owned();
+    };
+    let Some((found, expected)) = rest.rsplit_once(", expected ") else {
+        return message.to_owned();
+    };
+    let found = if let Some(s) = found.strip_prefix("string ") {
+        format!("the text {s}")
+    } else if let Some(n) = found.strip_prefix("integer ") {
+        format!("the integer {}", n.trim_matches('`'))
+    } else if let Some(n) = found.strip_prefix("floating point ") {
+        format!("the number {}", n.trim_matches('`'))
+    } else if let Some(b) = found.strip_prefix("boolean ") {
+        b.trim_matches('`').to_owned()
+    } else if found == "map" {
+        "a table".to_owned()
+    } else if found == "sequence" {
+        "an array".to_owned()
+    } else {
+        found.to_owned()
+    };
+    let expected = match expected {
+        "f64" | "f32" => "a number (e.g. 2.0e-4, no quotes)",
+        "u64" | "u32" | "usize" | "u16" | "u8" | "i64" | "i32" => "a whole number (no quotes)",
+        "a boolean" | "bool" => "true or false",
+        "a string" => "text in quotes",
+        other => other,
+    };
+    format!("found {found}, expected {expected}")
 }
 
 fn join_key(prefix: &str, name: &str) -> String {

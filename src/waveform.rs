@@ -74,8 +74,10 @@ pub enum WaveformError {
         requirement: String,
     },
     #[error(
-        "`contact.edge_time` = {edge_time:?} s is below the time resolution of a sequence \
-         that runs to {t_end:?} s: use at least {minimum:e} s"
+        "the waveform runs to {t_end:?} s (`simulation.t_end`), so long that its times cannot \
+         resolve edges of `contact.edge_time` = {edge_time:?} s: lower `simulation.t_end` to \
+         what the circuit needs (a relay's chatter is over in milliseconds), or raise \
+         `contact.edge_time` to at least {minimum:e} s"
     )]
     EdgeBelowResolution {
         edge_time: f64,

@@ -279,3 +279,33 @@ fn signal_analysis_errors_exit_2_naming_what_to_fix() {
         .code(2)
         .stderr(predicate::str::contains("3 values of --low for 2 --signal"));
 }
+
+/// A `Flags:` line that disagrees with the data is named as such, not
+/// taken for a file cut short (or read as extra points).
+#[test]
+fn a_wrong_flags_line_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, from, to) in [
+        ("rc_tran.raw", "Flags: real", "Flags: complex"),
+        (
+            "control_write_ac_binary.raw",
+            "Flags: complex",
+            "Flags: real   ",
+        ),
+    ] {
+        let bytes = std::fs::read(data(name)).unwrap();
+        let at = bytes
+            .windows(from.len())
+            .position(|w| w == from.as_bytes())
+            .unwrap_or_else(|| panic!("{name} has no {from}"));
+        let mut edited = bytes.clone();
+        edited.splice(at..at + from.len(), to.bytes());
+        let path = dir.path().join(name);
+        std::fs::write(&path, edited).unwrap();
+        raw_cmd()
+            .arg(&path)
+            .assert()
+            .code(2)
+            .stderr(predicate::str::contains("`Flags:`").and(predicate::str::contains("wrong")));
+    }
+}

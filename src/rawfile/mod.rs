@@ -312,6 +312,17 @@ pub enum RawError {
         expected: usize,
         found: usize,
     },
+    #[error(
+        "at {at}: the header's `Flags:` says {flagged}, but the data hold {bytes} bytes a \
+         value for every declared point, as {found} values do: the `Flags:` line is wrong \
+         (or the file was edited); fix it to `Flags: {found}`"
+    )]
+    FlagMismatch {
+        at: Position,
+        flagged: &'static str,
+        found: &'static str,
+        bytes: usize,
+    },
     #[error("at {at}: expected {expected}, found {text:?}")]
     BadValue {
         at: Position,
@@ -826,6 +837,20 @@ fn next_is_header(rest: &[u8]) -> bool {
     starts(b"Title:") || starts(b"Plotname:") || starts(b"Date:")
 }
 
+/// Whether the first value of each of the first `points` rows of `row`
+/// bytes (the scale: time, frequency) is finite and never decreases.
+fn scale_increases(data: &[u8], row: usize, points: usize) -> bool {
+    let mut previous = f64::NEG_INFINITY;
+    for k in 0..points.min(data.len() / row.max(1)) {
+        let x = le_f64(&data[k * row..], 0);
+        if !x.is_finite() || x < previous {
+            return false;
+        }
+        previous = x;
+    }
+    true
+}
+
 /// Where a plot's binary data really are, walked point by point.
 #[derive(Debug, Default)]
 struct Sections {
@@ -925,6 +950,35 @@ fn read_binary(
         return Ok((plot, Vec::new()));
     }
 
+    // Data that end exactly where the other kind of value would put them:
+    // the `Flags:` line is wrong (8 bytes a value for real, 16 for complex).
+    if uniform && !open_ended && declared > 0 {
+        let other = if complex { 8 } else { 16 };
+        let ends_there = |end: usize| {
+            rest.len() == end
+                || rest
+                    .get(end..)
+                    .is_some_and(|r| next_is_header(r.trim_ascii_start()))
+        };
+        let theirs = declared.checked_mul(nvars * other);
+        // Flagged real with twice the data: extra real points (ngspice's
+        // interpolation writes some) are told from complex values by the
+        // scale, which does not increase when read with the wrong size.
+        // Flagged complex with half the data: real values.
+        if theirs.is_some_and(ends_there)
+            && !declared.checked_mul(row).is_some_and(ends_there)
+            && (complex
+                || (!scale_increases(rest, row, declared)
+                    && scale_increases(rest, nvars * other, declared)))
+        {
+            return Err(RawError::FlagMismatch {
+                at: cur.at(),
+                flagged: if complex { "complex" } else { "real" },
+                found: if complex { "real" } else { "complex" },
+                bytes: other,
+            });
+        }
+    }
     // A file whose data do not end where the header says, at the end of
     // the file or at the next plot's header, went through `.options
     // interp`: walk it point by point (restarts, extra points).

@@ -140,6 +140,15 @@ fn locate(file: &mut BufReader<File>, len: u64) -> Result<Option<Vec<Located>>, 
         let data = pos + cur.pos as u64;
         let available = (len - data).checked_div(row).unwrap_or(0);
         let claimed = declared as u64;
+        // Data the size the other kind of value would have: the full
+        // reader says the `Flags:` line is wrong.
+        let other = (header.nvars * if header.plot.flags.complex { 8 } else { 16 }) as u64;
+        if claimed > 0
+            && claimed.checked_mul(other) == Some(len - data)
+            && claimed.checked_mul(row) != Some(len - data)
+        {
+            return Ok(None);
+        }
         if declared == 0 || claimed > available {
             // A killed run: its data end the file.
             plots.push(Located {
