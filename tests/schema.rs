@@ -1,0 +1,225 @@
+//! The JSON Schemas in docs/schema/ describe what the commands really
+//! print: every document below, from real runs (ngspice included), must
+//! validate, and the schemas forbid keys they do not list, so a field
+//! added to the output without its schema fails here.
+//!
+//! The validator covers the part of JSON Schema (2020-12) the schemas use:
+//! `type`, `properties`, `required`, `additionalProperties`, `items`,
+//! `enum`, `oneOf`, `minimum` and local `$ref`s.
+
+mod common;
+
+use std::path::PathBuf;
+
+use assert_cmd::Command;
+use serde_json::Value;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn schema(name: &str) -> Value {
+    let path = root()
+        .join("docs/schema")
+        .join(format!("{name}.schema.json"));
+    serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap()
+}
+
+/// Errors of `value` against `schema` (whose `$defs` resolve `$ref`s), as
+/// JSON-pointer-ish paths with a reason.
+fn validate(root: &Value, schema: &Value, value: &Value, at: &str, errors: &mut Vec<String>) {
+    if let Some(r) = schema.get("$ref").and_then(Value::as_str) {
+        let name = r.strip_prefix("#/$defs/").expect("local refs only");
+        validate(root, &root["$defs"][name], value, at, errors);
+    }
+    if let Some(t) = schema.get("type") {
+        let types: Vec<&str> = match t {
+            Value::String(s) => vec![s.as_str()],
+            Value::Array(a) => a.iter().filter_map(Value::as_str).collect(),
+            _ => panic!("bad type in schema at {at}"),
+        };
+        let ok = types.iter().any(|t| match *t {
+            "null" => value.is_null(),
+            "boolean" => value.is_boolean(),
+            "string" => value.is_string(),
+            "number" => value.is_number(),
+            "integer" => value.is_i64() || value.is_u64(),
+            "array" => value.is_array(),
+            "object" => value.is_object(),
+            other => panic!("unknown type {other}"),
+        });
+        if !ok {
+            errors.push(format!("{at}: {value} is not {types:?}"));
+            return;
+        }
+    }
+    if let Some(options) = schema.get("enum").and_then(Value::as_array) {
+        if !options.contains(value) {
+            errors.push(format!("{at}: {value} is not one of {options:?}"));
+        }
+    }
+    if let (Some(min), Some(x)) = (
+        schema.get("minimum").and_then(Value::as_f64),
+        value.as_f64(),
+    ) {
+        if x < min {
+            errors.push(format!("{at}: {x} < minimum {min}"));
+        }
+    }
+    if let Some(options) = schema.get("oneOf").and_then(Value::as_array) {
+        let passing = options
+            .iter()
+            .filter(|s| {
+                let mut e = Vec::new();
+                validate(root, s, value, at, &mut e);
+                e.is_empty()
+            })
+            .count();
+        if passing != 1 {
+            errors.push(format!(
+                "{at}: {passing} of the oneOf alternatives match {value}"
+            ));
+        }
+    }
+    if let (Some(items), Some(array)) = (schema.get("items"), value.as_array()) {
+        for (i, v) in array.iter().enumerate() {
+            validate(root, items, v, &format!("{at}[{i}]"), errors);
+        }
+    }
+    if let Some(object) = value.as_object() {
+        let properties = schema.get("properties").and_then(Value::as_object);
+        if let Some(required) = schema.get("required").and_then(Value::as_array) {
+            for key in required.iter().filter_map(Value::as_str) {
+                if !object.contains_key(key) {
+                    errors.push(format!("{at}: missing `{key}`"));
+                }
+            }
+        }
+        for (key, v) in object {
+            match properties.and_then(|p| p.get(key)) {
+                Some(s) => validate(root, s, v, &format!("{at}.{key}"), errors),
+                None => match schema.get("additionalProperties") {
+                    Some(Value::Bool(false)) => {
+                        errors.push(format!("{at}: `{key}` is not in the schema"));
+                    }
+                    Some(s @ Value::Object(_)) => {
+                        validate(root, s, v, &format!("{at}.{key}"), errors);
+                    }
+                    _ => {}
+                },
+            }
+        }
+    }
+}
+
+fn assert_valid(name: &str, doc: &Value, what: &str) {
+    let schema = schema(name);
+    let mut errors = Vec::new();
+    validate(&schema, &schema, doc, "$", &mut errors);
+    assert!(errors.is_empty(), "{what} against {name}: {errors:#?}");
+}
+
+fn json_of(args: &[&str], code: i32) -> Value {
+    let out = Command::cargo_bin("chatterspice")
+        .unwrap()
+        .args(args)
+        .assert()
+        .code(code);
+    serde_json::from_slice(&out.get_output().stdout).unwrap()
+}
+
+fn example(name: &str) -> String {
+    root()
+        .join("examples/scenarios")
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
+
+#[test]
+fn the_validator_rejects_what_the_schemas_forbid() {
+    let mut doc = json_of(&["bounce", "--format", "json"], 0);
+    assert_valid("bounce", &doc, "default bounce");
+    doc["undocumented"] = Value::Bool(true);
+    let s = schema("bounce");
+    let mut errors = Vec::new();
+    validate(&s, &s, &doc, "$", &mut errors);
+    assert!(
+        errors.iter().any(|e| e.contains("undocumented")),
+        "{errors:?}"
+    );
+    doc.as_object_mut().unwrap().remove("undocumented");
+    doc["outcome"] = Value::String("sideways".into());
+    doc["impacts"][0]["impact_time"] = Value::String("soon".into());
+    let mut errors = Vec::new();
+    validate(&s, &s, &doc, "$", &mut errors);
+    assert_eq!(errors.len(), 2, "{errors:?}");
+}
+
+#[test]
+fn bounce_output_matches_its_schema() {
+    for scenario in ["rigid.toml", "kelvin-voigt.toml", "hunt-crossley.toml"] {
+        let doc = json_of(&["bounce", &example(scenario), "--format", "json"], 0);
+        assert_valid("bounce", &doc, scenario);
+    }
+}
+
+#[test]
+fn run_and_check_output_match_their_schemas() {
+    let Some(_) = common::ngspice() else { return };
+    let default = json_of(&["run", "--format", "json"], 0);
+    assert_valid("run", &default, "default run");
+    for scenario in [
+        "relay-driver-zener.toml",
+        "capacitive-load.toml",
+        "lamp.toml",
+    ] {
+        let doc = json_of(&["run", &example(scenario), "--format", "json"], 0);
+        assert_valid("run", &doc, scenario);
+    }
+    let check = json_of(
+        &[
+            "check",
+            &example("relay-driver-zener.toml"),
+            "--format",
+            "json",
+        ],
+        0,
+    );
+    assert_valid("check", &check, "coil check");
+    assert!(check["run"].is_object());
+}
+
+#[test]
+fn sweep_summaries_match_their_schema() {
+    let Some(_) = common::ngspice() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let text = chatterspice::scenario::DEFAULT_SCENARIO_TOML.replace(
+        "../netlists/mcu_input.cir",
+        &root().join("netlists/mcu_input.cir").to_string_lossy(),
+    );
+    let path = dir.path().join("relay.toml");
+    std::fs::write(
+        &path,
+        format!(
+            "{text}\n[limits]\nmax_bounces = 4\n\n[sweep]\nsamples = 6\n[sweep.vary]\n\
+             \"mechanics.mass\" = 0.2\n"
+        ),
+    )
+    .unwrap();
+    for (name, extra) in [("mech", vec!["--mechanics-only"]), ("ngspice", vec![])] {
+        let out = dir.path().join(name);
+        let mut cmd = Command::cargo_bin("chatterspice").unwrap();
+        cmd.arg("sweep")
+            .arg(&path)
+            .args(&extra)
+            .arg("--out")
+            .arg(&out)
+            .assert()
+            .code(1);
+        let summary: Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        assert_valid("sweep-summary", &summary, name);
+    }
+}
