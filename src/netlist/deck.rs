@@ -940,6 +940,10 @@ mod tests {
             param_names(".param cf=8.2n rf = 1k tau={rf*cf}"),
             ["cf", "rf", "tau"]
         );
+        assert_eq!(param_names(".PARAM CF = 8.2n"), ["cf"]);
+        assert_eq!(param_names(".param x='1k*2' y = { x / 2 }"), ["x", "y"]);
+        let upper = "t\n.PARAM CF = 4.7u\n";
+        assert_eq!(param_value(upper, "cf"), Some(4.7e-6));
     }
 
     #[test]

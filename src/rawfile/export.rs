@@ -3,7 +3,7 @@
 //!
 //! CSV: the header row is the vector names; a complex vector becomes two
 //! columns `NAME.re`, `NAME.im` (the AC frequency axis stays one real
-//! column). Values are written by `ryu`: the shortest string that reads
+//! column). Values are written by `zmij`: the shortest string that reads
 //! back to the identical `f64` (`0.001`, `1.5`, `0.0`, `1e-7`), so output
 //! is byte-identical across runs and platforms and loses nothing. A
 //! vector shorter than the plot (`unpadded`) leaves its cells empty. Large
@@ -56,7 +56,7 @@ pub fn select_plot(raw: &RawFile, index: Option<usize>) -> Result<&Plot, ExportE
 
 /// The CSV cell text of a value (see the module doc).
 pub fn format_value(x: f64) -> String {
-    ryu::Buffer::new().format(x).to_owned()
+    zmij::Buffer::new().format(x).to_owned()
 }
 
 /// Writes `plot` as CSV.
@@ -78,7 +78,7 @@ pub fn plot_csv<W: Write>(plot: &Plot, out: W) -> Result<(), ExportError> {
     w.write_record(&header)?;
 
     let mut record = csv::ByteRecord::new();
-    let mut digits = ryu::Buffer::new();
+    let mut digits = zmij::Buffer::new();
     let mut push = |record: &mut csv::ByteRecord, x: Option<f64>| match x {
         Some(x) => record.push_field(digits.format(x).as_bytes()),
         None => record.push_field(b""),

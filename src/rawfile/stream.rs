@@ -9,7 +9,7 @@
 //! `.options interp`) returns `None`, and the caller reads the file whole
 //! with [`super::RawFile::read`], which copes with all of them.
 //!
-//! Numbers are written by [`ryu`]: the shortest digits that read back to
+//! Numbers are written by [`zmij`]: the shortest digits that read back to
 //! the identical `f64` (`1.5`, `0.001`, `1e-7`, `3.3000000000000003`).
 
 use std::fs::File;
@@ -230,8 +230,8 @@ fn write_plot<W: Write>(
 
     let width = if complex { 16 } else { 8 };
     let row = located.header.nvars * width;
-    // Formatting, not reading, is the cost: about 25 ns a number with
-    // ryu. (Splitting a block between two threads was measured slower on
+    // Formatting, not reading, is the cost: about 15 ns a number with
+    // zmij. (Splitting a block between two threads was measured slower on
     // the 2-core development machine.)
     let rows_per_block = (BLOCK_BYTES / row.max(1)).max(1);
     let mut block = vec![0u8; rows_per_block * row];
@@ -263,7 +263,7 @@ fn write_plot<W: Write>(
 fn format_rows(data: &[u8], row: usize, width: usize, pairs: &[bool], text: &mut Vec<u8>) {
     text.clear();
     text.reserve(data.len() / 8 * 24);
-    let mut digits = ryu::Buffer::new();
+    let mut digits = zmij::Buffer::new();
     if width == 8 {
         // A real plot: every value is one column.
         for r in data.chunks_exact(row) {
@@ -293,8 +293,8 @@ fn format_rows(data: &[u8], row: usize, width: usize, pairs: &[bool], text: &mut
     }
 }
 
-/// Appends `x`: ryu's shortest digits that read back to the same `f64`.
-fn push_number(out: &mut Vec<u8>, buf: &mut ryu::Buffer, x: f64) {
+/// Appends `x`: the shortest digits that read back to the same `f64`.
+fn push_number(out: &mut Vec<u8>, buf: &mut zmij::Buffer, x: f64) {
     out.extend_from_slice(buf.format(x).as_bytes());
 }
 
@@ -314,7 +314,7 @@ mod tests {
         fn every_number_reads_back_to_the_same_bits(bits in any::<u64>()) {
             let x = f64::from_bits(bits);
             let mut out = Vec::new();
-            push_number(&mut out, &mut ryu::Buffer::new(), x);
+            push_number(&mut out, &mut zmij::Buffer::new(), x);
             let back: f64 = std::str::from_utf8(&out).unwrap().parse().unwrap();
             if x.is_nan() {
                 prop_assert!(back.is_nan());
