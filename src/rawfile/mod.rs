@@ -331,6 +331,21 @@ pub enum RawError {
     },
 }
 
+/// The metadata of `path`, which must be a regular file: a device or a
+/// pipe could feed a reader without end.
+fn regular_file(path: &Path) -> Result<std::fs::Metadata, RawError> {
+    let meta = std::fs::metadata(path).map_err(|source| RawError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    if !meta.is_file() {
+        return Err(RawError::NotAFile {
+            path: path.to_path_buf(),
+        });
+    }
+    Ok(meta)
+}
+
 impl RawFile {
     /// Reads and parses a raw file; errors name the path. Only regular
     /// files of at most [`MAX_LOADED_BYTES`] are read (a device such as
@@ -341,12 +356,7 @@ impl RawFile {
             path: path.to_path_buf(),
             source,
         };
-        let meta = std::fs::metadata(path).map_err(io)?;
-        if !meta.is_file() {
-            return Err(RawError::NotAFile {
-                path: path.to_path_buf(),
-            });
-        }
+        let meta = regular_file(path)?;
         if meta.len() > MAX_LOADED_BYTES {
             return Err(RawError::TooLarge {
                 path: path.to_path_buf(),

@@ -19,7 +19,7 @@ use std::path::Path;
 use super::export::ExportError;
 use super::{
     Cursor, DataKind, Header, RawError, RawWarning, next_is_header, parse_header,
-    real_in_complex_plot,
+    real_in_complex_plot, regular_file,
 };
 
 /// A header and its `Binary:` line fit in this; a longer one is not
@@ -58,14 +58,7 @@ pub fn stream_csv<W: Write>(
         path: path.to_path_buf(),
         source,
     };
-    let meta = std::fs::metadata(path).map_err(io)?;
-    if !meta.is_file() {
-        return Err(RawError::NotAFile {
-            path: path.to_path_buf(),
-        }
-        .into());
-    }
-    let len = meta.len();
+    let len = regular_file(path)?.len();
     let mut file = BufReader::with_capacity(BLOCK_BYTES, File::open(path).map_err(io)?);
     let Some(plots) = locate(&mut file, len).map_err(|e| match e {
         Locate::Raw(e) => in_file(e),

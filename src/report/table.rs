@@ -148,19 +148,7 @@ pub fn render_run(run: &RunResult) -> String {
     }
 
     out.push('\n');
-    let mut rows = vec![
-        [
-            "probe",
-            "edges",
-            "glitches",
-            "first edge",
-            "last edge",
-            "shortest pulse",
-            "min",
-            "max",
-        ]
-        .map(String::from),
-    ];
+    let mut rows = vec![PROBE_HEADER.map(String::from)];
     for p in &run.probes {
         rows.push(probe_row(&p.analysis.signal, &p.analysis));
         if let Some(ideal) = &p.ideal {
@@ -248,19 +236,7 @@ pub fn render_run(run: &RunResult) -> String {
 /// Probe analyses alone (`raw --signal`): the probe table of `run`, and
 /// the pulses of current probes.
 pub fn render_probes(probes: &[ProbeAnalysis]) -> String {
-    let mut rows = vec![
-        [
-            "probe",
-            "edges",
-            "glitches",
-            "first edge",
-            "last edge",
-            "shortest pulse",
-            "min",
-            "max",
-        ]
-        .map(String::from),
-    ];
+    let mut rows = vec![PROBE_HEADER.map(String::from)];
     for a in probes {
         rows.push(probe_row(&a.signal, a));
     }
@@ -347,6 +323,18 @@ fn signed(value: f64, unit: &str) -> String {
         format!("+{text}")
     }
 }
+
+/// The columns of [`probe_row`].
+const PROBE_HEADER: [&str; 8] = [
+    "probe",
+    "edges",
+    "glitches",
+    "first edge",
+    "last edge",
+    "shortest pulse",
+    "min",
+    "max",
+];
 
 fn probe_row(label: &str, a: &ProbeAnalysis) -> [String; 8] {
     let unit = a.kind.unit();
