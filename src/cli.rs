@@ -15,6 +15,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::time::Duration;
 
 mod calibrate;
+mod capture;
 mod raw;
 
 use chatterspice::chatter::Chatter;
@@ -57,6 +58,10 @@ pub enum Command {
     Sweep(SweepArgs),
     /// Join the CSVs of a sweep's shards (--shard K/N) into the CSV of one run.
     Merge(MergeArgs),
+    /// A scope capture of the contact → the chatter it shows: levels,
+    /// thresholds, every make and break (table, JSON, or the time,state CSV
+    /// that --measured reads).
+    Capture(capture::CaptureArgs),
     /// Fit the scenario's free keys to a record of the contact and/or its
     /// [datasheet] figures; writes the fitted scenario with [provenance].
     Fit(calibrate::FitArgs),
@@ -85,6 +90,7 @@ impl Command {
             Command::Raw(args) => done(raw::raw(args)),
             Command::Sweep(args) => sweep(args),
             Command::Merge(args) => done(merge(args)),
+            Command::Capture(args) => done(capture::capture(args)),
             Command::Fit(args) => done(calibrate::fit(args)),
             Command::Parts(args) => done(calibrate::parts(args)),
         }

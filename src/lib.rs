@@ -11,6 +11,7 @@
 
 pub mod analysis;
 pub mod calibrate;
+pub mod capture;
 pub mod chatter;
 pub mod check;
 pub mod coil;

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 
 use chatterspice::calibrate::fit::{self, FitRequest, Record};
@@ -30,6 +30,10 @@ pub struct FitArgs {
     /// A scope capture of the contact (CSV) to fit the make/break times to.
     #[arg(long, value_name = "SCOPE.csv", conflicts_with = "measured")]
     pub capture: Option<PathBuf>,
+
+    /// With --capture: the channel to read (name or number).
+    #[arg(long, value_name = "NAME|N", requires = "capture")]
+    pub channel: Option<String>,
 
     /// A `time,state` file of the contact's states to fit the make/break
     /// times to.
@@ -61,11 +65,11 @@ pub struct FitArgs {
 
 fn read_record(args: &FitArgs) -> Result<Option<Record>> {
     if let Some(scope) = &args.capture {
-        bail!(
-            "{}: reading analog scope captures needs the capture reader, which this build lacks; \
-             convert the capture to a time,state file and pass it with --measured",
-            scope.display()
-        );
+        let c = super::capture::analyse(scope, args.channel.as_deref(), None, None)?;
+        return Ok(Some(Record {
+            name: c.source.clone(),
+            intervals: c.shifted_intervals(),
+        }));
     }
     let Some(csv) = &args.measured else {
         return Ok(None);

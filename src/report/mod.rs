@@ -19,7 +19,7 @@ pub mod json;
 pub mod png;
 pub mod svg;
 pub mod table;
-pub(crate) mod units;
+pub mod units;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};

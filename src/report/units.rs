@@ -18,7 +18,7 @@ pub(crate) fn prefix(exponent: i32) -> &'static str {
 }
 
 /// `value` with three significant digits and an SI prefix: "12.5 µs".
-pub(crate) fn engineering(value: f64, unit: &str) -> String {
+pub fn engineering(value: f64, unit: &str) -> String {
     if value == 0.0 || !value.is_finite() {
         return format!("0 {unit}");
     }

@@ -1,0 +1,254 @@
+//! From a trace to the contact's states: two levels from the trace itself,
+//! hysteresis thresholds between them, and each edge timed at the 50 %
+//! crossing.
+//!
+//! - **Levels**: the two most populated bins of a 200-bin histogram of the
+//!   values that lie at least a third of the range apart, each refined to
+//!   the mean of the samples in its bin and its neighbours. Ringing,
+//!   noise and quantisation spread a level over a few bins but do not move
+//!   its mode; a capture that is mostly one level still has the other as
+//!   the second mode.
+//! - **Thresholds**: 30 % and 70 % of the way from the lower level to the
+//!   higher (or the user's). An edge is a crossing of the far threshold
+//!   after the near one: an excursion that does not cross both (ringing at
+//!   a make, noise) is no edge.
+//! - **Timing**: the last crossing of the 50 % level before the threshold
+//!   crossing, interpolated between its two samples.
+//! - **Polarity**: the level the trace ends on is closed (a capture of a
+//!   closing ends closed), unless the user says which.
+
+use crate::chatter::{ContactState, Interval};
+
+/// Which level means closed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Closed {
+    High,
+    Low,
+}
+
+/// What the trace shows.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Edges {
+    /// The open and closed levels, in the trace's unit.
+    pub open: f64,
+    pub closed: f64,
+    /// The hysteresis thresholds (low < high).
+    pub low: f64,
+    pub high: f64,
+    /// s, every make and break, in order.
+    pub makes: Vec<f64>,
+    pub breaks: Vec<f64>,
+    /// The contact's states from the first sample to the last.
+    pub intervals: Vec<Interval>,
+}
+
+/// Why a trace has no chatter to find.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum EdgeError {
+    #[error("the trace is flat ({value} throughout): there is no second level to find")]
+    Flat { value: f64 },
+    #[error(
+        "the thresholds low = {low} and high = {high} must be finite with low < high, \
+         in the trace's unit"
+    )]
+    Thresholds { low: f64, high: f64 },
+}
+
+/// The two levels of `value`, lower first.
+pub fn levels(value: &[f64]) -> Result<(f64, f64), EdgeError> {
+    const BINS: usize = 200;
+    let (min, max) = value
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    if !(max > min) {
+        return Err(EdgeError::Flat { value: min });
+    }
+    let width = (max - min) / BINS as f64;
+    let bin = |v: f64| (((v - min) / width) as usize).min(BINS - 1);
+    let mut counts = [0usize; BINS];
+    for &v in value {
+        counts[bin(v)] += 1;
+    }
+    let first = (0..BINS)
+        .max_by_key(|&i| (counts[i], std::cmp::Reverse(i)))
+        .unwrap_or(0);
+    let apart = BINS / 3;
+    let second = (0..BINS)
+        .filter(|&i| i.abs_diff(first) >= apart)
+        .max_by_key(|&i| (counts[i], std::cmp::Reverse(i)))
+        .unwrap_or(if first < BINS / 2 { BINS - 1 } else { 0 });
+    let refine = |b: usize| {
+        let (lo, hi) = (b.saturating_sub(1), (b + 1).min(BINS - 1));
+        let (sum, n) = value
+            .iter()
+            .filter(|&&v| (lo..=hi).contains(&bin(v)))
+            .fold((0.0, 0usize), |(s, n), &v| (s + v, n + 1));
+        if n == 0 {
+            min + (b as f64 + 0.5) * width
+        } else {
+            sum / n as f64
+        }
+    };
+    let (a, b) = (refine(first), refine(second));
+    Ok(if a < b { (a, b) } else { (b, a) })
+}
+
+/// The edges of (`time`, `value`): thresholds `low`/`high` (default 30 %
+/// and 70 % between the levels), closed level per `closed` (default: the
+/// one the trace ends nearer to).
+pub fn edges(
+    time: &[f64],
+    value: &[f64],
+    thresholds: Option<(f64, f64)>,
+    closed: Option<Closed>,
+) -> Result<Edges, EdgeError> {
+    let (lower, upper) = levels(value)?;
+    let (low, high) =
+        thresholds.unwrap_or((lower + 0.3 * (upper - lower), lower + 0.7 * (upper - lower)));
+    if !(low.is_finite() && high.is_finite() && low < high) {
+        return Err(EdgeError::Thresholds { low, high });
+    }
+    let mid = 0.5 * (low + high);
+    // Schmitt states: Some(true) high, Some(false) low, None not yet known.
+    let mut state = if value[0] >= high {
+        Some(true)
+    } else if value[0] <= low {
+        Some(false)
+    } else {
+        None
+    };
+    let initial = state;
+    let mut transitions: Vec<(f64, bool)> = Vec::new();
+    for k in 1..value.len() {
+        let v = value[k];
+        let to = if v >= high && state != Some(true) {
+            Some(true)
+        } else if v <= low && state != Some(false) {
+            Some(false)
+        } else {
+            None
+        };
+        let Some(up) = to else { continue };
+        if state.is_some() {
+            transitions.push((mid_crossing(time, value, k, mid, up), up));
+        }
+        state = Some(up);
+    }
+    let ends_high = state.unwrap_or(value[value.len() - 1] >= mid);
+    let closed_high = match closed {
+        Some(Closed::High) => true,
+        Some(Closed::Low) => false,
+        None => ends_high,
+    };
+    let start_high = initial.unwrap_or_else(|| transitions.first().map_or(ends_high, |t| !t.1));
+    let state_of = |high: bool| {
+        if high == closed_high {
+            ContactState::Closed
+        } else {
+            ContactState::Open
+        }
+    };
+    let mut intervals = Vec::with_capacity(transitions.len() + 1);
+    let mut since = time[0];
+    let mut current = start_high;
+    let (mut makes, mut breaks) = (Vec::new(), Vec::new());
+    for &(t, up) in &transitions {
+        let t = t.max(since);
+        intervals.push(Interval {
+            state: state_of(current),
+            start: since,
+            end: t,
+        });
+        if state_of(up) == ContactState::Closed {
+            makes.push(t);
+        } else {
+            breaks.push(t);
+        }
+        since = t;
+        current = up;
+    }
+    intervals.push(Interval {
+        state: state_of(current),
+        start: since,
+        end: time[time.len() - 1],
+    });
+    let (open, closed_level) = if closed_high {
+        (lower, upper)
+    } else {
+        (upper, lower)
+    };
+    Ok(Edges {
+        open,
+        closed: closed_level,
+        low,
+        high,
+        makes,
+        breaks,
+        intervals,
+    })
+}
+
+/// The time the signal last crossed `mid` (going `up`) at or before sample
+/// `k`, where it crossed the far threshold: linear between the samples.
+fn mid_crossing(time: &[f64], value: &[f64], k: usize, mid: f64, up: bool) -> f64 {
+    let past = |v: f64| if up { v >= mid } else { v <= mid };
+    let mut j = k;
+    while j > 0 && past(value[j - 1]) {
+        j -= 1;
+    }
+    if j == 0 {
+        return time[0];
+    }
+    let (t0, t1, v0, v1) = (time[j - 1], time[j], value[j - 1], value[j]);
+    if v1 == v0 {
+        return t1;
+    }
+    t0 + (mid - v0) / (v1 - v0) * (t1 - t0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn levels_of_a_noisy_two_level_trace() {
+        let v: Vec<f64> = (0..1000)
+            .map(|i| if i < 300 { 5.0 } else { 0.02 } + 0.05 * ((i * 7919) % 13) as f64 / 13.0)
+            .collect();
+        let (lo, hi) = levels(&v).unwrap();
+        assert!(
+            (lo - 0.045).abs() < 0.03 && (hi - 5.025).abs() < 0.03,
+            "{lo} {hi}"
+        );
+        assert!(levels(&[1.0; 10]).is_err());
+    }
+
+    #[test]
+    fn ringing_that_does_not_cross_both_thresholds_is_no_edge() {
+        // 5 V open, a make at t = 10 with ringing down to 1.2 V (between
+        // 30 % = 1.5 V and 50 %): one make.
+        let time: Vec<f64> = (0..40).map(f64::from).collect();
+        let value: Vec<f64> = (0..40)
+            .map(|i| match i {
+                i if i < 10 => 5.0,
+                10 => 0.5,
+                12 => 1.2,
+                14 => 1.2,
+                _ => 0.0,
+            })
+            .collect();
+        let e = edges(&time, &value, None, None).unwrap();
+        assert_eq!(e.makes.len(), 1);
+        assert!(e.breaks.is_empty());
+        // 50 % = 2.5 V between 5 V at t = 9 and 0.5 V at t = 10.
+        assert!(
+            (e.makes[0] - (9.0 + 2.5 / 4.5)).abs() < 1e-12,
+            "{:?}",
+            e.makes
+        );
+        assert_eq!(e.closed, 0.0);
+        assert_eq!(e.intervals[0].state, ContactState::Open);
+    }
+}

@@ -1,0 +1,120 @@
+//! Scope captures of a contact: read an instrument's CSV export
+//! ([`layout`]), find the contact's levels and edges ([`edges`]), and
+//! report the chatter it shows in the names of the simulated one.
+
+pub mod edges;
+pub mod layout;
+
+use serde::Serialize;
+
+use crate::chatter::{Chatter, ContactState, Interval};
+
+pub use edges::{Closed, EdgeError, Edges};
+pub use layout::{CaptureError, Layout, Trace, parse_capture, read_capture};
+
+/// What a capture shows: the JSON of `chatterspice capture`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Capture {
+    pub source: String,
+    pub layout: &'static str,
+    pub channel: String,
+    pub samples: usize,
+    /// s, the median spacing of the samples.
+    pub sample_interval: f64,
+    pub levels: Levels,
+    pub thresholds: Thresholds,
+    pub first_make: Option<f64>,
+    pub settle_time: Option<f64>,
+    pub bounce_count: usize,
+    pub makes: Vec<f64>,
+    pub breaks: Vec<f64>,
+    pub intervals: Vec<Interval>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Levels {
+    pub open: f64,
+    pub closed: f64,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Thresholds {
+    pub low: f64,
+    pub high: f64,
+}
+
+impl Capture {
+    /// The chatter of `trace` (named `source`), with optional thresholds
+    /// and polarity.
+    pub fn of(
+        source: &str,
+        trace: &Trace,
+        thresholds: Option<(f64, f64)>,
+        closed: Option<Closed>,
+    ) -> Result<Capture, EdgeError> {
+        let e = edges::edges(&trace.time, &trace.value, thresholds, closed)?;
+        let chatter = Chatter::from_intervals(e.intervals.clone());
+        let mut steps: Vec<f64> = trace.time.windows(2).map(|w| w[1] - w[0]).collect();
+        steps.sort_by(f64::total_cmp);
+        Ok(Capture {
+            source: source.to_owned(),
+            layout: trace.layout.as_str(),
+            channel: trace.channel.clone(),
+            samples: trace.time.len(),
+            sample_interval: steps[steps.len() / 2],
+            levels: Levels {
+                open: e.open,
+                closed: e.closed,
+            },
+            thresholds: Thresholds {
+                low: e.low,
+                high: e.high,
+            },
+            first_make: chatter.first_impact,
+            settle_time: chatter.settle_time,
+            bounce_count: chatter.bounce_count,
+            makes: e.makes,
+            breaks: e.breaks,
+            intervals: e.intervals,
+        })
+    }
+
+    /// The `time,state` CSV that `--measured` reads: one row per state
+    /// change and a last row at the end of the record. Its times start at
+    /// 0 (the first sample); the capture's own time base is
+    /// [`Capture::intervals`] less [`Capture::csv_origin`].
+    pub fn state_csv(&self) -> String {
+        let origin = self.csv_origin();
+        let name = |s: ContactState| match s {
+            ContactState::Open => "open",
+            ContactState::Closed => "closed",
+        };
+        let mut out = String::from("time,state\n");
+        for i in &self.intervals {
+            out.push_str(&format!("{:?},{}\n", i.start - origin, name(i.state)));
+        }
+        if let Some(last) = self.intervals.last().filter(|l| l.end > l.start) {
+            out.push_str(&format!("{:?},{}\n", last.end - origin, name(last.state)));
+        }
+        out
+    }
+
+    /// s, the capture time of the CSV's t = 0: its first sample.
+    pub fn csv_origin(&self) -> f64 {
+        self.intervals.first().map_or(0.0, |i| i.start)
+    }
+
+    /// The intervals from t = 0 at the first sample (what the fit and the
+    /// circuit use: the scope's trigger is not the force step anyway).
+    pub fn shifted_intervals(&self) -> Vec<Interval> {
+        let o = self.csv_origin();
+        self.intervals
+            .iter()
+            .map(|i| Interval {
+                state: i.state,
+                start: i.start - o,
+                end: i.end - o,
+            })
+            .collect()
+    }
+}
