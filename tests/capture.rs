@@ -403,3 +403,82 @@ fn unreadable_captures_name_the_line_and_column() {
         .code(2)
         .stderr(predicate::str::contains("flat"));
 }
+
+/// `fit --capture`: a Rigol capture of a known relay, a prior off by up to
+/// 2× in every free key; the fit must reproduce every captured event
+/// within 10 µs and come back to the truth (not stay at its prior).
+#[test]
+fn fit_capture_recovers_a_known_relay() {
+    let truth_text = "[mechanics]\nmass = 2.0e-4\nstiffness = 800.0\ndamping = 0.02\nforce = 0.5\n\
+                      gap = 5.0e-4\n\n[surface]\nlaw = \"kelvin-voigt\"\nstiffness = 8.0e4\n\
+                      damping = 0.5\n\n[simulation]\nt_end = 0.02\n";
+    let truth = Scenario::parse(truth_text, Path::new("truth.toml")).unwrap();
+    let c = chatterspice::simulate(
+        &truth.mechanics().unwrap(),
+        &truth.surface(),
+        &truth.settings(),
+    )
+    .unwrap();
+    let settle = c.settle_time.unwrap();
+    let intervals: Vec<Interval> = c
+        .intervals
+        .iter()
+        .map(|i| Interval {
+            state: i.state,
+            start: i.start + OFFSET,
+            end: i.end.min(settle + 1e-3) + OFFSET,
+        })
+        .filter(|i| i.end > i.start)
+        .collect();
+    let (t, v) = trace(&intervals, false);
+    let dir = tempfile::tempdir().unwrap();
+    let scope = dir.path().join("scope.csv");
+    std::fs::write(&scope, rigol(&t, &v)).unwrap();
+    let prior = dir.path().join("prior.toml");
+    std::fs::write(
+        &prior,
+        truth_text
+            .replacen("stiffness = 800.0", "stiffness = 1600.0", 1)
+            .replacen("force = 0.5", "force = 0.3", 1)
+            .replacen("stiffness = 8.0e4", "stiffness = 4.0e4", 1)
+            .replacen("damping = 0.5", "damping = 1.0", 1),
+    )
+    .unwrap();
+    let out = Command::cargo_bin("chatterspice")
+        .unwrap()
+        .arg("fit")
+        .arg(&prior)
+        .arg("--capture")
+        .arg(&scope)
+        .args([
+            "--free",
+            "mechanics.stiffness,mechanics.force,surface.stiffness,surface.damping",
+            "--format",
+            "json",
+        ])
+        .assert()
+        .success();
+    let report: Value = serde_json::from_slice(&out.get_output().stdout).unwrap();
+    for e in report["events"].as_array().unwrap() {
+        if e["dropped"] == true {
+            continue;
+        }
+        let r = e["residual"].as_f64().unwrap();
+        assert!(r.abs() < 10e-6, "{e}");
+    }
+    for (key, want, tol) in [
+        ("mechanics.stiffness", 800.0, 0.05),
+        ("mechanics.force", 0.5, 0.05),
+        ("surface.stiffness", 8.0e4, 0.05),
+        ("surface.damping", 0.5, 0.10),
+    ] {
+        let p = report["parameters"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["key"] == key)
+            .unwrap();
+        let got = p["value"].as_f64().unwrap();
+        assert!((got / want - 1.0).abs() < tol, "{key}: {got} vs {want}");
+    }
+}

@@ -62,7 +62,7 @@ pub fn levels(value: &[f64]) -> Result<(f64, f64), EdgeError> {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
             (a.min(v), b.max(v))
         });
-    if !(max > min) {
+    if max.partial_cmp(&min) != Some(std::cmp::Ordering::Greater) {
         return Err(EdgeError::Flat { value: min });
     }
     let width = (max - min) / BINS as f64;
