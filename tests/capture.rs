@@ -455,10 +455,18 @@ fn fit_capture_recovers_a_known_relay() {
             "mechanics.stiffness,mechanics.force,surface.stiffness,surface.damping",
             "--format",
             "json",
+            "--report",
         ])
+        .arg(dir.path().join("report"))
         .assert()
         .success();
     let report: Value = serde_json::from_slice(&out.get_output().stdout).unwrap();
+    // The overlay draws the scope trace (grey) under the measured states.
+    let svg = std::fs::read_to_string(dir.path().join("report/overlay.svg")).unwrap();
+    assert!(
+        svg.contains(r##"stroke="#999""##),
+        "no trace in the overlay"
+    );
     for e in report["events"].as_array().unwrap() {
         if e["dropped"] == true {
             continue;

@@ -101,6 +101,29 @@ pub fn table(report: &FitReport) -> String {
 /// measured one on top, the fitted model's below (shifted by the time
 /// offset), with the edge thresholds of a two-level trace (30 % / 70 %).
 pub fn overlay_svg(measured: &[Interval], report: &FitReport) -> String {
+    overlay_svg_with(measured, report, None)
+}
+
+/// The analog trace a record was read from, for [`overlay_svg_with`]:
+/// times on the record's axis, its levels and thresholds in its unit.
+#[derive(Debug, Clone, Copy)]
+pub struct TraceOverlay<'a> {
+    pub time: &'a [f64],
+    pub value: &'a [f64],
+    pub open: f64,
+    pub closed: f64,
+    pub low: f64,
+    pub high: f64,
+}
+
+/// [`overlay_svg`], with the measured lane drawn over the analog trace
+/// (grey, scaled so that its open level meets the open state and its
+/// closed level the closed one) and the trace's own thresholds.
+pub fn overlay_svg_with(
+    measured: &[Interval],
+    report: &FitReport,
+    trace: Option<TraceOverlay<'_>>,
+) -> String {
     let model: Vec<(EventKind, f64)> = report
         .events
         .iter()
@@ -120,10 +143,50 @@ pub fn overlay_svg(measured: &[Interval], report: &FitReport) -> String {
         r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="sans-serif" font-size="12">"#
     );
     let _ = writeln!(svg, r#"<rect width="{w}" height="{h}" fill="white"/>"#);
+    // The analog trace under the measured lane (top 30): at most two
+    // points (its extremes) per pixel column.
+    let fractions = match trace {
+        Some(tr) if tr.open != tr.closed => {
+            let frac = |v: f64| (v - tr.open) / (tr.closed - tr.open);
+            let mut points = String::new();
+            let columns = (w - left - right) as usize;
+            let mut column = usize::MAX;
+            let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+            let flush = |points: &mut String, c: usize, lo: f64, hi: f64| {
+                if c < columns && lo.is_finite() {
+                    let xx = left + c as f64;
+                    let _ = write!(
+                        points,
+                        "{xx:.1},{:.1} {xx:.1},{:.1} ",
+                        30.0 + 80.0 * frac(lo),
+                        30.0 + 80.0 * frac(hi)
+                    );
+                }
+            };
+            for (&t, &v) in tr.time.iter().zip(tr.value) {
+                let c = ((x(t) - left).max(0.0)) as usize;
+                if c != column {
+                    flush(&mut points, column, lo, hi);
+                    column = c;
+                    (lo, hi) = (v, v);
+                } else {
+                    (lo, hi) = (lo.min(v), hi.max(v));
+                }
+            }
+            flush(&mut points, column, lo, hi);
+            let _ = writeln!(
+                svg,
+                r##"<polyline points="{points}" fill="none" stroke="#999" stroke-width="1"/>"##
+            );
+            let (a, b) = (frac(tr.low), frac(tr.high));
+            [a.min(b), a.max(b)]
+        }
+        _ => [0.3, 0.7],
+    };
     // Lane `top` .. `top + 80`: open high, closed low.
     let lane = |svg: &mut String, top: f64, label: &str, steps: &[(f64, bool)], colour: &str| {
         let y = |closed: bool| if closed { top + 80.0 } else { top };
-        for frac in [0.3, 0.7] {
+        for frac in fractions {
             let yy = top + 80.0 * frac;
             let _ = writeln!(
                 svg,

@@ -63,16 +63,23 @@ pub struct FitArgs {
     pub force: bool,
 }
 
-fn read_record(args: &FitArgs) -> Result<Option<Record>> {
+/// The record to fit and, for a scope capture, its trace (shifted like the
+/// record), levels and thresholds for the overlay plot.
+type Captured = (chatterspice::capture::Trace, chatterspice::capture::Capture);
+
+fn read_record(args: &FitArgs) -> Result<(Option<Record>, Option<Captured>)> {
     if let Some(scope) = &args.capture {
-        let c = super::capture::analyse(scope, args.channel.as_deref(), None, None)?;
-        return Ok(Some(Record {
+        let (mut trace, c) = super::capture::analyse(scope, args.channel.as_deref(), None, None)?;
+        let origin = c.csv_origin();
+        trace.time.iter_mut().for_each(|t| *t -= origin);
+        let record = Record {
             name: c.source.clone(),
             intervals: c.shifted_intervals(),
-        }));
+        };
+        return Ok((Some(record), Some((trace, c))));
     }
     let Some(csv) = &args.measured else {
-        return Ok(None);
+        return Ok((None, None));
     };
     let text = std::fs::read_to_string(csv)
         .with_context(|| format!("{}: cannot read the measured chatter", csv.display()))?;
@@ -81,7 +88,7 @@ fn read_record(args: &FitArgs) -> Result<Option<Record>> {
         || csv.display().to_string(),
         |n| n.to_string_lossy().into_owned(),
     );
-    Ok(Some(Record { name, intervals }))
+    Ok((Some(Record { name, intervals }), None))
 }
 
 pub fn fit(args: &FitArgs) -> Result<()> {
@@ -94,7 +101,7 @@ pub fn fit(args: &FitArgs) -> Result<()> {
     let text = std::fs::read_to_string(&args.scenario)
         .with_context(|| format!("{}: cannot read the scenario", args.scenario.display()))?;
     let scenario = Scenario::parse(&text, &args.scenario)?;
-    let record = read_record(args)?;
+    let (record, captured) = read_record(args)?;
     let request = FitRequest {
         record: record.clone(),
         free: args.free.clone(),
@@ -121,7 +128,15 @@ pub fn fit(args: &FitArgs) -> Result<()> {
             args.force,
         )?;
         let intervals = record.map(|r| r.intervals).unwrap_or_default();
-        let svg = render::overlay_svg(&intervals, &result);
+        let overlay = captured.as_ref().map(|(trace, c)| render::TraceOverlay {
+            time: &trace.time,
+            value: &trace.value,
+            open: c.levels.open,
+            closed: c.levels.closed,
+            low: c.thresholds.low,
+            high: c.thresholds.high,
+        });
+        let svg = render::overlay_svg_with(&intervals, &result, overlay);
         report::write_new_file(&dir.join("overlay.svg"), svg.as_bytes(), args.force)?;
     }
     let out = match args.format {

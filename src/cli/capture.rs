@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 
-use chatterspice::capture::{Capture, Closed, read_capture};
+use chatterspice::capture::{Capture, Closed, Trace, read_capture};
 use chatterspice::report::{self, units::engineering};
 
 use super::{emit, refuse_existing};
@@ -69,13 +69,13 @@ pub struct CaptureArgs {
     pub force: bool,
 }
 
-/// Reads and analyses the capture `args` name.
+/// Reads and analyses the capture `file`: its trace and what it shows.
 pub fn analyse(
     file: &std::path::Path,
     channel: Option<&str>,
     thresholds: Option<(f64, f64)>,
     closed: Option<ClosedLevel>,
-) -> Result<Capture> {
+) -> Result<(Trace, Capture)> {
     report::protect_input(file);
     let trace = read_capture(file, channel)?;
     let closed = closed.map(|c| match c {
@@ -86,14 +86,15 @@ pub fn analyse(
         || file.display().to_string(),
         |n| n.to_string_lossy().into_owned(),
     );
-    Capture::of(&source, &trace, thresholds, closed)
-        .with_context(|| format!("{}: channel {}", file.display(), trace.channel))
+    let capture = Capture::of(&source, &trace, thresholds, closed)
+        .with_context(|| format!("{}: channel {}", file.display(), trace.channel))?;
+    Ok((trace, capture))
 }
 
 pub fn capture(args: &CaptureArgs) -> Result<()> {
     refuse_existing(args.output.as_deref(), args.force)?;
     let thresholds = args.low.zip(args.high);
-    let c = analyse(&args.file, args.channel.as_deref(), thresholds, args.closed)?;
+    let (_, c) = analyse(&args.file, args.channel.as_deref(), thresholds, args.closed)?;
     let text = match args.format {
         CaptureFormat::Json => {
             let mut t = serde_json::to_string_pretty(&c).expect("a capture serializes");
