@@ -10,6 +10,7 @@
 //! an analysis of the probed signals.
 
 pub mod analysis;
+pub mod arc;
 pub mod calibrate;
 pub mod capture;
 pub mod chatter;

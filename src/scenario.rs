@@ -13,6 +13,7 @@
 //! A validated [`Scenario`] converts into the library's inputs:
 //! [`Scenario::mechanics`], [`Scenario::surface`], [`Scenario::settings`].
 
+pub use crate::arc::ArcSection;
 pub use crate::calibrate::sections::{DatasheetSection, FitSection, ProvenanceSection};
 use std::collections::BTreeMap;
 use std::fmt;
@@ -354,6 +355,11 @@ pub struct LimitsSection {
     pub max_nc_bounce_time: Option<f64>,
     /// Most NC bounces after each release.
     pub max_nc_bounces: Option<u64>,
+    /// J, the most arc energy in one operation, all its arcs together
+    /// (needs `[arc]` and a run).
+    pub max_arc_energy: Option<f64>,
+    /// The most arcs in one operation (needs `[arc]` and a run).
+    pub max_arc_count: Option<u64>,
 }
 
 /// The file as serde sees it; [`Scenario`] adds the origin and the
@@ -377,6 +383,7 @@ struct Document {
     datasheet: Option<DatasheetSection>,
     fit: Option<FitSection>,
     provenance: Option<ProvenanceSection>,
+    arc: Option<ArcSection>,
 }
 
 /// A loaded and validated scenario file.
@@ -406,6 +413,8 @@ pub struct Scenario {
     pub fit: Option<FitSection>,
     /// `[provenance]`: what a `fit` fitted this scenario to.
     pub provenance: Option<ProvenanceSection>,
+    /// `[arc]`: the contact arcs at every opening (docs/arcs.md).
+    pub arc: Option<ArcSection>,
     /// Computed once during validation: converting a Hunt–Crossley
     /// restitution into χ is a root solve that can fail.
     resolved_surface: Surface,
@@ -634,6 +643,7 @@ impl Scenario {
             datasheet: document.datasheet,
             fit: document.fit,
             provenance: document.provenance,
+            arc: document.arc,
             resolved_surface,
             resolved_back_stop,
             embedded_netlist: None,
@@ -1089,6 +1099,26 @@ impl Check<'_> {
         if let Some(limits) = &d.limits {
             self.limits(limits)?;
             self.release_limits(limits, d.coil.is_some())?;
+        }
+        if let Some(arc) = &d.arc {
+            self.arc(arc)?;
+        }
+        if let Some(limits) = d.limits.as_ref().filter(|_| d.arc.is_none()) {
+            let given = [
+                ("limits.max_arc_energy", limits.max_arc_energy.is_some()),
+                ("limits.max_arc_count", limits.max_arc_count.is_some()),
+            ];
+            if let Some((key, _)) = given.iter().find(|(_, set)| *set) {
+                return Err(ScenarioError::MissingKey {
+                    at: self.at(key),
+                    key: "arc".to_owned(),
+                    help: format!(
+                        "`{key}` holds the arcs that [arc] models: add an [arc] section \
+                         (e.g. material = \"Ag\") or remove the limit"
+                    ),
+                    source: None,
+                });
+            }
         }
         Ok((surface, back_stop))
     }
@@ -1634,9 +1664,50 @@ impl Check<'_> {
                 l.max_nc_bounce_time,
                 "the longest NC bounce allowed after a release, in s",
             ),
+            (
+                "limits.max_arc_energy",
+                l.max_arc_energy,
+                "the most arc energy allowed in one operation, in J",
+            ),
         ] {
             if let Some(v) = value {
                 self.number(key, v, v > 0.0, format!("must be > 0: {what}"))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// `[arc]`: every number positive and within the envelope.
+    fn arc(&self, a: &ArcSection) -> Result<(), ScenarioError> {
+        for (key, value, ok, requirement) in [
+            (
+                "arc.v_min",
+                a.v_min,
+                a.v_min.is_some_and(|v| v > 0.0),
+                "must be > 0: the minimum arc voltage, in V (silver: 12)",
+            ),
+            (
+                "arc.i_min",
+                a.i_min,
+                a.i_min.is_some_and(|v| v > 0.0),
+                "must be > 0: the minimum arc current, in A (silver: 0.4)",
+            ),
+            (
+                "arc.field",
+                a.field,
+                a.field.is_some_and(|v| v >= 0.0),
+                "must be ≥ 0: the arc column's voltage gradient, in V/m",
+            ),
+            (
+                "arc.opening_speed",
+                a.opening_speed,
+                a.opening_speed.is_some_and(|v| v > 0.0),
+                "must be > 0: how fast a measured record's contacts part, in m/s",
+            ),
+        ] {
+            if let Some(v) = value {
+                self.number(key, v, ok, requirement)?;
+                self.envelope(key, value)?;
             }
         }
         Ok(())
@@ -1944,6 +2015,10 @@ pub const ENVELOPE: &[(&str, f64, f64, &str)] = &[
     ("simulation.t_end", 0.0, 1e6, "s"),
     ("simulation.min_open_time", 0.0, 1.0, "s"),
     ("simulation.min_gap", 0.0, 1.0, "m"),
+    ("arc.v_min", 0.0, 1e4, "V"),
+    ("arc.i_min", 0.0, 1e4, "A"),
+    ("arc.field", 0.0, 1e8, "V/m"),
+    ("arc.opening_speed", 0.0, 1e3, "m/s"),
 ];
 
 /// Number keys under this prefix name a `.param` of the netlist.

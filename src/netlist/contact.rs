@@ -406,7 +406,7 @@ fn emit_chain(
 }
 
 /// `+ t v t v ...` continuation lines, closed with `)`.
-pub(super) fn pairs(out: &mut String, values: impl Iterator<Item = (f64, f64)>) {
+pub(crate) fn pairs(out: &mut String, values: impl Iterator<Item = (f64, f64)>) {
     let mut current = String::from("+");
     for (t, v) in values {
         let pair = format!(" {} {}", format_time(t), format_time(v));
@@ -427,13 +427,13 @@ fn reciprocal(g: f64) -> f64 {
     format!("{r:.14e}").parse().unwrap_or(r)
 }
 
-pub(super) fn line(out: &mut String, text: &str) {
+pub(crate) fn line(out: &mut String, text: &str) {
     out.push_str(text);
     out.push('\n');
 }
 
 /// `* ` comment lines, wrapped at word boundaries.
-pub(super) fn comment(out: &mut String, text: &str) {
+pub(crate) fn comment(out: &mut String, text: &str) {
     let mut current = String::from("*");
     for word in text.split_whitespace() {
         if current.len() > 1 && current.len() + 1 + word.len() > LINE_WIDTH {

@@ -1,0 +1,370 @@
+//! Every arc and breakdown of a run, read back from its raw file.
+//!
+//! A sample is **arcing** when the arc state is on and the clamp carries
+//! at least half of I_min (the arc, not the closed contact, carries the
+//! current); it is **breaking down** when the state is off and the clamp
+//! conducts at all (more than [`DISCHARGE_FRACTION`] of I_min): the gap
+//! has reached its breakdown voltage with too little current to arc.
+//! Consecutive samples of one kind are one event. Energies are ∫ v·i dt
+//! of the contact voltage and the whole contact current over the event
+//! (trapezoids on ngspice's own time points).
+
+use serde::Serialize;
+
+use super::ArcModel;
+use super::element::ArcVectors;
+use crate::chatter::{Chatter, ContactState};
+use crate::rawfile::{Plot, Vector};
+
+/// A breakdown is a clamp current above this fraction of I_min while the
+/// arc state is off (below it is the clamp's own leakage, < 1 µA).
+pub const DISCHARGE_FRACTION: f64 = 1e-3;
+
+/// One arc.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ArcEvent {
+    /// Which operation (0-based): each break starts the next.
+    pub operation: usize,
+    /// `"bounce N"` (the N-th opening after the first make), `"break"`
+    /// (the opening at release) or `"make"` (before the first make: a
+    /// pre-strike as the gap closes).
+    pub opening: String,
+    /// s
+    pub start: f64,
+    /// s
+    pub duration: f64,
+    /// A, the largest |i|.
+    pub peak_current: f64,
+    /// J, ∫ v·i dt.
+    pub energy: f64,
+    /// C, ∫ |i| dt.
+    pub charge: f64,
+    /// m, the gap when the arc ended.
+    pub gap_at_end: f64,
+    /// Why it ended: `current_below_i_min`, `contact_closed` (the bounce
+    /// closed the contact under the arc) or `run_end` (still burning when
+    /// the simulation stopped).
+    pub ends: &'static str,
+}
+
+/// One breakdown of the open gap (the state off: the current too small
+/// to arc).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Breakdown {
+    pub operation: usize,
+    pub opening: String,
+    /// s
+    pub start: f64,
+    /// s
+    pub duration: f64,
+    /// V, the largest |v| across the gap.
+    pub peak_voltage: f64,
+    /// A, the largest |i|.
+    pub peak_current: f64,
+    /// J
+    pub energy: f64,
+    /// An arc followed at once (the discharge's current reached I_min).
+    pub reignited: bool,
+}
+
+/// The totals over the run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ArcTotals {
+    pub count: usize,
+    /// J, all arcs.
+    pub energy: f64,
+    pub breakdowns: usize,
+    /// J, all breakdowns.
+    pub breakdown_energy: f64,
+    /// s, the longest arc.
+    pub longest: f64,
+    /// J, the most energy in one operation (arcs only): what
+    /// `max_arc_energy` limits.
+    pub max_operation_energy: f64,
+    /// The most arcs in one operation: what `max_arc_count` limits.
+    pub max_operation_count: usize,
+}
+
+/// Arcs, breakdowns and totals of one run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ArcReport {
+    pub model: ArcModel,
+    pub arcs: Vec<ArcEvent>,
+    pub breakdowns: Vec<Breakdown>,
+    pub totals: ArcTotals,
+    /// V, the largest |v| across the contact over the run.
+    pub peak_voltage: f64,
+}
+
+/// Why the arc vectors could not be read.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("the raw file has no vector `{0}`, which the arc analysis reads")]
+pub struct MissingArcVector(pub String);
+
+/// An opening of the contact and its label.
+#[derive(Debug, Clone, PartialEq)]
+struct Opening {
+    start: f64,
+    end: f64,
+    label: String,
+    operation: usize,
+}
+
+/// The openings of `chatter`, labelled. `coil_offs`: when the coil was
+/// switched off (a closure followed by an opening after a coil-off is a
+/// release: a break). Without a coil, only an opening that lasts to the
+/// end of the record is a break.
+fn openings(chatter: &Chatter, coil_offs: &[f64]) -> Vec<Opening> {
+    let mut out = Vec::new();
+    let mut operation = 0;
+    let mut bounce = 0;
+    let mut closed_since: Option<f64> = None;
+    let last = chatter.intervals.len().saturating_sub(1);
+    for (k, iv) in chatter.intervals.iter().enumerate() {
+        match iv.state {
+            ContactState::Closed => {
+                closed_since.get_or_insert(iv.start);
+            }
+            ContactState::Open => {
+                let label = match closed_since.take() {
+                    None => "make".to_owned(),
+                    Some(since) => {
+                        let released = coil_offs.iter().any(|&t| t >= since && t <= iv.start)
+                            || (coil_offs.is_empty() && k == last);
+                        if released {
+                            "break".to_owned()
+                        } else {
+                            bounce += 1;
+                            format!("bounce {bounce}")
+                        }
+                    }
+                };
+                out.push(Opening {
+                    start: iv.start,
+                    end: iv.end,
+                    label: label.clone(),
+                    operation,
+                });
+                if label == "break" {
+                    operation += 1;
+                    bounce = 0;
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The opening an event starting at `t` belongs to.
+fn opening_at(openings: &[Opening], t: f64) -> (usize, String) {
+    openings
+        .iter()
+        .filter(|o| o.start <= t)
+        .min_by(|a, b| {
+            let da = if t <= a.end { 0.0 } else { t - a.end };
+            let db = if t <= b.end { 0.0 } else { t - b.end };
+            da.total_cmp(&db).then(b.start.total_cmp(&a.start))
+        })
+        .or_else(|| openings.first())
+        .map_or((0, "make".to_owned()), |o| (o.operation, o.label.clone()))
+}
+
+/// The arc report of `plot`, whose contact instance wrote `vectors`.
+pub fn analyze(
+    plot: &Plot,
+    vectors: &ArcVectors,
+    model: &ArcModel,
+    gap: &super::GapProfile,
+    chatter: &Chatter,
+    coil_offs: &[f64],
+) -> Result<ArcReport, MissingArcVector> {
+    let real = |name: &str| {
+        plot.real(name)
+            .ok_or_else(|| MissingArcVector(name.to_owned()))
+    };
+    let time = match plot.scale() {
+        Some(Vector::Real(t)) => t,
+        _ => return Err(MissingArcVector("time".to_owned())),
+    };
+    let i = real(&vectors.current)?;
+    let v = real(&vectors.voltage)?;
+    let st = real(&vectors.state)?;
+    let ic = real(&vectors.clamp)?;
+    let openings = openings(chatter, coil_offs);
+    let n = time
+        .len()
+        .min(i.len())
+        .min(v.len())
+        .min(st.len())
+        .min(ic.len());
+
+    #[derive(Clone, Copy, PartialEq)]
+    enum Kind {
+        Quiet,
+        Arc,
+        Discharge,
+    }
+    let kind = |k: usize| {
+        if st[k] >= 0.5 && ic[k].abs() >= 0.5 * model.i_min {
+            Kind::Arc
+        } else if st[k] < 0.5 && ic[k].abs() > DISCHARGE_FRACTION * model.i_min {
+            Kind::Discharge
+        } else {
+            Kind::Quiet
+        }
+    };
+
+    let mut arcs = Vec::new();
+    let mut breakdowns: Vec<Breakdown> = Vec::new();
+    let mut k = 0;
+    while k < n {
+        let this = kind(k);
+        if this == Kind::Quiet {
+            k += 1;
+            continue;
+        }
+        let first = k;
+        while k + 1 < n && kind(k + 1) == this {
+            k += 1;
+        }
+        let last = k;
+        k += 1;
+        let (mut energy, mut charge) = (0.0, 0.0);
+        for j in first..last {
+            let dt = time[j + 1] - time[j];
+            energy += 0.5 * (v[j] * i[j] + v[j + 1] * i[j + 1]) * dt;
+            charge += 0.5 * (i[j].abs() + i[j + 1].abs()) * dt;
+        }
+        let peak_current = i[first..=last].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let (start, end) = (time[first], time[last]);
+        let (operation, opening) = opening_at(&openings, start);
+        match this {
+            Kind::Arc => {
+                let ends = if last + 1 >= n {
+                    "run_end"
+                } else if st[last + 1] >= 0.5 {
+                    "contact_closed"
+                } else {
+                    "current_below_i_min"
+                };
+                if let Some(b) = breakdowns.last_mut() {
+                    if first > 0 && kind(first - 1) == Kind::Discharge {
+                        b.reignited = true;
+                    }
+                }
+                arcs.push(ArcEvent {
+                    operation,
+                    opening,
+                    start,
+                    duration: end - start,
+                    peak_current,
+                    energy,
+                    charge,
+                    gap_at_end: gap.at(end),
+                    ends,
+                });
+            }
+            Kind::Discharge => breakdowns.push(Breakdown {
+                operation,
+                opening,
+                start,
+                duration: end - start,
+                peak_voltage: v[first..=last].iter().fold(0.0f64, |m, x| m.max(x.abs())),
+                peak_current,
+                energy,
+                reignited: false,
+            }),
+            Kind::Quiet => unreachable!("quiet samples are skipped"),
+        }
+    }
+
+    let operations = arcs.iter().map(|a| a.operation + 1).max().unwrap_or(0);
+    let mut per_operation = vec![(0.0, 0usize); operations];
+    for a in &arcs {
+        per_operation[a.operation].0 += a.energy;
+        per_operation[a.operation].1 += 1;
+    }
+    let totals = ArcTotals {
+        count: arcs.len(),
+        energy: arcs.iter().map(|a| a.energy).sum(),
+        breakdowns: breakdowns.len(),
+        breakdown_energy: breakdowns.iter().map(|b| b.energy).sum(),
+        longest: arcs.iter().map(|a| a.duration).fold(0.0, f64::max),
+        max_operation_energy: per_operation.iter().map(|p| p.0).fold(0.0, f64::max),
+        max_operation_count: per_operation.iter().map(|p| p.1).max().unwrap_or(0),
+    };
+    Ok(ArcReport {
+        model: *model,
+        arcs,
+        breakdowns,
+        totals,
+        peak_voltage: v[..n].iter().fold(0.0f64, |m, x| m.max(x.abs())),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::chatter::Interval;
+
+    fn chatter(states: &[(ContactState, f64, f64)]) -> Chatter {
+        Chatter::from_intervals(
+            states
+                .iter()
+                .map(|&(state, start, end)| Interval { state, start, end })
+                .collect(),
+        )
+    }
+
+    #[test]
+    fn openings_are_labelled_bounce_break_and_make() {
+        use ContactState::{Closed, Open};
+        let c = chatter(&[
+            (Open, 0.0, 1.0),
+            (Closed, 1.0, 2.0),
+            (Open, 2.0, 2.1),
+            (Closed, 2.1, 3.0),
+            (Open, 3.0, 3.1),
+            (Closed, 3.1, 10.0),
+            (Open, 10.0, 20.0),
+        ]);
+        let labels: Vec<_> = openings(&c, &[])
+            .into_iter()
+            .map(|o| (o.label, o.operation))
+            .collect();
+        assert_eq!(
+            labels,
+            [
+                ("make".to_owned(), 0),
+                ("bounce 1".to_owned(), 0),
+                ("bounce 2".to_owned(), 0),
+                ("break".to_owned(), 0)
+            ]
+        );
+        // With a coil: the opening after coil-off is the break, and the
+        // next closing is operation 1.
+        let c = chatter(&[
+            (Open, 0.0, 1.0),
+            (Closed, 1.0, 5.0),
+            (Open, 5.0, 8.0),
+            (Closed, 8.0, 8.5),
+            (Open, 8.5, 8.6),
+            (Closed, 8.6, 12.0),
+            (Open, 12.0, 20.0),
+        ]);
+        let labels: Vec<_> = openings(&c, &[4.0, 11.0])
+            .into_iter()
+            .map(|o| (o.label, o.operation))
+            .collect();
+        assert_eq!(
+            labels,
+            [
+                ("make".to_owned(), 0),
+                ("break".to_owned(), 0),
+                ("bounce 1".to_owned(), 1),
+                ("break".to_owned(), 1)
+            ]
+        );
+        assert_eq!(opening_at(&openings(&c, &[4.0, 11.0]), 8.55).1, "bounce 1");
+    }
+}

@@ -1,0 +1,147 @@
+//! The arc inside ngspice: lines added to the contact subcircuit.
+//!
+//! The contact's own element (the time-varying conductance) stays as it
+//! is, between internal node `a` and terminal `b`; the subcircuit's first
+//! terminal becomes `ax`, joined to `a` by a 0 V source `Vs` that senses
+//! the whole contact current. In parallel with the conductance:
+//!
+//! - the **arc state** `st` (1 burning or able to burn, 0 not): a
+//!   voltage-controlled switch `Sst` on `|i(Vs)|` with its threshold at
+//!   I_min, closing at I_min and opening 0.4 % below it. A closed contact
+//!   carrying at least I_min holds the state on, so a separation under
+//!   current starts an arc at once; a current that falls below I_min puts
+//!   it out;
+//! - the **hold voltage** `th`: V_arc(t) = V_min + E·gap(t) while the state
+//!   is on, the breakdown voltage max(V_bd(gap(t)), V_min) while it is off
+//!   (both are PWL sources sampled from the gap profile);
+//! - the **clamp** `Barc`: a smooth odd current source that draws nothing
+//!   while |v| < th and conducts steeply above it, so the contact voltage
+//!   can exceed th only by a few millivolts (softplus of width
+//!   [`CLAMP_SOFTNESS`]; at 1 A it holds th − 20 mV, at 100 A th + 9 mV).
+//!
+//! Its current is sensed by `Vc`, and `Bva` copies the contact voltage to
+//! a node, so the raw file has what the arc analysis needs.
+
+use super::{ArcModel, GapProfile};
+use crate::netlist::contact::{comment, line, pairs};
+use crate::netlist::{ContactInclude, NetlistError};
+use crate::waveform::format_time;
+
+/// V, the softplus width of the clamp.
+pub const CLAMP_SOFTNESS: f64 = 5e-3;
+
+/// A, the clamp's current scale (conductance × softness): 10 kS above th.
+pub const CLAMP_SCALE: f64 = 50.0;
+
+/// The arc state's hysteresis, relative to I_min: on at I_min, off this
+/// fraction below it.
+pub const STATE_HYSTERESIS: f64 = 4e-3;
+
+/// The vectors the arc analysis reads for contact instance `instance`
+/// (e.g. `x1`, lowercase as ngspice names it).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ArcVectors {
+    /// The whole contact current, a → b.
+    pub current: String,
+    /// The contact voltage v(a, b).
+    pub voltage: String,
+    /// The arc state, 0..1.
+    pub state: String,
+    /// The clamp's (arc or breakdown) current.
+    pub clamp: String,
+}
+
+impl ArcVectors {
+    pub fn of(instance: &str) -> ArcVectors {
+        ArcVectors {
+            current: format!("i(v.{instance}.vs)"),
+            voltage: format!("v({instance}.va)"),
+            state: format!("v({instance}.st)"),
+            clamp: format!("i(v.{instance}.vc)"),
+        }
+    }
+
+    pub fn all(&self) -> [&str; 4] {
+        [&self.current, &self.voltage, &self.state, &self.clamp]
+    }
+}
+
+/// `include` with the arc added (see the module overview), the hold
+/// voltages sampled at the gap profile's times.
+pub fn with_arc(
+    mut include: ContactInclude,
+    model: &ArcModel,
+    gap: &GapProfile,
+) -> Result<ContactInclude, NetlistError> {
+    let subckt = include.subckt.clone();
+    let header = format!(".subckt {subckt} a b\n");
+    let ends = format!(".ends {subckt}\n");
+    let (Some(head_at), Some(ends_at)) = (include.text.find(&header), include.text.rfind(&ends))
+    else {
+        unreachable!("contact_include writes `.subckt NAME a b` and `.ends NAME`");
+    };
+    let mut arc = String::new();
+    comment(
+        &mut arc,
+        &format!(
+            "Arc: V_min = {} V, I_min = {} A, column gradient {} V/m. Vs senses the \
+             contact current; switch Sst holds the arc state V(st) on from I_min; the \
+             clamp Barc holds |V(a,b)| at V_arc = V_min + E*gap(t) while the state is \
+             on, at the gap's breakdown voltage while it is off.",
+            format_time(model.v_min),
+            format_time(model.i_min),
+            format_time(model.field)
+        ),
+    );
+    line(&mut arc, "Vs ax a 0");
+    line(&mut arc, "Vc a ac 0");
+    let samples = gap.samples();
+    line(&mut arc, "Vvarc varc 0 PWL(");
+    pairs(
+        &mut arc,
+        samples.iter().map(|&(t, g)| (t, model.arc_voltage(g))),
+    );
+    line(&mut arc, "Vvbd vbd 0 PWL(");
+    pairs(
+        &mut arc,
+        samples.iter().map(|&(t, g)| (t, model.hold_voltage(g))),
+    );
+    line(&mut arc, "Bia ia 0 V = abs(i(Vs))");
+    line(&mut arc, "Von on 0 1");
+    line(&mut arc, "Sst on st ia 0 arc_state");
+    line(&mut arc, "Rst st 0 1k");
+    let half = 0.5 * STATE_HYSTERESIS * model.i_min;
+    line(
+        &mut arc,
+        &format!(
+            ".model arc_state sw vt={} vh={} ron=1m roff=1e9",
+            format_time(model.i_min - half),
+            format_time(half)
+        ),
+    );
+    line(
+        &mut arc,
+        "Bth th 0 V = V(varc) + (V(vbd) - V(varc)) * (1 - V(st))",
+    );
+    let s = format_time(CLAMP_SOFTNESS);
+    let softplus = |x: &str| format!("(max({x}/{s},0) + ln(1 + exp(-abs({x}/{s}))))");
+    line(
+        &mut arc,
+        &format!(
+            "Barc ac b I = {} * ({} - {})",
+            format_time(CLAMP_SCALE),
+            softplus("(V(ac,b) - V(th))"),
+            softplus("(-V(ac,b) - V(th))")
+        ),
+    );
+    line(&mut arc, "Bva va 0 V = V(a,b)");
+
+    let mut text = String::with_capacity(include.text.len() + arc.len() + 8);
+    text.push_str(&include.text[..head_at]);
+    text.push_str(&format!(".subckt {subckt} ax b\n"));
+    text.push_str(&include.text[head_at + header.len()..ends_at]);
+    text.push_str(&arc);
+    text.push_str(&include.text[ends_at..]);
+    include.text = text;
+    Ok(include)
+}
