@@ -23,6 +23,8 @@ use std::time::Duration;
 use thiserror::Error;
 
 use crate::analysis::{self, AnalysisError, Comparison, ProbeAnalysis};
+use crate::arc::element::{ArcVectors, with_arc};
+use crate::arc::{ArcModel, ArcReport, GapProfile, analysis::MissingArcVector};
 use crate::chatter::{Chatter, ContactState, Interval};
 use crate::coil::coupled::Iteration;
 use crate::coil::coupled::nc_include;
@@ -144,6 +146,13 @@ pub enum RunError {
         netlist: PathBuf,
         plots: String,
     },
+    #[error("{}: cannot analyse the arcs of the {run} run", netlist.display())]
+    Arc {
+        run: &'static str,
+        netlist: PathBuf,
+        #[source]
+        source: MissingArcVector,
+    },
     #[error("{}: probe `{signal}` ({run} run)", origin.display())]
     Probe {
         origin: PathBuf,
@@ -199,6 +208,8 @@ pub struct RunResult {
     /// For a coil-driven relay: each operation (closing and release) with
     /// its timing. Empty for a step force.
     pub operations: Vec<Operation>,
+    /// With `[arc]`: every arc and breakdown at the contact.
+    pub arcs: Option<ArcReport>,
 }
 
 /// Run the whole pipeline on `scenario` with `runner`. A scenario with a
@@ -222,7 +233,8 @@ pub fn run(
             }
         })?;
     let (waveform, model) = contact_waveform(scenario, &chatter)?;
-    run_chatter(scenario, chatter, waveform, &model, runner, options)
+    let gap = GapProfile::from_step_force(&mechanics, &chatter);
+    run_chatter(scenario, chatter, waveform, &model, gap, runner, options)
 }
 
 /// [`run`] with a measured chatter sequence (e.g. from
@@ -251,7 +263,11 @@ pub fn run_measured(
             source,
         }
     })?;
-    run_chatter(scenario, chatter, waveform, &model, runner, options)
+    let speed = scenario.arc.map_or(crate::arc::DEFAULT_OPENING_SPEED, |a| {
+        a.model().opening_speed
+    });
+    let gap = GapProfile::from_intervals(&chatter.intervals, speed, scenario.mechanics.gap);
+    run_chatter(scenario, chatter, waveform, &model, gap, runner, options)
 }
 
 /// The scenario has what `run` needs besides the relay.
@@ -276,6 +292,7 @@ fn run_chatter(
     chatter: Chatter,
     waveform: Waveform,
     model: &ContactModel,
+    gap: GapProfile,
     runner: &dyn Runner,
     options: &RunOptions,
 ) -> Result<RunResult, RunError> {
@@ -296,8 +313,16 @@ fn run_chatter(
         .element
         .unwrap_or_else(|| ContactElement::for_waveform(&waveform));
     let include = netlist::contact_include(&waveform, &circuit.subckt, element)?;
+    let arc = arc_setup(scenario, &netlist_text);
+    let include = match &arc {
+        Some((arc_model, _)) => with_arc(include, arc_model, &gap)?,
+        None => include,
+    };
 
-    let signals: Vec<&str> = scenario.probes.iter().map(|p| p.signal.as_str()).collect();
+    let mut signals: Vec<&str> = scenario.probes.iter().map(|p| p.signal.as_str()).collect();
+    if let Some((_, vectors)) = &arc {
+        signals.extend(vectors.all());
+    }
     let end = chatter_end(&chatter) + model.edge_time;
     let deck = netlist::prepare_deck_with_params(
         &DeckRequest {
@@ -359,12 +384,25 @@ fn run_chatter(
         ideal.as_ref().map(|sim| &sim.plot),
     )?;
 
+    let arcs = arc
+        .as_ref()
+        .map(|(arc_model, vectors)| {
+            crate::arc::analysis::analyze(&simulation.plot, vectors, arc_model, &gap, &chatter, &[])
+        })
+        .transpose()
+        .map_err(|source| RunError::Arc {
+            run: "bounced",
+            netlist: netlist_path.clone(),
+            source,
+        })?;
+
     let mut warnings: Vec<String> = deck.warnings.iter().map(ToString::to_string).collect();
     warnings.extend(simulation.warnings.iter().cloned());
     warnings.extend(probes.iter().filter_map(|p| p.analysis.threshold_warning()));
     Ok(RunResult {
         coupling: None,
         operations: Vec::new(),
+        arcs,
         netlist: netlist_path,
         chatter,
         waveform,
@@ -484,7 +522,21 @@ fn run_coil(
         warnings,
         coupling: Some(coupled.iterations),
         operations: coupled.operations,
+        arcs: None,
     })
+}
+
+/// With `[arc]`: the arc numbers and the vectors of the contact instance
+/// the arcs are read from (the first, when the netlist has several).
+/// `None` without `[arc]`, or when the netlist has no contact instance
+/// (the deck names that error).
+fn arc_setup(scenario: &Scenario, netlist_text: &str) -> Option<(ArcModel, ArcVectors)> {
+    let section = scenario.arc.as_ref()?;
+    let circuit = scenario.circuit.as_ref()?;
+    let instance = netlist::instances_of(netlist_text, &circuit.subckt)
+        .into_iter()
+        .next()?;
+    Some((section.model(), ArcVectors::of(&instance)))
 }
 
 /// The contact waveform of `chatter` as `scenario`'s `[contact]` section

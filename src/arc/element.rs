@@ -28,10 +28,10 @@ use crate::netlist::{ContactInclude, NetlistError};
 use crate::waveform::format_time;
 
 /// V, the softplus width of the clamp.
-pub const CLAMP_SOFTNESS: f64 = 5e-3;
+pub const CLAMP_SOFTNESS: f64 = 2e-3;
 
 /// A, the clamp's current scale (conductance × softness): 10 kS above th.
-pub const CLAMP_SCALE: f64 = 50.0;
+pub const CLAMP_SCALE: f64 = 20.0;
 
 /// The arc state's hysteresis, relative to I_min: on at I_min, off this
 /// fraction below it.

@@ -10,6 +10,7 @@
 use serde::Serialize;
 
 use crate::analysis::{Comparison, ProbeAnalysis};
+use crate::arc::{ArcEvent, ArcModel, ArcTotals, Breakdown};
 use crate::chatter::Chatter;
 use crate::check::{Evidence, Verdict};
 use crate::coil::coupled::Iteration;
@@ -96,6 +97,18 @@ pub struct RunJson<'a> {
     /// The first closing's operate, bounce and settle time, from the
     /// coil being energized (or the force step).
     timing: Closing,
+    /// With `[arc]`: every arc at the contact.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    arcs: Option<&'a [ArcEvent]>,
+    /// With `[arc]`: the totals (count, energy, breakdowns, ...).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    arc_totals: Option<&'a ArcTotals>,
+    /// With `[arc]`: every breakdown of the open gap.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    breakdowns: Option<&'a [Breakdown]>,
+    /// With `[arc]`: the numbers the arcs were simulated with.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    arc_model: Option<&'a ArcModel>,
 }
 
 /// One probe: the contract's fields (flattened from the analysis), then
@@ -167,6 +180,10 @@ impl<'a> RunJson<'a> {
             coupling: run.coupling.as_deref(),
             operations: &run.operations,
             timing: Closing::first(&run.chatter, &run.operations),
+            arcs: run.arcs.as_ref().map(|a| a.arcs.as_slice()),
+            arc_totals: run.arcs.as_ref().map(|a| &a.totals),
+            breakdowns: run.arcs.as_ref().map(|a| a.breakdowns.as_slice()),
+            arc_model: run.arcs.as_ref().map(|a| &a.model),
         }
     }
 }
