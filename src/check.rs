@@ -28,6 +28,7 @@ use serde::Serialize;
 use thiserror::Error;
 
 use crate::analysis::ProbeAnalysis;
+use crate::arc::ArcReport;
 use crate::chatter::{Chatter, Interval};
 use crate::coil::{Closing, Operation};
 use crate::mechanics::{MechanicsError, simulate};
@@ -175,7 +176,7 @@ pub enum CheckError {
     #[error(
         "{}: nothing to check: add a [limits] section (max_bounce_time, max_bounces, \
          max_operate_time, max_settle_time; with a coil max_release_time, \
-         max_nc_bounce_time, max_nc_bounces) or limits on a [[probe]] (max_edges, \
+         max_nc_bounce_time, max_nc_bounces; with [arc] max_arc_energy, max_arc_count) or limits on a [[probe]] (max_edges, \
          max_glitches, max_peak, max_value, min_value, max_last_edge)",
         path.display()
     )]
@@ -391,10 +392,43 @@ pub fn evaluate(scenario: &Scenario, run: &RunResult) -> Verdict {
         .as_ref()
         .map(|l| relay_checks(l, &run.chatter, &run.operations))
         .unwrap_or_default();
+    if let Some(limits) = &scenario.limits {
+        checks.extend(arc_checks(limits, run.arcs.as_ref()));
+    }
     for (i, (probe, result)) in scenario.probes.iter().zip(&run.probes).enumerate() {
         checks.extend(probe_checks(i, probe, &result.analysis));
     }
     Verdict::new(checks)
+}
+
+/// `max_arc_energy` and `max_arc_count` against the worst operation of
+/// the run's arcs.
+pub fn arc_checks(limits: &LimitsSection, arcs: Option<&ArcReport>) -> Vec<LimitCheck> {
+    let missing = || "the run has no arc report: add an [arc] section".to_owned();
+    let mut out = Vec::new();
+    if let Some(limit) = limits.max_arc_energy {
+        out.push(LimitCheck::new(
+            "limits.max_arc_energy".into(),
+            "arc energy in one operation".into(),
+            "J",
+            Bound::Max,
+            limit,
+            arcs.map(|a| a.totals.max_operation_energy)
+                .ok_or_else(missing),
+        ));
+    }
+    if let Some(limit) = limits.max_arc_count {
+        out.push(LimitCheck::new(
+            "limits.max_arc_count".into(),
+            "arcs in one operation".into(),
+            "",
+            Bound::Max,
+            limit as f64,
+            arcs.map(|a| a.totals.max_operation_count as f64)
+                .ok_or_else(missing),
+        ));
+    }
+    out
 }
 
 /// What [`run`] did to reach its verdict.
@@ -445,9 +479,20 @@ pub fn run_with(
     relay_only(scenario)
 }
 
-/// Whether a probe has a limit; an error when nothing at all is limited.
+/// Whether a limit needs the circuit run: a probe's limits, or the arc
+/// limits.
+pub fn needs_circuit(scenario: &Scenario) -> bool {
+    let arc_limits = scenario
+        .limits
+        .as_ref()
+        .is_some_and(|l| l.max_arc_energy.is_some() || l.max_arc_count.is_some());
+    scenario.probes.iter().any(Probe::has_limits) || arc_limits
+}
+
+/// Whether a limit needs the circuit; an error when nothing at all is
+/// limited.
 fn limits_to_hold(scenario: &Scenario) -> Result<bool, CheckError> {
-    let probe_limits = scenario.probes.iter().any(Probe::has_limits);
+    let probe_limits = needs_circuit(scenario);
     if scenario.limits.is_none() && !probe_limits {
         return Err(CheckError::NoLimits {
             path: scenario.origin.clone(),

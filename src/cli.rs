@@ -393,12 +393,11 @@ fn run(args: &RunArgs) -> Result<()> {
 
 fn check(args: &CheckArgs) -> Result<Status> {
     let scenario = load_scenario(args.scenario.as_deref())?;
-    let needs_ngspice = scenario.coil.is_some() || scenario.probes.iter().any(|p| p.has_limits());
+    let needs_ngspice = scenario.coil.is_some() || check::needs_circuit(&scenario);
     let options = args.simulator.run_options();
     let (verdict, evidence) = if let Some(csv) = &args.measured {
         let intervals = read_measured(csv)?;
-        let probe_limits = scenario.probes.iter().any(|p| p.has_limits());
-        if probe_limits {
+        if check::needs_circuit(&scenario) {
             let ngspice = Ngspice::locate_within(
                 args.simulator.ngspice.as_deref(),
                 args.simulator.timeout(),

@@ -472,6 +472,7 @@ fn run_coil(
         runner,
         &CouplingOptions {
             timeout: options.timeout,
+            keep_workdir: options.keep_workdir,
             ..options.coupling.clone()
         },
     )
@@ -490,12 +491,43 @@ fn run_coil(
         .element
         .unwrap_or_else(|| ContactElement::for_waveform(&waveform));
     let mut include = netlist::contact_include(&waveform, &circuit.subckt, element)?;
+    let netlist_text = scenario.netlist().transpose()?.map(|(_, text)| text);
+    let arc = netlist_text
+        .as_deref()
+        .and_then(|text| arc_setup(scenario, text));
+    let gap = GapProfile::from_path(scenario.mechanics.gap, &coupled.path);
+    if let Some((arc_model, _)) = &arc {
+        include = with_arc(include, arc_model, &gap)?;
+    }
     if let Some(nc) = &circuit.nc_subckt {
         let nc = nc_include(&coupled.back, &model, nc, &scenario.origin)
             .map_err(|e| RunError::Coupling(Box::new(e)))?;
         include.text.push_str(&nc);
     }
     let probes = probe_results(scenario, &coupled.chatter, ("coupled", &coupled.plot), None)?;
+    let coil_offs: Vec<f64> = coupled
+        .operations
+        .iter()
+        .filter_map(|op| op.coil_off)
+        .collect();
+    let arcs = arc
+        .as_ref()
+        .map(|(arc_model, vectors)| {
+            crate::arc::analysis::analyze(
+                &coupled.plot,
+                vectors,
+                arc_model,
+                &gap,
+                &coupled.chatter,
+                &coil_offs,
+            )
+        })
+        .transpose()
+        .map_err(|source| RunError::Arc {
+            run: "coupled",
+            netlist: circuit.netlist.clone(),
+            source,
+        })?;
     let elapsed: f64 = coupled.iterations.iter().map(|i| i.ngspice_elapsed).sum();
     let netlist_path = circuit.netlist.clone();
     let warnings = coupled
@@ -522,7 +554,7 @@ fn run_coil(
         warnings,
         coupling: Some(coupled.iterations),
         operations: coupled.operations,
-        arcs: None,
+        arcs,
     })
 }
 

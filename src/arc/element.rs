@@ -6,14 +6,16 @@
 //! the whole contact current. In parallel with the conductance:
 //!
 //! - the **arc state** `st` (1 burning or able to burn, 0 not): a
-//!   voltage-controlled switch `Sst` on `|i(Vs)|` with its threshold at
+//!   voltage-controlled switch `Sst` on `|i(Vs)|` (seen through a lag of
+//!   [`STATE_LAG`]) with its threshold at
 //!   I_min, closing at I_min and opening 0.4 % below it. A closed contact
 //!   carrying at least I_min holds the state on, so a separation under
 //!   current starts an arc at once; a current that falls below I_min puts
 //!   it out;
 //! - the **hold voltage** `th`: V_arc(t) = V_min + E·gap(t) while the state
 //!   is on, the breakdown voltage max(V_bd(gap(t)), V_min) while it is off
-//!   (both are PWL sources sampled from the gap profile);
+//!   (both are PWL sources sampled from the gap profile), following a
+//!   change of state with a lag of [`THRESHOLD_LAG`];
 //! - the **clamp** `Barc`: a smooth odd current source that draws nothing
 //!   while |v| < th and conducts steeply above it, so the contact voltage
 //!   can exceed th only by a few millivolts (softplus of width
@@ -21,6 +23,14 @@
 //!
 //! Its current is sensed by `Vc`, and `Bva` copies the contact voltage to
 //! a node, so the raw file has what the arc analysis needs.
+//!
+//! The include also sets `.options method=gear`: against a capacitance
+//! across the contact (wiring, a snubber) the clamp's 10 kS make a mode
+//! of tens of picoseconds, which the trapezoidal rule, not being
+//! L-stable, turns into an alternation of the arc current from one time
+//! point to the next (measured: 0.02 A and 1.97 A in turn about a 1 A
+//! arc); Gear's method damps it. A netlist's own later `.options method`
+//! wins.
 
 use super::{ArcModel, GapProfile};
 use crate::netlist::contact::{comment, line, pairs};
@@ -32,6 +42,24 @@ pub const CLAMP_SOFTNESS: f64 = 2e-3;
 
 /// A, the clamp's current scale (conductance × softness): 10 kS above th.
 pub const CLAMP_SCALE: f64 = 20.0;
+
+/// s, the lag of the hold voltage behind the arc state (an RC of 1 Ω and
+/// this many farads). A restrike drops the hold voltage from the
+/// breakdown voltage to V_arc; the lag makes the circuit's capacitance
+/// across the gap discharge into the arc over tens of nanoseconds, with
+/// currents of amperes, as in a real restrike, instead of in one time step
+/// through the clamp's 10 kS (kiloamperes for picoseconds, which no time
+/// step resolves).
+pub const THRESHOLD_LAG: f64 = 50e-9;
+
+/// s, the time constant of the current the arc state sees (an RC of 1 Ω
+/// and this many farads). At separation the capacitance across the
+/// contact (wiring, a snubber) takes the current for the nanoseconds the
+/// voltage needs to reach V_arc; a real contact bridges them with its
+/// molten metal bridge, so the state must not see that dip as an
+/// extinction. 100 ns delays a DC extinction by 100 ns and ignores dips
+/// of a few ns.
+pub const STATE_LAG: f64 = 100e-9;
 
 /// The arc state's hysteresis, relative to I_min: on at I_min, off this
 /// fraction below it.
@@ -106,7 +134,12 @@ pub fn with_arc(
         &mut arc,
         samples.iter().map(|&(t, g)| (t, model.hold_voltage(g))),
     );
-    line(&mut arc, "Bia ia 0 V = abs(i(Vs))");
+    line(&mut arc, "Bia iar 0 V = abs(i(Vs))");
+    line(&mut arc, "Ria iar ia 1");
+    line(
+        &mut arc,
+        &format!("Cia ia 0 {} IC=0", format_time(STATE_LAG)),
+    );
     line(&mut arc, "Von on 0 1");
     line(&mut arc, "Sst on st ia 0 arc_state");
     line(&mut arc, "Rst st 0 1k");
@@ -121,7 +154,16 @@ pub fn with_arc(
     );
     line(
         &mut arc,
-        "Bth th 0 V = V(varc) + (V(vbd) - V(varc)) * (1 - V(st))",
+        "Bth thr 0 V = V(varc) + (V(vbd) - V(varc)) * (1 - V(st))",
+    );
+    line(&mut arc, "Rth thr th 1");
+    line(
+        &mut arc,
+        &format!(
+            "Cth th 0 {} IC={}",
+            format_time(THRESHOLD_LAG),
+            format_time(model.hold_voltage(gap.at(0.0)))
+        ),
     );
     let s = format_time(CLAMP_SOFTNESS);
     let softplus = |x: &str| format!("(max({x}/{s},0) + ln(1 + exp(-abs({x}/{s}))))");
@@ -135,6 +177,13 @@ pub fn with_arc(
         ),
     );
     line(&mut arc, "Bva va 0 V = V(a,b)");
+    comment(
+        &mut arc,
+        "The clamp is stiff against any capacitance across the contact: the \
+         trapezoidal rule would make the arc current alternate from one time point \
+         to the next, so the run integrates with Gear's method.",
+    );
+    line(&mut arc, ".options method=gear");
 
     let mut text = String::with_capacity(include.text.len() + arc.len() + 8);
     text.push_str(&include.text[..head_at]);

@@ -32,6 +32,8 @@ use super::cycle::Stops;
 use super::forced::simulate_cycle;
 use super::timing::{Operation, Switching, operations};
 use super::{Coil, CoilError};
+use crate::arc::GapProfile;
+use crate::arc::element::{ArcVectors, with_arc};
 use crate::chatter::{Chatter, ContactState, Interval};
 use crate::mechanics::Mechanics;
 use crate::netlist::coil::coil_include;
@@ -55,6 +57,9 @@ pub struct CouplingOptions {
     pub max_iterations: usize,
     /// Wall-clock limit of each ngspice run.
     pub timeout: Duration,
+    /// Keep every pass's ngspice work directory (they are named in the
+    /// warnings of `run`).
+    pub keep_workdir: bool,
     /// Settle the coil and the mechanics against each ngspice run's coil
     /// voltage before the next run (see [`super::accelerate`]); `false`
     /// is the plain relaxation, which hands the mechanics' path straight
@@ -73,6 +78,7 @@ impl Default for CouplingOptions {
             tolerance: 1e-7,
             max_iterations: 20,
             timeout: RunRequest::DEFAULT_TIMEOUT,
+            keep_workdir: false,
             accelerate: true,
         }
     }
@@ -287,6 +293,14 @@ pub fn run_coupled(
     // The coil's own vectors too, in case the netlist `.save`s only some.
     let mut signals: Vec<&str> = scenario.probes.iter().map(|p| p.signal.as_str()).collect();
     signals.extend([psi.as_str(), volts.as_str(), current.as_str()]);
+    // With [arc], the contact carries the arc in every pass.
+    let arc = scenario.arc.map(|a| a.model());
+    let arc_vectors = instances_of(&netlist_text, &circuit.subckt)
+        .first()
+        .map(|instance| ArcVectors::of(instance));
+    if let (Some(_), Some(vectors)) = (&arc, &arc_vectors) {
+        signals.extend(vectors.all());
+    }
 
     // Iteration 0: the armature at rest, the contact open.
     let mut chatter = steady_chatter(ContactState::Open, settings.t_end);
@@ -305,6 +319,9 @@ pub fn run_coupled(
             &circuit.subckt,
             ContactElement::for_waveform(&waveform),
         )?;
+        if let Some(arc) = &arc {
+            contact = with_arc(contact, arc, &GapProfile::from_path(m.gap, &path))?;
+        }
         if let Some(nc) = &circuit.nc_subckt {
             contact
                 .text
@@ -338,7 +355,7 @@ pub fn run_coupled(
                 deck: deck.text.clone(),
                 includes,
                 timeout: options.timeout,
-                keep_workdir: false,
+                keep_workdir: options.keep_workdir,
             })
             .map_err(|source| CouplingError::Spice {
                 netlist: netlist_path.clone(),

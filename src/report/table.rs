@@ -10,6 +10,7 @@ use std::fmt::Write;
 
 use super::units::engineering;
 use crate::analysis::ProbeAnalysis;
+use crate::arc::ArcReport;
 use crate::chatter::{Chatter, Impact, Outcome};
 use crate::check::{Bound, Verdict, quantity};
 use crate::coil::{Closing, Operation};
@@ -229,7 +230,73 @@ pub fn render_run(run: &RunResult) -> String {
             out.push_str(&align(&rows, 1));
         }
     }
+    if let Some(report) = &run.arcs {
+        out.push('\n');
+        out.push_str(&render_arcs(report));
+    }
     // Warnings are not part of the table: the CLI prints them on stderr.
+    out
+}
+
+/// The arcs of a run: the totals line, then one row per arc and per
+/// breakdown.
+pub fn render_arcs(report: &ArcReport) -> String {
+    let mut out = String::new();
+    let t = &report.totals;
+    let m = &report.model;
+    let _ = writeln!(
+        out,
+        "arcs: {} arc{}, {} in all (most in one operation: {}); {} breakdown{}, {}; \
+         contact peak {} (V_min {}, I_min {}, field {})",
+        t.count,
+        if t.count == 1 { "" } else { "s" },
+        engineering(t.energy, "J"),
+        engineering(t.max_operation_energy, "J"),
+        t.breakdowns,
+        if t.breakdowns == 1 { "" } else { "s" },
+        engineering(t.breakdown_energy, "J"),
+        engineering(report.peak_voltage, "V"),
+        engineering(m.v_min, "V"),
+        engineering(m.i_min, "A"),
+        engineering(m.field, "V/m"),
+    );
+    if report.arcs.is_empty() && report.breakdowns.is_empty() {
+        return out;
+    }
+    let mut rows = vec![
+        [
+            "event", "opening", "start", "duration", "peak", "energy", "ends",
+        ]
+        .map(String::from),
+    ];
+    for a in &report.arcs {
+        rows.push([
+            "  arc".to_owned(),
+            a.opening.clone(),
+            ms(Some(a.start)),
+            engineering(a.duration, "s"),
+            engineering(a.peak_current, "A"),
+            engineering(a.energy, "J"),
+            a.ends.replace('_', " "),
+        ]);
+    }
+    for b in &report.breakdowns {
+        rows.push([
+            "  breakdown".to_owned(),
+            b.opening.clone(),
+            ms(Some(b.start)),
+            engineering(b.duration, "s"),
+            engineering(b.peak_voltage, "V"),
+            engineering(b.energy, "J"),
+            if b.reignited {
+                "arc followed"
+            } else {
+                "collapsed"
+            }
+            .to_owned(),
+        ]);
+    }
+    out.push_str(&align(&rows, 2));
     out
 }
 
