@@ -399,6 +399,15 @@ fn run_chatter(
     let mut warnings: Vec<String> = deck.warnings.iter().map(ToString::to_string).collect();
     warnings.extend(simulation.warnings.iter().cloned());
     warnings.extend(probes.iter().filter_map(|p| p.analysis.threshold_warning()));
+    warnings.extend(arc_warnings(
+        scenario,
+        &netlist_text,
+        arcs.as_ref(),
+        &simulation.plot,
+        &waveform,
+        &chatter,
+        &gap,
+    ));
     Ok(RunResult {
         coupling: None,
         operations: Vec::new(),
@@ -530,12 +539,23 @@ fn run_coil(
         })?;
     let elapsed: f64 = coupled.iterations.iter().map(|i| i.ngspice_elapsed).sum();
     let netlist_path = circuit.netlist.clone();
-    let warnings = coupled
+    let mut warnings: Vec<String> = coupled
         .deck
         .warnings
         .iter()
         .map(ToString::to_string)
         .collect();
+    if let Some(text) = &netlist_text {
+        warnings.extend(arc_warnings(
+            scenario,
+            text,
+            arcs.as_ref(),
+            &coupled.plot,
+            &waveform,
+            &coupled.chatter,
+            &gap,
+        ));
+    }
     Ok(RunResult {
         netlist: netlist_path,
         chatter: coupled.chatter,
@@ -556,6 +576,56 @@ fn run_coil(
         operations: coupled.operations,
         arcs,
     })
+}
+
+/// What to say about arcs: with `[arc]`, an arc still burning when the
+/// simulation stopped; without it, a result that is not physical because
+/// the contact would have arced or its gap broken down.
+fn arc_warnings(
+    scenario: &Scenario,
+    netlist_text: &str,
+    arcs: Option<&ArcReport>,
+    plot: &Plot,
+    waveform: &Waveform,
+    chatter: &Chatter,
+    gap: &GapProfile,
+) -> Vec<String> {
+    if let Some(report) = arcs {
+        return report
+            .arcs
+            .iter()
+            .filter(|a| a.ends == "run_end")
+            .map(|a| {
+                format!(
+                    "the arc at {} (from {:.4} ms) still burns when the simulation stops: \
+                     the circuit drives more than V_arc = V_min + field·gap across the \
+                     widest gap; extend .tran, or the contact cannot break this load",
+                    a.opening,
+                    a.start * 1e3
+                )
+            })
+            .collect();
+    }
+    let Some(circuit) = &scenario.circuit else {
+        return Vec::new();
+    };
+    let Some((a, b)) = netlist::instance_nodes_of(netlist_text, &circuit.subckt)
+        .into_iter()
+        .next()
+    else {
+        return Vec::new();
+    };
+    let vector = |node: &str| (!matches!(node, "0" | "gnd")).then(|| format!("v({node})"));
+    let (va, vb) = (vector(&a), vector(&b));
+    crate::arc::analysis::unphysical_warning(
+        plot,
+        (va.as_deref(), vb.as_deref()),
+        |t| waveform.conductance_at(t),
+        chatter,
+        gap,
+    )
+    .into_iter()
+    .collect()
 }
 
 /// With `[arc]`: the arc numbers and the vectors of the contact instance

@@ -173,6 +173,8 @@ fn run_and_check_output_match_their_schemas() {
         "relay-driver-zener.toml",
         "capacitive-load.toml",
         "lamp.toml",
+        "lamp-arc.toml",
+        "solenoid.toml",
     ] {
         let doc = json_of(&["run", &example(scenario), "--format", "json"], 0);
         assert_valid("run", &doc, scenario);

@@ -280,7 +280,7 @@ pub fn analyze(
             Kind::Arc => {
                 let ends = if last + 1 >= n {
                     "run_end"
-                } else if st[last + 1] >= 0.5 {
+                } else if !open(time[last + 1]) {
                     "contact_closed"
                 } else {
                     "current_below_i_min"
@@ -338,6 +338,104 @@ pub fn analyze(
         totals,
         peak_voltage: v[..n].iter().fold(0.0f64, |m, x| m.max(x.abs())),
     })
+}
+
+/// For a run without `[arc]`: a warning when what the open contact saw
+/// is not physical, i.e. when it separated under at least the reference
+/// material's I_min and then saw more than its V_min (a real contact
+/// arcs), or when an open gap saw more than its breakdown voltage.
+/// `nodes` are the contact's terminal vectors (`v(a)`, `v(b)`; `None` for
+/// ground); `None` when the run is physical or the vectors are missing.
+pub fn unphysical_warning(
+    plot: &Plot,
+    nodes: (Option<&str>, Option<&str>),
+    conductance: impl Fn(f64) -> f64,
+    chatter: &Chatter,
+    gap: &super::GapProfile,
+) -> Option<String> {
+    let Some(Vector::Real(time)) = plot.scale() else {
+        return None;
+    };
+    let zero = vec![0.0; time.len()];
+    let node = |name: Option<&str>| match name {
+        None => Some(zero.as_slice()),
+        Some(n) => plot.real(n),
+    };
+    let (a, b) = (node(nodes.0)?, node(nodes.1)?);
+    let v = |k: usize| a[k] - b[k];
+    let material = super::REFERENCE_MATERIAL;
+    let model = super::ArcSection {
+        material: Some(material),
+        ..super::ArcSection::default()
+    }
+    .model();
+    let n = time.len().min(a.len()).min(b.len());
+    let (mut arcs, mut breakdowns, mut worst_current, mut worst_excess) = (0, 0, 0.0f64, None);
+    let mut closed_before = false;
+    for iv in &chatter.intervals {
+        if iv.state == ContactState::Closed {
+            closed_before = true;
+            continue;
+        }
+        let first = time.partition_point(|&t| t < iv.start);
+        let last = time.partition_point(|&t| t <= iv.end).min(n);
+        if first >= last {
+            continue;
+        }
+        if closed_before && first > 0 {
+            let k = first - 1;
+            let current = (v(k) * conductance(time[k])).abs();
+            let peak = (first..last).map(|k| v(k).abs()).fold(0.0, f64::max);
+            if current >= model.i_min && peak >= model.v_min {
+                arcs += 1;
+                worst_current = worst_current.max(current);
+            }
+        }
+        let mut broke = false;
+        for k in first..last {
+            let g = gap.at(time[k]);
+            let hold = model.hold_voltage(g);
+            if g > 0.0 && v(k).abs() > hold {
+                broke = true;
+                let excess = (v(k).abs(), g);
+                if worst_excess.is_none_or(|(w, _): (f64, f64)| excess.0 > w) {
+                    worst_excess = Some(excess);
+                }
+            }
+        }
+        breakdowns += usize::from(broke);
+    }
+    if arcs == 0 && breakdowns == 0 {
+        return None;
+    }
+    let mut what = Vec::new();
+    if arcs > 0 {
+        what.push(format!(
+            "{arcs} opening{} separated under up to {:.3} A and then saw more than {} V, \
+             where a real contact arcs ({}: {} V, {} A)",
+            if arcs == 1 { "" } else { "s" },
+            worst_current,
+            model.v_min,
+            material.as_str(),
+            model.v_min,
+            model.i_min
+        ));
+    }
+    if let Some((volts, g)) = worst_excess {
+        what.push(format!(
+            "{breakdowns} opening{} saw more than the gap's breakdown voltage (up to {:.0} V \
+             across {:.3} µm, which breaks down at {:.0} V)",
+            if breakdowns == 1 { "" } else { "s" },
+            volts,
+            g * 1e6,
+            model.hold_voltage(g)
+        ));
+    }
+    Some(format!(
+        "the contact model does not arc, so this result is not physical: {}. \
+         Add an [arc] section (e.g. material = \"Ag\") to simulate the arcs and breakdowns",
+        what.join("; ")
+    ))
 }
 
 #[cfg(test)]

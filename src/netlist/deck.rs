@@ -741,6 +741,28 @@ pub fn instances_of(netlist_text: &str, subckt: &str) -> Vec<String> {
         .collect()
 }
 
+/// The first two nodes (lowercased) of each `X` card of `netlist_text`
+/// that uses `subckt`, in order: the contact's terminals a and b.
+pub fn instance_nodes_of(netlist_text: &str, subckt: &str) -> Vec<(String, String)> {
+    let lines = physical_lines(netlist_text);
+    if lines.is_empty() {
+        return Vec::new();
+    }
+    let mut live = vec![true; lines.len()];
+    live[0] = false;
+    cards(&lines, &live)
+        .iter()
+        .filter(|c| instantiates(&c.text, subckt))
+        .filter_map(|c| {
+            let mut tokens = c.text.split_whitespace().skip(1);
+            Some((
+                tokens.next()?.to_ascii_lowercase(),
+                tokens.next()?.to_ascii_lowercase(),
+            ))
+        })
+        .collect()
+}
+
 /// Whether an `X` card's subcircuit is `subckt`: the last token that is
 /// not a `name=value` parameter (nor `params:`).
 fn instantiates(card: &str, subckt: &str) -> bool {

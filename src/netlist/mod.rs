@@ -31,8 +31,8 @@ pub use contact::{
     check_subckt_name, contact_include, contact_include_split,
 };
 pub use deck::{
-    Deck, DeckRequest, DeckWarning, Tran, instances_of, param_value, prepare_deck,
-    prepare_deck_with_params, save_names,
+    Deck, DeckRequest, DeckWarning, Tran, instance_nodes_of, instances_of, param_value,
+    prepare_deck, prepare_deck_with_params, save_names,
 };
 pub use number::parse_number;
 

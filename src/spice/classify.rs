@@ -210,6 +210,13 @@ pub fn classify(exit: Exit, log: &str) -> Option<Failure> {
 }
 
 fn netlist_failure(lines: &[&str]) -> Option<Failure> {
+    // stdout and stderr arrive on two pipes: ngspice's stdout banner can
+    // land between an error and its text.
+    let lines: Vec<&str> = lines
+        .iter()
+        .copied()
+        .filter(|l| !l.starts_with("Note: ") && !l.starts_with("Circuit: "))
+        .collect();
     for (i, l) in lines.iter().enumerate() {
         if let Some(rest) = l.strip_prefix("Error on line ") {
             let digits: String = rest.chars().take_while(char::is_ascii_digit).collect();

@@ -302,6 +302,24 @@ pub(crate) struct Finished {
     pub log: String,
 }
 
+/// `cmd.spawn()`, tried again a few times while the executable is busy
+/// (ETXTBSY): a script written just before (a wrapper, a test's stand-in)
+/// stays open for writing in any child another thread forks before that
+/// child's exec closes it.
+fn spawn_retrying_busy(cmd: &mut Command) -> io::Result<std::process::Child> {
+    const TEXT_FILE_BUSY: i32 = 26;
+    let mut tries = 0;
+    loop {
+        match cmd.spawn() {
+            Err(e) if e.raw_os_error() == Some(TEXT_FILE_BUSY) && tries < 20 => {
+                tries += 1;
+                std::thread::sleep(Duration::from_millis(5));
+            }
+            result => return result,
+        }
+    }
+}
+
 /// Runs `cmd` (stdin closed), collecting stdout and stderr as one log,
 /// killing and reaping it after `timeout`.
 pub(crate) fn run_child(mut cmd: Command, timeout: Duration) -> io::Result<Finished> {
@@ -313,7 +331,7 @@ pub(crate) fn run_child(mut cmd: Command, timeout: Duration) -> io::Result<Finis
     #[cfg(unix)]
     std::os::unix::process::CommandExt::process_group(&mut cmd, 0);
     let started = Instant::now();
-    let mut child = cmd.spawn()?;
+    let mut child = spawn_retrying_busy(&mut cmd)?;
     let (tx, rx) = mpsc::channel::<Option<String>>();
     let mut open_streams = 0;
     if let Some(out) = child.stdout.take() {

@@ -97,6 +97,12 @@ pub enum SweepError {
         path.display()
     )]
     CoilNeedsCircuit { path: PathBuf },
+    #[error(
+        "{}: `limits.max_arc_energy` and `limits.max_arc_count` hold the arcs of the \
+         circuit run: drop --mechanics-only, or remove those limits",
+        path.display()
+    )]
+    ArcLimitsNeedCircuit { path: PathBuf },
     #[error("shard `{text}`: give K/N with 1 <= K <= N, e.g. --shard 3/8 for the third of eight")]
     Shard { text: String },
     #[error("cannot write the sweep's rows")]
@@ -194,6 +200,12 @@ pub struct Record {
     /// s, for a coil-driven relay: the longest bounce on the rest stop
     /// (the NC contact) after a release.
     pub nc_bounce_time: Option<f64>,
+    /// With `[arc]`: the run's arcs.
+    pub arc_count: Option<usize>,
+    /// J, with `[arc]`: all the run's arcs together.
+    pub arc_energy: Option<f64>,
+    /// With `[arc]`: the run's breakdowns of the open gap.
+    pub breakdowns: Option<usize>,
     /// One per `[[probe]]`, for a circuit sweep that reached ngspice's
     /// results; empty otherwise.
     pub probes: Vec<ProbeRecord>,

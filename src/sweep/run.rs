@@ -131,6 +131,15 @@ pub fn run(
                 path: scenario.origin.clone(),
             });
         }
+        Mode::Mechanics
+            if scenario
+                .limits
+                .is_some_and(|l| l.max_arc_energy.is_some() || l.max_arc_count.is_some()) =>
+        {
+            return Err(SweepError::ArcLimitsNeedCircuit {
+                path: scenario.origin.clone(),
+            });
+        }
         Mode::Mechanics => Vec::new(),
         Mode::Circuit(_) => {
             if scenario.circuit.is_none() || scenario.probes.is_empty() {
@@ -146,7 +155,12 @@ pub fn run(
         }
     };
     let ideal = options.run.compare_ideal && matches!(options.mode, Mode::Circuit(_));
-    let header = table::header(sampler.keys(), &signals, coil, ideal);
+    let columns = table::Columns {
+        coil,
+        ideal,
+        arc: scenario.arc.is_some() && matches!(options.mode, Mode::Circuit(_)),
+    };
+    let header = table::header(sampler.keys(), &signals, columns);
     let probes = signals.len();
     out.write_all(&header)
         .and_then(|()| out.flush())
@@ -177,7 +191,7 @@ pub fn run(
                     let records: Vec<Record> = positions
                         .map(|p| worker.evaluate(options.shard.sample(p)))
                         .collect();
-                    let rows = table::rows(&records, sampler.keys().len(), probes, coil, ideal);
+                    let rows = table::rows(&records, sampler.keys().len(), probes, columns);
                     if tx.send((c, rows, records)).is_err() {
                         break;
                     }
@@ -251,6 +265,9 @@ impl<'a, 'r> Worker<'a, 'r> {
             bounce_time: None,
             release_time: None,
             nc_bounce_time: None,
+            arc_count: None,
+            arc_energy: None,
+            breakdowns: None,
             probes: Vec::new(),
             verdict: Verdict::Error,
             failed_limits: Vec::new(),
@@ -354,6 +371,11 @@ fn record_probes(record: &mut Record, result: &RunResult) {
             ideal_edges: p.ideal.as_ref().map(|i| i.edges),
         })
         .collect();
+    if let Some(arcs) = &result.arcs {
+        record.arc_count = Some(arcs.totals.count);
+        record.arc_energy = Some(arcs.totals.energy);
+        record.breakdowns = Some(arcs.totals.breakdowns);
+    }
 }
 
 /// An error and its causes on one line, each cause's first line only:

@@ -43,6 +43,8 @@ pub struct Collected {
     pub settle_time: Vec<Option<f64>>,
     /// s, a coil-driven relay's longest release time.
     pub release_time: Vec<Option<f64>>,
+    /// J, with `[arc]`: all arcs of the sample.
+    pub arc_energy: Vec<Option<f64>>,
     /// `[probe][sample]`
     pub edges: Vec<Vec<Option<u32>>>,
     /// `[probe][sample]`, max |value|.
@@ -76,6 +78,7 @@ impl Collected {
         self.bounce_time.push(r.bounce_time);
         self.settle_time.push(r.settle_time);
         self.release_time.push(r.release_time);
+        self.arc_energy.push(r.arc_energy);
         for (p, (edges, peak)) in self.edges.iter_mut().zip(&mut self.peak).enumerate() {
             let probe = r.probes.get(p);
             edges.push(probe.map(|x| u32::try_from(x.edges).unwrap_or(u32::MAX)));
@@ -171,6 +174,7 @@ impl Collected {
             bounce_time: Distribution::of(self.bounce_time.iter().flatten().copied()),
             settle_time: Distribution::of(self.settle_time.iter().flatten().copied()),
             release_time: Distribution::of(self.release_time.iter().flatten().copied()),
+            arc_energy: Distribution::of(self.arc_energy.iter().flatten().copied()),
             probes,
             worst,
             first_errors: self
@@ -315,6 +319,8 @@ pub struct Summary {
     pub settle_time: Option<Distribution>,
     /// s, coil off → the NO contact opens (a coil-driven relay only).
     pub release_time: Option<Distribution>,
+    /// J, all arcs of a sample (with `[arc]` only).
+    pub arc_energy: Option<Distribution>,
     pub probes: Vec<ProbeSummary>,
     pub worst: Option<Worst>,
     /// The first few errors.
@@ -370,6 +376,7 @@ impl Summary {
             ("bounce time".to_owned(), &self.bounce_time, "s"),
             ("settle time".to_owned(), &self.settle_time, "s"),
             ("release time".to_owned(), &self.release_time, "s"),
+            ("arc energy".to_owned(), &self.arc_energy, "J"),
         ];
         for p in &self.probes {
             rows.push((format!("{} edges", p.signal), &p.edges, ""));

@@ -6,7 +6,8 @@
 //! `bounce_time` (s, first make → closed for good); for a
 //! coil-driven relay `release_time` and `nc_bounce_time` (s, the longest
 //! of its operations: coil off → break, and the bounce on the rest stop);
-//! then per probe
+//! with `[arc]` `arc_count`, `arc_energy` (J, all arcs of the run) and
+//! `breakdowns`; then per probe
 //! `<signal>.edges` and `<signal>.peak` (max |value|, V or A), then
 //! `verdict` (`pass`, `fail`, `error`; see [`super::verdict`]),
 //! `failed_limits` (the keys of the limits that failed, space-separated,
@@ -40,16 +41,33 @@ pub const OUTCOME_COLUMNS: [&str; 5] = [
 /// The columns of a coil-driven relay's release, after the outcome's.
 pub const RELEASE_COLUMNS: [&str; 2] = ["release_time", "nc_bounce_time"];
 
-/// The header line for `keys` and probe `signals`, with the release
-/// columns for a coil-driven relay and, when the ideal contact ran too,
-/// each probe's `<signal>.ideal_edges`.
-pub fn header(keys: &[String], signals: &[String], coil: bool, ideal: bool) -> Vec<u8> {
+/// The arc columns of a circuit sweep with `[arc]`, before the probes'.
+pub const ARC_COLUMNS: [&str; 3] = ["arc_count", "arc_energy", "breakdowns"];
+
+/// Which optional columns a sweep's CSV has.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Columns {
+    /// The release columns of a coil-driven relay.
+    pub coil: bool,
+    /// Each probe's `<signal>.ideal_edges`.
+    pub ideal: bool,
+    /// The arc columns (`[arc]`, circuit sweeps).
+    pub arc: bool,
+}
+
+/// The header line for `keys` and probe `signals`, with the optional
+/// columns `columns` asks for.
+pub fn header(keys: &[String], signals: &[String], columns: Columns) -> Vec<u8> {
+    let Columns { coil, ideal, arc } = columns;
     let mut w = Writer::from_writer(Vec::new());
     let mut names: Vec<String> = vec!["index".to_owned()];
     names.extend(keys.iter().cloned());
     names.extend(OUTCOME_COLUMNS.iter().map(|s| (*s).to_owned()));
     if coil {
         names.extend(RELEASE_COLUMNS.iter().map(|s| (*s).to_owned()));
+    }
+    if arc {
+        names.extend(ARC_COLUMNS.iter().map(|s| (*s).to_owned()));
     }
     for s in signals {
         names.push(format!("{s}.edges"));
@@ -69,7 +87,8 @@ pub fn header(keys: &[String], signals: &[String], coil: bool, ideal: bool) -> V
 /// probes, each `\n`-terminated. A record without values or probes (a
 /// sample that failed before them) has empty cells there, so every row
 /// has the header's width.
-pub fn rows(records: &[Record], keys: usize, probes: usize, coil: bool, ideal: bool) -> Vec<u8> {
+pub fn rows(records: &[Record], keys: usize, probes: usize, columns: Columns) -> Vec<u8> {
+    let Columns { coil, ideal, arc } = columns;
     let mut w = Writer::from_writer(Vec::with_capacity(records.len() * 96));
     let mut cell = String::new();
     let mut number = |w: &mut Writer<Vec<u8>>, value: Option<f64>| {
@@ -96,6 +115,14 @@ pub fn rows(records: &[Record], keys: usize, probes: usize, coil: bool, ideal: b
         if coil {
             number(&mut w, r.release_time);
             number(&mut w, r.nc_bounce_time);
+        }
+        if arc {
+            let count = |n: Option<usize>| n.map_or_else(String::new, |n| n.to_string());
+            w.write_field(count(r.arc_count))
+                .expect("writing to memory");
+            number(&mut w, r.arc_energy);
+            w.write_field(count(r.breakdowns))
+                .expect("writing to memory");
         }
         for i in 0..probes {
             let p = r.probes.get(i);
@@ -454,6 +481,9 @@ mod tests {
             settle_time: Some(2e-3),
             bounce_time: Some(1e-3),
             release_time: None,
+            arc_count: None,
+            arc_energy: None,
+            breakdowns: None,
             nc_bounce_time: None,
             probes: vec![ProbeRecord {
                 edges: 5,
@@ -469,7 +499,7 @@ mod tests {
     #[test]
     fn rows_match_the_header_and_quote_what_needs_it() {
         let keys = vec!["mechanics.mass".to_owned(), "surface.damping".to_owned()];
-        let h = header(&keys, &["v(a,b)".to_owned()], false, false);
+        let h = header(&keys, &["v(a,b)".to_owned()], Columns::default());
         assert_eq!(
             String::from_utf8(h).unwrap(),
             "index,mechanics.mass,surface.damping,outcome,bounce_count,first_impact,settle_time,\
@@ -482,13 +512,13 @@ mod tests {
         failed.verdict = Verdict::Error;
         failed.error = Some("ngspice failed: timeout, 60 s".to_owned());
         failed.probes = vec![];
-        let text = String::from_utf8(rows(&[record(0)], 2, 1, false, false)).unwrap();
+        let text = String::from_utf8(rows(&[record(0)], 2, 1, Columns::default())).unwrap();
         assert_eq!(
             text,
             "0,0.00015,0.25,stuck,3,0.001,0.002,0.001,5,3.3,pass,,\n"
         );
         failed.values.clear();
-        let text = String::from_utf8(rows(&[failed], 2, 1, false, false)).unwrap();
+        let text = String::from_utf8(rows(&[failed], 2, 1, Columns::default())).unwrap();
         assert_eq!(
             text,
             "1,,,,,0.001,0.002,0.001,,,error,,\"ngspice failed: timeout, 60 s\"\n"
@@ -496,7 +526,7 @@ mod tests {
     }
 
     fn csv_of(indices: &[u64]) -> Vec<u8> {
-        let mut out = header(&["k".to_owned()], &[], false, false);
+        let mut out = header(&["k".to_owned()], &[], Columns::default());
         let records: Vec<Record> = indices
             .iter()
             .map(|&i| Record {
@@ -505,7 +535,7 @@ mod tests {
                 ..record(i)
             })
             .collect();
-        out.extend(rows(&records, 1, 0, false, false));
+        out.extend(rows(&records, 1, 0, Columns::default()));
         out
     }
 
@@ -527,7 +557,7 @@ mod tests {
         let report = merge(gap, &mut Vec::new(), None, true).unwrap();
         assert_eq!(report.missing, vec![1, 2]);
 
-        let other = header(&["j".to_owned()], &[], false, false);
+        let other = header(&["j".to_owned()], &[], Columns::default());
         let err = merge(
             vec![
                 ("a".into(), Cursor::new(csv_of(&[0]))),
