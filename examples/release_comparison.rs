@@ -103,6 +103,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         // Each driver's contact differs: the panels mark their own break.
         contact: None,
         probes: panels,
+        arcs: Vec::new(),
     };
     std::fs::write(&out, svg::render(&plot)?)?;
     eprintln!("wrote {}", out.display());

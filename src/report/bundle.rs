@@ -115,5 +115,17 @@ pub fn plot(run: &RunResult) -> Result<String, BundleError> {
         window: svg::suggested_window(last_event, end),
         contact: Some(ContactTrace::States(&run.chatter.intervals)),
         probes,
+        arcs: run
+            .arcs
+            .iter()
+            .flat_map(|r| {
+                let arcs = r.arcs.iter().map(|a| (a.start, a.start + a.duration, true));
+                let breakdowns = r
+                    .breakdowns
+                    .iter()
+                    .map(|b| (b.start, b.start + b.duration, false));
+                arcs.chain(breakdowns)
+            })
+            .collect(),
     })?)
 }

@@ -101,6 +101,9 @@ pub struct SvgPlot<'a> {
     pub window: (f64, f64),
     pub contact: Option<ContactTrace<'a>>,
     pub probes: Vec<ProbePanel<'a>>,
+    /// Arcs and breakdowns to mark on the contact panel: (start, end, s;
+    /// `true` for an arc, `false` for a breakdown).
+    pub arcs: Vec<(f64, f64, bool)>,
 }
 
 /// A time window from 0 to a little after `last_event` (s; e.g. the last
@@ -131,6 +134,8 @@ const CONTACT_COLOR: &str = "#2a8a3a";
 const THRESHOLD_COLOR: &str = "#c0392b";
 const EDGE_COLOR: &str = "#e67e22";
 const GRID_COLOR: &str = "#e3e3e3";
+const ARC_COLOR: &str = "#d4145a";
+const BREAKDOWN_COLOR: &str = "#8e44ad";
 const AXIS_COLOR: &str = "#333333";
 
 /// The SVG document for `plot`.
@@ -211,13 +216,47 @@ pub fn render(plot: &SvgPlot) -> Result<String, SvgError> {
                 let (lo, hi) = extent(points).unwrap_or((0.0, 1.0));
                 (Axis::decades(lo, hi), "contact resistance", points.clone())
             }
-            _ => (Axis::states(), "contact", points.clone()),
+            _ => (
+                Axis::states(),
+                if plot.arcs.is_empty() {
+                    "contact"
+                } else {
+                    "contact (arcs shaded, breakdowns low)"
+                },
+                points.clone(),
+            ),
         };
         let y = |v: f64| top + CONTACT_HEIGHT * (1.0 - axis.fraction(v));
         y_ticks(&mut out, &axis, top, CONTACT_HEIGHT);
+        // Arcs as bands behind the trace (at least 2 px wide, so a
+        // microsecond arc in a 10 ms window shows), breakdowns as ticks.
+        let _ = writeln!(out, r#"<g clip-path="url(#panel{id})">"#);
+        for &(a, b, arc) in plot.arcs.iter().filter(|m| m.1 >= t0 && m.0 <= t1) {
+            let (xa, xb) = (x(a.max(t0)), x(b.min(t1)));
+            let (color, what, h0, h1) = if arc {
+                (ARC_COLOR, "arc", top, CONTACT_HEIGHT)
+            } else {
+                (
+                    BREAKDOWN_COLOR,
+                    "breakdown",
+                    top + 0.75 * CONTACT_HEIGHT,
+                    0.25 * CONTACT_HEIGHT,
+                )
+            };
+            let _ = writeln!(
+                out,
+                r#"<rect x="{}" y="{}" width="{}" height="{}" fill="{color}" fill-opacity="0.35"><title>{what} {} to {} s</title></rect>"#,
+                num(xa.min(xb - 2.0)),
+                num(h0),
+                num((xb - xa).max(2.0)),
+                num(h1),
+                num(a),
+                num(b)
+            );
+        }
         let _ = writeln!(
             out,
-            r#"<g clip-path="url(#panel{id})"><polyline fill="none" stroke="{CONTACT_COLOR}" stroke-width="1.5" stroke-linejoin="round" points="{}"/></g>"#,
+            r#"<polyline fill="none" stroke="{CONTACT_COLOR}" stroke-width="1.5" stroke-linejoin="round" points="{}"/></g>"#,
             polyline(&values, x, y)
         );
         panel_frame(&mut out, top, CONTACT_HEIGHT);
@@ -769,6 +808,7 @@ mod tests {
             window: (0.0, 1e-3),
             contact: Some(ContactTrace::States(intervals)),
             probes: vec![ProbePanel::from_analysis(&a, Series { time, value })],
+            arcs: Vec::new(),
         }
     }
 
@@ -811,6 +851,7 @@ mod tests {
             window: (0.0, 1e-3),
             contact: None,
             probes: vec![probe],
+            arcs: Vec::new(),
         };
         let svg = render(&plot).unwrap();
         // The range [-0.5, 1] V padded by 8 % of its span: [-0.62, 1.12].
@@ -832,6 +873,31 @@ mod tests {
         // Non-finite samples are skipped, not drawn.
         let points = decimate(&time, &[0.0, f64::NAN, 20.0, 30.0], 0.0, 3.0, 4);
         assert_eq!(points, vec![(0.0, 0.0), (2.0, 20.0), (3.0, 30.0)]);
+    }
+
+    #[test]
+    fn arcs_and_breakdowns_are_marked_on_the_contact_panel() {
+        let (time, value) = square(2001);
+        let iv = intervals();
+        let mut plot = demo(&time, &value, &iv);
+        // A 1 µs arc at 200 µs, a breakdown at 250 µs, one outside.
+        plot.arcs = vec![
+            (2e-4, 2.01e-4, true),
+            (2.5e-4, 2.6e-4, false),
+            (5e-3, 6e-3, true),
+        ];
+        let svg = render(&plot).unwrap();
+        assert_balanced(&svg);
+        assert_eq!(svg.matches("<title>arc ").count(), 1, "{svg}");
+        assert_eq!(svg.matches("<title>breakdown ").count(), 1);
+        // 1 µs of a 1 ms window is under a pixel: drawn 2 px wide.
+        assert!(svg.contains(&format!(r#"width="2.0" height="{}""#, num(CONTACT_HEIGHT))));
+        assert!(svg.contains("arcs shaded"));
+        assert!(
+            !render(&demo(&time, &value, &iv))
+                .unwrap()
+                .contains("<title>arc")
+        );
     }
 
     #[test]
@@ -890,6 +956,7 @@ mod tests {
                 value: &r,
             })),
             probes: vec![],
+            arcs: Vec::new(),
         };
         let svg = render(&plot).unwrap();
         assert_balanced(&svg);
@@ -918,6 +985,7 @@ mod tests {
             window: (0.0, 1.0),
             contact: None,
             probes: vec![],
+            arcs: Vec::new(),
         };
         assert_eq!(render(&empty), Err(SvgError::Empty));
     }
