@@ -254,3 +254,163 @@ fn an_ac_arc_goes_out_at_its_first_current_zero() {
     // After the zero the open contact sees the whole source voltage.
     assert!(result.probes[0].analysis.min < -300.0);
 }
+
+fn cli() -> assert_cmd::Command {
+    assert_cmd::Command::cargo_bin("chatterspice").unwrap()
+}
+
+fn run_json(scenario: &Path) -> serde_json::Value {
+    let out = cli()
+        .args(["run", scenario.to_str().unwrap(), "--format", "json"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// The coil-driven examples: the solenoid's break arcs and, without a
+/// freewheel diode, its gap then breaks down at kilovolts; with the diode
+/// the contact never sees much more than the supply. The mains heater's
+/// break arc goes out just before a current zero of its 50 Hz.
+#[test]
+fn the_coil_driven_power_examples() {
+    let Some(_) = common::ngspice() else { return };
+    let bare = run_json(&data("examples/scenarios/solenoid.toml"));
+    let diode = run_json(&data("examples/scenarios/solenoid-diode.toml"));
+    for doc in [&bare, &diode] {
+        let breaks: Vec<_> = doc["arcs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|a| a["opening"] == "break")
+            .collect();
+        assert_eq!(breaks.len(), 1, "{breaks:?}");
+        // 1 A in 20 mH against ~12 V: L·ΔI/ΔV ≈ 1 ms or more.
+        assert!(breaks[0]["duration"].as_f64().unwrap() > 1e-3);
+        assert_eq!(breaks[0]["ends"], "current_below_i_min");
+    }
+    let peak = |doc: &serde_json::Value| {
+        doc["probes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["signal"] == "v(v12,sol)")
+            .map(|p| p["max"].as_f64().unwrap().max(-p["min"].as_f64().unwrap()))
+            .unwrap()
+    };
+    assert!(peak(&bare) > 500.0, "{}", peak(&bare));
+    assert!(peak(&diode) < 14.0, "{}", peak(&diode));
+    assert!(
+        bare["breakdowns"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|b| b["opening"] == "break" && b["peak_voltage"].as_f64().unwrap() > 500.0)
+    );
+
+    let mains = run_json(&data("examples/scenarios/mains-heater.toml"));
+    let arcs = mains["arcs"].as_array().unwrap();
+    let brk = arcs.iter().find(|a| a["opening"] == "break").unwrap();
+    let end = brk["start"].as_f64().unwrap() + brk["duration"].as_f64().unwrap();
+    // The next current zero: a multiple of 10 ms after the break began.
+    let zero = (brk["start"].as_f64().unwrap() / 10e-3).ceil() * 10e-3;
+    assert!(
+        end < zero && zero - end < 0.5e-3,
+        "ended {end}, zero {zero}"
+    );
+    assert!(
+        arcs.iter()
+            .all(|a| a["start"].as_f64().unwrap() <= brk["start"].as_f64().unwrap())
+    );
+    // Every bounce opening arcs: the source is far above V_arc.
+    let bounces = mains["bounce"]["bounce_count"].as_u64().unwrap() as usize;
+    assert_eq!(
+        arcs.iter()
+            .filter(|a| a["opening"].as_str().unwrap().starts_with("bounce"))
+            .count(),
+        bounces
+    );
+}
+
+#[test]
+fn without_arc_a_power_run_warns_and_a_signal_run_does_not() {
+    let Some(_) = common::ngspice() else { return };
+    let out = cli()
+        .args([
+            "run",
+            data("examples/scenarios/lamp.toml").to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("not physical") && stderr.contains("[arc]"),
+        "{stderr}"
+    );
+    let out = cli().args(["run"]).output().unwrap();
+    assert!(out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("not physical"), "{stderr}");
+}
+
+#[test]
+fn arc_limits_pass_and_fail_in_check() {
+    let Some(_) = common::ngspice() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(data("examples/scenarios/lamp-arc.toml"))
+        .unwrap()
+        .replace("../../netlists", data("netlists").to_str().unwrap());
+    for (limits, code) in [
+        ("max_arc_energy = 1.0e-3\nmax_arc_count = 7\n", 0),
+        ("max_arc_energy = 1.0e-4\n", 1),
+        ("max_arc_count = 6\n", 1),
+    ] {
+        let path = dir.path().join("s.toml");
+        std::fs::write(&path, format!("{text}\n[limits]\n{limits}")).unwrap();
+        let out = cli()
+            .args(["check", path.to_str().unwrap(), "--format", "json"])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(code), "{limits}");
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let failed: Vec<_> = v["checks"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|c| c["passed"] == false)
+            .map(|c| c["key"].as_str().unwrap().to_owned())
+            .collect();
+        assert_eq!(failed.len(), code as usize, "{failed:?}");
+    }
+}
+
+#[test]
+fn bad_arc_sections_name_the_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let cut = DEFAULT_SCENARIO_TOML.find("[circuit]").unwrap();
+    let base = &DEFAULT_SCENARIO_TOML[..cut];
+    for (section, needle) in [
+        ("[arc]\nmaterial = \"Sn\"\n", "material"),
+        ("[arc]\nvmin = 12.0\n", "vmin"),
+        ("[arc]\nv_min = -1.0\n", "arc.v_min"),
+        ("[arc]\ni_min = 0.0\n", "arc.i_min"),
+        ("[arc]\nfield = 1e300\n", "arc.field"),
+        ("[limits]\nmax_arc_count = 3\n", "[arc]"),
+    ] {
+        let path = dir.path().join("bad.toml");
+        std::fs::write(&path, format!("{base}{section}")).unwrap();
+        let out = cli()
+            .args(["bounce", path.to_str().unwrap()])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{section}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(needle), "{section}: {stderr}");
+        assert!(stderr.contains("bad.toml:"), "{section}: {stderr}");
+    }
+}

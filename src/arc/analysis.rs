@@ -324,9 +324,9 @@ pub fn analyze(
     }
     let totals = ArcTotals {
         count: arcs.len(),
-        energy: arcs.iter().map(|a| a.energy).sum(),
+        energy: arcs.iter().map(|a| a.energy).fold(0.0, |s, e| s + e),
         breakdowns: breakdowns.len(),
-        breakdown_energy: breakdowns.iter().map(|b| b.energy).sum(),
+        breakdown_energy: breakdowns.iter().map(|b| b.energy).fold(0.0, |s, e| s + e),
         longest: arcs.iter().map(|a| a.duration).fold(0.0, f64::max),
         max_operation_energy: per_operation.iter().map(|p| p.0).fold(0.0, f64::max),
         max_operation_count: per_operation.iter().map(|p| p.1).max().unwrap_or(0),
