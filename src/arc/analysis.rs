@@ -392,8 +392,8 @@ pub fn unphysical_warning(
             }
         }
         let mut broke = false;
-        for k in first..last {
-            let g = gap.at(time[k]);
+        for (k, &t) in time.iter().enumerate().take(last).skip(first) {
+            let g = gap.at(t);
             let hold = model.hold_voltage(g);
             if g > 0.0 && v(k).abs() > hold {
                 broke = true;
