@@ -727,6 +727,16 @@ fn replace(fates: &mut [Fate], card: &Card, text: String) {
 /// `x2`) of the `X` cards of `netlist_text` that use `subckt`, in order.
 /// Only the netlist itself is read, not its includes.
 pub fn instances_of(netlist_text: &str, subckt: &str) -> Vec<String> {
+    cards_using(netlist_text, subckt)
+        .iter()
+        .filter_map(|c| c.split_whitespace().next())
+        .map(str::to_ascii_lowercase)
+        .collect()
+}
+
+/// The text of each `X` card of `netlist_text` (not its includes) that
+/// uses `subckt`, in order.
+fn cards_using(netlist_text: &str, subckt: &str) -> Vec<String> {
     let lines = physical_lines(netlist_text);
     if lines.is_empty() {
         return Vec::new();
@@ -734,27 +744,19 @@ pub fn instances_of(netlist_text: &str, subckt: &str) -> Vec<String> {
     let mut live = vec![true; lines.len()];
     live[0] = false;
     cards(&lines, &live)
-        .iter()
+        .into_iter()
         .filter(|c| instantiates(&c.text, subckt))
-        .filter_map(|c| c.text.split_whitespace().next())
-        .map(str::to_ascii_lowercase)
+        .map(|c| c.text)
         .collect()
 }
 
 /// The first two nodes (lowercased) of each `X` card of `netlist_text`
 /// that uses `subckt`, in order: the contact's terminals a and b.
 pub fn instance_nodes_of(netlist_text: &str, subckt: &str) -> Vec<(String, String)> {
-    let lines = physical_lines(netlist_text);
-    if lines.is_empty() {
-        return Vec::new();
-    }
-    let mut live = vec![true; lines.len()];
-    live[0] = false;
-    cards(&lines, &live)
+    cards_using(netlist_text, subckt)
         .iter()
-        .filter(|c| instantiates(&c.text, subckt))
         .filter_map(|c| {
-            let mut tokens = c.text.split_whitespace().skip(1);
+            let mut tokens = c.split_whitespace().skip(1);
             Some((
                 tokens.next()?.to_ascii_lowercase(),
                 tokens.next()?.to_ascii_lowercase(),
@@ -1038,6 +1040,15 @@ mod tests {
         assert_eq!(instances_of(text, "coil"), ["x2"]);
         assert_eq!(instances_of(text, "CONTACT"), ["x_relay"]);
         assert!(instances_of(text, "NONE").is_empty());
+        // The terminals, across a continuation line.
+        assert_eq!(
+            instance_nodes_of(text, "CONTACT"),
+            [("in".to_owned(), "0".to_owned())]
+        );
+        assert_eq!(
+            instance_nodes_of(text, "coil"),
+            [("a".to_owned(), "b".to_owned())]
+        );
     }
 
     #[test]
