@@ -508,6 +508,14 @@ fn run_coil(
     if let Some((arc_model, _)) = &arc {
         include = with_arc(include, arc_model, &gap)?;
     }
+    // The deck `.include`s the coil too: `--out` writes it beside the
+    // contact include, so that the deck runs again by hand.
+    if let Some(coil) = &scenario.coil {
+        let text = netlist::coil::coil_include(coil, &circuit.coil_subckt, &coupled.path)?;
+        include
+            .data_files
+            .push((crate::coil::coupled::COIL_FILE.to_owned(), text));
+    }
     if let Some(nc) = &circuit.nc_subckt {
         let nc = nc_include(&coupled.back, &model, nc, &scenario.origin)
             .map_err(|e| RunError::Coupling(Box::new(e)))?;

@@ -579,3 +579,39 @@ fn a_relative_ngspice_path_is_the_current_directory_s() {
         .assert()
         .success();
 }
+
+/// `--out` of a coil-driven relay holds everything its deck includes, the
+/// coil too: the deck runs again by hand in ngspice.
+#[test]
+fn a_coil_driven_bundle_runs_again_by_hand() {
+    let ng = ngspice_or_skip!();
+    let scenario =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenarios/relay-driver-zener.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bundle");
+    chatterspice()
+        .args([
+            "run",
+            scenario.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .assert()
+        .success();
+    let deck = std::fs::read_to_string(out.join("netlist.cir")).unwrap();
+    for include in [".include contact.inc", ".include coil.inc"] {
+        assert!(deck.contains(include), "{include}");
+    }
+    assert!(out.join("coil.inc").is_file());
+    let status = std::process::Command::new(ng.program())
+        .current_dir(&out)
+        .args(["-b", "-r", "again.raw", "netlist.cir"])
+        .output()
+        .unwrap();
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stdout)
+    );
+    assert!(out.join("again.raw").metadata().unwrap().len() > 1000);
+}

@@ -47,7 +47,7 @@ use crate::waveform::{ContactModel, Waveform, WaveformError};
 
 /// The include names in the run's work directory.
 const CONTACT_FILE: &str = "contact.inc";
-const COIL_FILE: &str = "coil.inc";
+pub const COIL_FILE: &str = "coil.inc";
 
 /// How to iterate.
 #[derive(Debug, Clone, PartialEq)]

@@ -148,9 +148,10 @@ pub struct ContactInclude {
     pub subckt: String,
     /// The include file's text.
     pub text: String,
-    /// Data files the include reads, by plain file name relative to the
-    /// directory ngspice runs in: (file name, contents). Only
-    /// [`ContactElement::EventRamp`] has one.
+    /// Files the include or the deck reads besides it, by plain file
+    /// name relative to the directory ngspice runs in: (file name,
+    /// contents). [`ContactElement::EventRamp`]'s data file; `run` adds a
+    /// coil-driven relay's coil include.
     pub data_files: Vec<(String, String)>,
     /// Corners of the waveform.
     pub points: usize,
