@@ -56,7 +56,6 @@ use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 use crate::chatter::{Chatter, ContactState, Interval};
-use crate::scenario::ContactSection;
 
 /// The smallest `edge_time` relative to the largest time in the sequence:
 /// 2⁻⁴⁰ ≈ 9.1e-13, so t + edge_time > t always holds in f64 (whose
@@ -138,16 +137,6 @@ pub struct ContactModel {
     pub r_open: f64,
     /// s, duration of each make or break edge, > 0.
     pub edge_time: f64,
-}
-
-impl From<&ContactSection> for ContactModel {
-    fn from(c: &ContactSection) -> Self {
-        ContactModel {
-            r_closed: c.r_closed,
-            r_open: c.r_open,
-            edge_time: c.edge_time,
-        }
-    }
 }
 
 /// A finite `value` for which `ok` holds, or the error naming `key`.

@@ -1,0 +1,104 @@
+//! `[limits]`: what `check` holds the relay to.
+
+use super::*;
+
+/// `[limits]`: what `check` holds the relay to. SI units; all optional.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LimitsSection {
+    /// s, settle time − first impact.
+    pub max_bounce_time: Option<f64>,
+    /// Most bounces (openings after the first impact).
+    pub max_bounces: Option<u64>,
+    /// s, the operate time as datasheets define it: from the coil being
+    /// energized (or the force step) to the first make, bounce excluded.
+    pub max_operate_time: Option<f64>,
+    /// s, the same figure as `max_operate_time` (its older name).
+    pub max_first_make: Option<f64>,
+    /// s, from the coil being energized (or the force step) to closed for
+    /// good: operate plus bounce time.
+    pub max_settle_time: Option<f64>,
+    /// s, coil off → the NO contact's break, in every operation (a
+    /// coil-driven relay only).
+    pub max_release_time: Option<f64>,
+    /// s, the bounce of the armature on its rest stop (the NC contact)
+    /// after each release, first touch to last.
+    pub max_nc_bounce_time: Option<f64>,
+    /// Most NC bounces after each release.
+    pub max_nc_bounces: Option<u64>,
+    /// J, the most arc energy in one operation, all its arcs together
+    /// (needs `[arc]` and a run).
+    pub max_arc_energy: Option<f64>,
+    /// The most arcs in one operation (needs `[arc]` and a run).
+    pub max_arc_count: Option<u64>,
+}
+
+impl Check<'_> {
+    pub(super) fn limits(&self, l: &LimitsSection) -> Result<(), ScenarioError> {
+        for (key, value, what) in [
+            (
+                "limits.max_bounce_time",
+                l.max_bounce_time,
+                "the longest bounce time allowed (first make → closed for good), in s",
+            ),
+            (
+                "limits.max_operate_time",
+                l.max_operate_time,
+                "the longest operate time allowed (coil on → first make), in s",
+            ),
+            (
+                "limits.max_first_make",
+                l.max_first_make,
+                "the longest operate time allowed (coil on → first make), in s",
+            ),
+            (
+                "limits.max_settle_time",
+                l.max_settle_time,
+                "the longest time allowed from coil on to closed for good, in s",
+            ),
+            (
+                "limits.max_release_time",
+                l.max_release_time,
+                "the longest release time allowed (coil off → the NO contact breaks), in s",
+            ),
+            (
+                "limits.max_nc_bounce_time",
+                l.max_nc_bounce_time,
+                "the longest NC bounce allowed after a release, in s",
+            ),
+            (
+                "limits.max_arc_energy",
+                l.max_arc_energy,
+                "the most arc energy allowed in one operation, in J",
+            ),
+        ] {
+            if let Some(v) = value {
+                self.number(key, v, v > 0.0, format!("must be > 0: {what}"))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The release limits need a coil: a step force never releases.
+    pub(super) fn release_limits(
+        &self,
+        l: &LimitsSection,
+        coil: bool,
+    ) -> Result<(), ScenarioError> {
+        let given = [
+            ("limits.max_release_time", l.max_release_time.is_some()),
+            ("limits.max_nc_bounce_time", l.max_nc_bounce_time.is_some()),
+            ("limits.max_nc_bounces", l.max_nc_bounces.is_some()),
+        ];
+        match given.iter().find(|(_, set)| *set) {
+            Some((key, _)) if !coil => Err(ScenarioError::Conflict {
+                at: self.at(key),
+                key: (*key).to_owned(),
+                other: "mechanics.force".to_owned(),
+                advice: "a release needs a coil that is switched off: with a step force the \
+                         contact never releases; give a [coil] or remove the limit",
+            }),
+            _ => Ok(()),
+        }
+    }
+}

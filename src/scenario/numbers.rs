@@ -1,0 +1,362 @@
+//! The scenario's numbers by dotted key: what sweeps vary and fits move.
+
+use super::*;
+
+/// The number keys that [`Scenario::set_number`] sets and `[sweep]`
+/// varies, besides `probe[N].low` and `probe[N].high`. (`coil.turns` is an
+/// integer and is left out.)
+pub const NUMBER_KEYS: &[&str] = &[
+    "mechanics.mass",
+    "mechanics.stiffness",
+    "mechanics.damping",
+    "mechanics.force",
+    "mechanics.gap",
+    "mechanics.initial_position",
+    "mechanics.initial_velocity",
+    "mechanics.preload",
+    "coil.resistance",
+    "coil.pole_area",
+    "coil.air_gap",
+    "coil.iron_gap",
+    "surface.stiffness",
+    "surface.damping",
+    "surface.restitution",
+    "surface.exponent",
+    "surface.chi",
+    "surface.reference_velocity",
+    "back_stop.stiffness",
+    "back_stop.damping",
+    "back_stop.restitution",
+    "back_stop.exponent",
+    "back_stop.chi",
+    "back_stop.reference_velocity",
+    "contact.r_closed",
+    "contact.r_open",
+    "contact.edge_time",
+    "contact.holm.r_film",
+    "contact.holm.r_ref",
+    "contact.holm.f_ref",
+    "contact.holm.exponent",
+    "simulation.t_end",
+    "simulation.min_open_time",
+    "simulation.min_gap",
+];
+
+/// Every number key, for messages.
+pub(super) fn number_keys_described() -> String {
+    let mut known = NUMBER_KEYS.join(", ");
+    known.push_str(", probe[N].low, probe[N].high, circuit.params.NAME");
+    known
+}
+
+/// Where a number key lives.
+pub(super) enum Field<P, O> {
+    /// A number that always has a value.
+    Plain(P),
+    /// A number that may be absent (`mechanics.force`, the surface keys).
+    Optional(O),
+    /// A known key whose section the scenario does not have.
+    NoSection(&'static str),
+    Unknown,
+}
+
+/// The field of `key` in scenario `$s`, borrowed with `$($r)*` (`&` or
+/// `&mut`), so that the getter and the setter share one table.
+macro_rules! number_field {
+    ($s:expr, $key:expr, $($r:tt)*) => {{
+        let s = $s;
+        match $key {
+            "mechanics.mass" => Field::Plain($($r)* s.mechanics.mass),
+            "mechanics.stiffness" => Field::Plain($($r)* s.mechanics.stiffness),
+            "mechanics.damping" => Field::Plain($($r)* s.mechanics.damping),
+            "mechanics.force" => Field::Optional($($r)* s.mechanics.force),
+            "mechanics.gap" => Field::Plain($($r)* s.mechanics.gap),
+            "mechanics.initial_position" => Field::Plain($($r)* s.mechanics.initial_position),
+            "mechanics.initial_velocity" => Field::Plain($($r)* s.mechanics.initial_velocity),
+            "mechanics.preload" => Field::Plain($($r)* s.mechanics.preload),
+            "coil.resistance" | "coil.pole_area" | "coil.air_gap" | "coil.iron_gap" => {
+                match $($r)* s.coil {
+                    Some(c) => Field::Plain(match $key {
+                        "coil.resistance" => $($r)* c.resistance,
+                        "coil.pole_area" => $($r)* c.pole_area,
+                        "coil.air_gap" => $($r)* c.air_gap,
+                        _ => $($r)* c.iron_gap,
+                    }),
+                    None => Field::NoSection("[coil]"),
+                }
+            }
+            "surface.stiffness" => Field::Optional($($r)* s.surface.stiffness),
+            "surface.damping" => Field::Optional($($r)* s.surface.damping),
+            "surface.restitution" => Field::Optional($($r)* s.surface.restitution),
+            "surface.exponent" => Field::Optional($($r)* s.surface.exponent),
+            "surface.chi" => Field::Optional($($r)* s.surface.chi),
+            "surface.reference_velocity" => Field::Optional($($r)* s.surface.reference_velocity),
+            "back_stop.stiffness" | "back_stop.damping" | "back_stop.restitution"
+            | "back_stop.exponent" | "back_stop.chi" | "back_stop.reference_velocity" => {
+                match $($r)* s.back_stop {
+                    Some(b) => Field::Optional(match $key {
+                        "back_stop.stiffness" => $($r)* b.stiffness,
+                        "back_stop.damping" => $($r)* b.damping,
+                        "back_stop.restitution" => $($r)* b.restitution,
+                        "back_stop.exponent" => $($r)* b.exponent,
+                        "back_stop.chi" => $($r)* b.chi,
+                        _ => $($r)* b.reference_velocity,
+                    }),
+                    None => Field::NoSection("[back_stop]"),
+                }
+            }
+            "contact.r_closed" => Field::Plain($($r)* s.contact.r_closed),
+            "contact.r_open" => Field::Plain($($r)* s.contact.r_open),
+            "contact.edge_time" => Field::Plain($($r)* s.contact.edge_time),
+            "contact.holm.r_film" | "contact.holm.r_ref" | "contact.holm.f_ref"
+            | "contact.holm.exponent" => match $($r)* s.contact.holm {
+                Some(h) => Field::Plain(match $key {
+                    "contact.holm.r_film" => $($r)* h.r_film,
+                    "contact.holm.r_ref" => $($r)* h.r_ref,
+                    "contact.holm.f_ref" => $($r)* h.f_ref,
+                    _ => $($r)* h.exponent,
+                }),
+                None => Field::NoSection("[contact.holm]"),
+            },
+            "simulation.t_end" => Field::Plain($($r)* s.simulation.t_end),
+            "simulation.min_open_time" => Field::Plain($($r)* s.simulation.min_open_time),
+            "simulation.min_gap" => Field::Plain($($r)* s.simulation.min_gap),
+            other => match probe_key(other) {
+                Some((i, _)) if i >= s.probes.len() => Field::NoSection("[[probe]] of that number"),
+                Some((i, true)) => Field::Plain($($r)* s.probes[i].low),
+                Some((i, false)) => Field::Plain($($r)* s.probes[i].high),
+                None => Field::Unknown,
+            },
+        }
+    }};
+}
+
+/// The widest range of each number that still describes a relay, far
+/// beyond any real one, so that every simulation stays finite and ends:
+/// (key or key suffix, lowest, highest, unit). The other rules (> 0,
+/// below the gap, ...) apply on top.
+pub const ENVELOPE: &[(&str, f64, f64, &str)] = &[
+    ("mechanics.mass", 0.0, 1e3, "kg"),
+    ("mechanics.stiffness", 0.0, 1e12, "N/m"),
+    ("mechanics.damping", 0.0, 1e9, "N·s/m"),
+    ("mechanics.force", -1e9, 1e9, "N"),
+    ("mechanics.gap", 0.0, 1.0, "m"),
+    ("mechanics.initial_position", -1.0, 1.0, "m"),
+    ("mechanics.initial_velocity", -1e4, 1e4, "m/s"),
+    ("mechanics.preload", 0.0, 1e9, "N"),
+    (".stiffness", 1e-6, 1e20, "N/m or N/mⁿ"),
+    (".damping", 0.0, 1e12, "N·s/m"),
+    (".chi", 0.0, 1e6, "s/m"),
+    (".reference_velocity", 0.0, 1e4, "m/s"),
+    ("simulation.t_end", 0.0, 1e6, "s"),
+    ("simulation.min_open_time", 0.0, 1.0, "s"),
+    ("simulation.min_gap", 0.0, 1.0, "m"),
+    ("arc.v_min", 0.0, 1e4, "V"),
+    ("arc.i_min", 0.0, 1e4, "A"),
+    ("arc.field", 0.0, 1e8, "V/m"),
+    ("arc.opening_speed", 0.0, 1e3, "m/s"),
+];
+
+/// Number keys under this prefix name a `.param` of the netlist.
+pub(super) const PARAMS_PREFIX: &str = "circuit.params.";
+
+/// A SPICE parameter name: a letter or `_`, then letters, digits, `_`.
+pub(super) fn valid_param_name(name: &str) -> bool {
+    let mut chars = name.chars();
+    chars
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+}
+
+/// `probe[N].low` → (N, true), `probe[N].high` → (N, false).
+pub(super) fn probe_key(key: &str) -> Option<(usize, bool)> {
+    let rest = key.strip_prefix("probe[")?;
+    let (index, name) = rest.split_once("].")?;
+    let index = index.parse().ok()?;
+    match name {
+        "low" => Some((index, true)),
+        "high" => Some((index, false)),
+        _ => None,
+    }
+}
+
+impl Scenario {
+    /// The value of number `key` (one of [`NUMBER_KEYS`], or
+    /// `probe[N].low`/`.high`); `None` for an optional key the file does
+    /// not give (e.g. `surface.restitution` of a Kelvin–Voigt surface).
+    pub fn number(&self, key: &str) -> Result<Option<f64>, ScenarioError> {
+        if let Some(name) = key.strip_prefix(PARAMS_PREFIX) {
+            return self.circuit_param(key, name);
+        }
+        match number_field!(self, key, &) {
+            Field::Plain(v) => Ok(Some(*v)),
+            Field::Optional(v) => Ok(*v),
+            Field::NoSection(section) => Err(self.no_section(key, section)),
+            Field::Unknown => Err(self.unknown_number(key, "")),
+        }
+    }
+
+    /// `circuit.params.NAME`: the scenario's value, else the netlist's own
+    /// plain-number `.param NAME=value` (`None` when it gives an
+    /// expression, or the netlist cannot be read yet).
+    pub(super) fn circuit_param(
+        &self,
+        key: &str,
+        name: &str,
+    ) -> Result<Option<f64>, ScenarioError> {
+        let Some(circuit) = &self.circuit else {
+            return Err(self.no_section(key, "[circuit]"));
+        };
+        if !valid_param_name(name) {
+            return Err(self.unknown_number(key, ""));
+        }
+        if let Some(v) = circuit.params.get(name) {
+            return Ok(Some(*v));
+        }
+        Ok(match self.netlist() {
+            Some(Ok((_, text))) => crate::netlist::param_value(&text, name),
+            _ => None,
+        })
+    }
+
+    /// Set number `key` (see [`Scenario::number`]) and validate the
+    /// scenario again by the loader's rules, so that it stays one the file
+    /// could have given (a Hunt–Crossley restitution is converted to χ
+    /// again). On error the scenario is unchanged.
+    pub fn set_number(&mut self, key: &str, value: f64) -> Result<(), ScenarioError> {
+        self.set_numbers(&[(key, value)])
+    }
+
+    /// [`Scenario::set_number`] for several keys at once, validated once
+    /// at the end: a change that is only valid together with another
+    /// (`contact.r_closed` past the old `contact.r_open`) is accepted. On
+    /// error the scenario is unchanged.
+    pub fn set_numbers(&mut self, values: &[(&str, f64)]) -> Result<(), ScenarioError> {
+        let mut old: Vec<(&str, Option<f64>)> = Vec::with_capacity(values.len());
+        let mut failure = None;
+        for &(key, value) in values {
+            if let Some(name) = key.strip_prefix(PARAMS_PREFIX) {
+                match self.circuit.as_mut() {
+                    Some(c) if valid_param_name(name) => {
+                        old.push((key, c.params.insert(name.to_owned(), value)));
+                        continue;
+                    }
+                    Some(_) => {
+                        failure = Some(self.unknown_number(key, ""));
+                        break;
+                    }
+                    None => {
+                        failure = Some(self.no_section(key, "[circuit]"));
+                        break;
+                    }
+                }
+            }
+            match number_field!(&mut *self, key, &mut) {
+                Field::Plain(v) => old.push((key, Some(std::mem::replace(v, value)))),
+                Field::Optional(v) => old.push((key, v.replace(value))),
+                Field::NoSection(section) => {
+                    failure = Some(self.no_section(key, section));
+                    break;
+                }
+                Field::Unknown => {
+                    failure = Some(self.unknown_number(key, ""));
+                    break;
+                }
+            }
+        }
+        let probes = values.iter().any(|(key, _)| key.starts_with("probe["));
+        let result = match failure {
+            Some(e) => Err(e),
+            None => self.revalidate(probes),
+        };
+        match result {
+            Ok((surface, back_stop)) => {
+                self.resolved_surface = surface;
+                self.resolved_back_stop = back_stop;
+                Ok(())
+            }
+            Err(e) => {
+                for &(key, value) in old.iter().rev() {
+                    if let Some(name) = key.strip_prefix(PARAMS_PREFIX) {
+                        let params = &mut self.circuit.as_mut().expect("set above").params;
+                        match value {
+                            Some(v) => params.insert(name.to_owned(), v),
+                            None => params.remove(name),
+                        };
+                        continue;
+                    }
+                    match number_field!(&mut *self, key, &mut) {
+                        Field::Plain(v) => *v = value.expect("a plain number had a value"),
+                        Field::Optional(v) => *v = value,
+                        Field::NoSection(_) | Field::Unknown => {
+                            unreachable!("`{key}` was set above")
+                        }
+                    }
+                }
+                Err(e)
+            }
+        }
+    }
+
+    /// The loader's physics rules on the scenario as it now is; the
+    /// probes only when asked (their keys are formatted, which allocates).
+    pub(super) fn revalidate(
+        &self,
+        probes: bool,
+    ) -> Result<(Surface, Option<Surface>), ScenarioError> {
+        let index = KeyIndex {
+            text: "",
+            document_span: 0..0,
+            entries: Vec::new(),
+        };
+        let check = Check {
+            origin: &self.origin,
+            index: &index,
+        };
+        check.mechanics(&self.mechanics)?;
+        check.drive(&self.mechanics, self.coil.as_ref())?;
+        let surface = check.surface("surface", &self.surface)?;
+        let back_stop = check.back_stop(self.back_stop.as_ref(), self.coil.is_some())?;
+        check.contact(&self.contact)?;
+        check.simulation(&self.simulation)?;
+        if probes {
+            for (i, probe) in self.probes.iter().enumerate() {
+                check.probe(i, probe)?;
+            }
+        }
+        Ok((surface, back_stop))
+    }
+
+    pub(super) fn unknown_number(&self, key: &str, within: &'static str) -> ScenarioError {
+        ScenarioError::UnknownNumber {
+            at: Location {
+                path: self.origin.clone(),
+                line: None,
+            },
+            key: key.to_owned(),
+            within,
+            known: number_keys_described(),
+        }
+    }
+
+    pub(super) fn no_section(&self, key: &str, section: &'static str) -> ScenarioError {
+        ScenarioError::Sweep {
+            at: Location {
+                path: self.origin.clone(),
+                line: None,
+            },
+            key: key.to_owned(),
+            problem: format!("the scenario has no {section} section: add it to set this key"),
+        }
+    }
+
+    /// The `[sweep]` rules, which need the rest of the scenario (the
+    /// nominal values the tolerances are relative to).
+    pub(super) fn with_checked_sweep(self, check: &Check) -> Result<Scenario, ScenarioError> {
+        if let Some(sweep) = &self.sweep {
+            check.sweep(sweep, &self)?;
+        }
+        Ok(self)
+    }
+}
