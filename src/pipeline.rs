@@ -315,12 +315,12 @@ fn run_chatter(
     let include = netlist::contact_include(&waveform, &circuit.subckt, element)?;
     let arc = arc_setup(scenario, &netlist_text);
     let include = match &arc {
-        Some((arc_model, _)) => with_arc(include, arc_model, &gap)?,
+        Some((arc_model, ..)) => with_arc(include, arc_model, &gap)?,
         None => include,
     };
 
     let mut signals: Vec<&str> = scenario.probes.iter().map(|p| p.signal.as_str()).collect();
-    if let Some((_, vectors)) = &arc {
+    if let Some((_, vectors, _)) = &arc {
         signals.extend(vectors.all());
     }
     let end = chatter_end(&chatter) + model.edge_time;
@@ -386,8 +386,15 @@ fn run_chatter(
 
     let arcs = arc
         .as_ref()
-        .map(|(arc_model, vectors)| {
-            crate::arc::analysis::analyze(&simulation.plot, vectors, arc_model, &gap, &chatter, &[])
+        .map(|(arc_model, _, instance)| {
+            crate::arc::analysis::analyze(
+                &simulation.plot,
+                instance,
+                arc_model,
+                &gap,
+                &chatter,
+                &[],
+            )
         })
         .transpose()
         .map_err(|source| RunError::Arc {
@@ -505,7 +512,7 @@ fn run_coil(
         .as_deref()
         .and_then(|text| arc_setup(scenario, text));
     let gap = GapProfile::from_path(scenario.mechanics.gap, &coupled.path);
-    if let Some((arc_model, _)) = &arc {
+    if let Some((arc_model, ..)) = &arc {
         include = with_arc(include, arc_model, &gap)?;
     }
     // The deck `.include`s the coil too: `--out` writes it beside the
@@ -529,10 +536,10 @@ fn run_coil(
         .collect();
     let arcs = arc
         .as_ref()
-        .map(|(arc_model, vectors)| {
+        .map(|(arc_model, _, instance)| {
             crate::arc::analysis::analyze(
                 &coupled.plot,
-                vectors,
+                instance,
                 arc_model,
                 &gap,
                 &coupled.chatter,
@@ -640,13 +647,13 @@ fn arc_warnings(
 /// the arcs are read from (the first, when the netlist has several).
 /// `None` without `[arc]`, or when the netlist has no contact instance
 /// (the deck names that error).
-fn arc_setup(scenario: &Scenario, netlist_text: &str) -> Option<(ArcModel, ArcVectors)> {
+fn arc_setup(scenario: &Scenario, netlist_text: &str) -> Option<(ArcModel, ArcVectors, String)> {
     let section = scenario.arc.as_ref()?;
     let circuit = scenario.circuit.as_ref()?;
     let instance = netlist::instances_of(netlist_text, &circuit.subckt)
         .into_iter()
         .next()?;
-    Some((section.model(), ArcVectors::of(&instance)))
+    Some((section.model(), ArcVectors::of(&instance), instance))
 }
 
 /// The contact waveform of `chatter` as `scenario`'s `[contact]` section

@@ -414,3 +414,28 @@ fn bad_arc_sections_name_the_key() {
         assert!(stderr.contains("bad.toml:"), "{section}: {stderr}");
     }
 }
+
+/// A contact instantiated inside the user's own subcircuit: ngspice names
+/// its vectors with the path (`i(v.x_board.x_relay.vs)`), and the arcs are
+/// found there.
+#[test]
+fn a_contact_inside_a_subcircuit_arcs_too() {
+    let ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    let netlist = "Hierarchical\nV1 vcc 0 24\nX_BOARD vcc out BOARD\nR1 out 0 2\n\
+                   .subckt BOARD in out\nX_RELAY in out CONTACT\n.ends\n\
+                   .tran 0.1u 3m 0 1u\n.end\n";
+    let scenario = relay_on(
+        dir.path(),
+        netlist,
+        "[[probe]]\nsignal = \"v(out)\"\nlow = 1\nhigh = 5\n\n[arc]\nmaterial = \"Ag\"\n",
+    );
+    let result = run(&ng, &scenario);
+    let arcs = &result.arcs.as_ref().unwrap().arcs;
+    assert_eq!(
+        arcs.iter()
+            .filter(|a| a.opening.starts_with("bounce"))
+            .count(),
+        result.chatter.bounce_count
+    );
+}

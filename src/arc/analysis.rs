@@ -108,8 +108,15 @@ pub struct ArcReport {
 
 /// Why the arc vectors could not be read.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("the raw file has no vector `{0}`, which the arc analysis reads")]
-pub struct MissingArcVector(pub String);
+#[error(
+    "the raw file has no vector `{vector}` (nor the same inside a subcircuit) for contact \
+     instance `{instance}`, which the arc analysis reads: if the netlist has `.save` lines, \
+     save everything in the contact's subcircuit, or instantiate the contact at the top level"
+)]
+pub struct MissingArcVector {
+    pub instance: String,
+    pub vector: String,
+}
 
 /// An opening of the contact and its label.
 #[derive(Debug, Clone, PartialEq)]
@@ -179,22 +186,34 @@ fn opening_at(openings: &[Opening], t: f64) -> (usize, String) {
         .map_or((0, "make".to_owned()), |o| (o.operation, o.label.clone()))
 }
 
-/// The arc report of `plot`, whose contact instance wrote `vectors`.
+/// The arc report of `plot`, whose contact instance `instance` (as the
+/// netlist names it, e.g. `x1`) carried the arc element.
 pub fn analyze(
     plot: &Plot,
-    vectors: &ArcVectors,
+    instance: &str,
     model: &ArcModel,
     gap: &super::GapProfile,
     chatter: &Chatter,
     coil_offs: &[f64],
 ) -> Result<ArcReport, MissingArcVector> {
+    let vectors = ArcVectors::in_plot(instance, plot).ok_or_else(|| MissingArcVector {
+        instance: instance.to_owned(),
+        vector: ArcVectors::of(instance).current,
+    })?;
     let real = |name: &str| {
-        plot.real(name)
-            .ok_or_else(|| MissingArcVector(name.to_owned()))
+        plot.real(name).ok_or_else(|| MissingArcVector {
+            instance: instance.to_owned(),
+            vector: name.to_owned(),
+        })
     };
     let time = match plot.scale() {
         Some(Vector::Real(t)) => t,
-        _ => return Err(MissingArcVector("time".to_owned())),
+        _ => {
+            return Err(MissingArcVector {
+                instance: instance.to_owned(),
+                vector: "time".to_owned(),
+            });
+        }
     };
     let i = real(&vectors.current)?;
     let v = real(&vectors.voltage)?;

@@ -92,6 +92,28 @@ impl ArcVectors {
     pub fn all(&self) -> [&str; 4] {
         [&self.current, &self.voltage, &self.state, &self.clamp]
     }
+
+    /// The vectors of `instance` as `plot` names them: at the top level
+    /// (`i(v.x1.vs)`), or inside the user's own subcircuits, where ngspice
+    /// prefixes the path (`i(v.x_board.x1.vs)`; the first such path in
+    /// the raw file's order). `None` when the plot has no complete set.
+    pub fn in_plot(instance: &str, plot: &crate::rawfile::Plot) -> Option<ArcVectors> {
+        let complete = |v: &ArcVectors| v.all().iter().all(|n| plot.index_of(n).is_some());
+        let top = ArcVectors::of(instance);
+        if complete(&top) {
+            return Some(top);
+        }
+        let suffix = format!(".{}", instance.to_ascii_lowercase());
+        plot.variables
+            .iter()
+            .filter_map(|v| {
+                let name = v.name.to_ascii_lowercase();
+                let path = name.strip_prefix("i(v.")?.strip_suffix(".vs)")?.to_owned();
+                path.ends_with(&suffix).then_some(path)
+            })
+            .map(|path| ArcVectors::of(&path))
+            .find(complete)
+    }
 }
 
 /// `include` with the arc added (see the module overview), the hold
