@@ -18,6 +18,7 @@ mod calibrate;
 mod capture;
 mod raw;
 
+use chatterspice::arc::GapProfile;
 use chatterspice::chatter::Chatter;
 use chatterspice::check;
 use chatterspice::coil::CouplingOptions;
@@ -485,11 +486,16 @@ fn pwl(args: &PwlArgs) -> Result<()> {
     refuse_existing(args.output.as_deref(), args.force)?;
     let scenario = load_scenario(args.scenario.as_deref())?;
     let model = ContactModel::from(&scenario.contact);
-    let waveform = match &args.measured {
+    let (waveform, gap) = match &args.measured {
         Some(csv) => {
-            let text = std::fs::read_to_string(csv)
-                .with_context(|| format!("{}: cannot read the measured chatter", csv.display()))?;
-            Waveform::from_state_changes(&text, csv, &model)?
+            let intervals = read_measured(csv)?;
+            let speed = scenario
+                .arc
+                .map_or(chatterspice::arc::DEFAULT_OPENING_SPEED, |a| {
+                    a.model().opening_speed
+                });
+            let gap = GapProfile::from_intervals(&intervals, speed, scenario.mechanics.gap);
+            (Waveform::from_intervals(&intervals, &model)?, gap)
         }
         None => {
             let chatter = simulate(
@@ -503,7 +509,8 @@ fn pwl(args: &PwlArgs) -> Result<()> {
                     scenario.origin.display()
                 )
             })?;
-            pipeline::contact_waveform(&scenario, &chatter)?.0
+            let gap = GapProfile::from_step_force(&scenario.mechanics()?, &chatter);
+            (pipeline::contact_waveform(&scenario, &chatter)?.0, gap)
         }
     };
     let subckt = scenario
@@ -513,7 +520,10 @@ fn pwl(args: &PwlArgs) -> Result<()> {
     let element = args
         .element
         .unwrap_or_else(|| ContactElement::for_waveform(&waveform));
-    let include = netlist::contact_include(&waveform, subckt, element)?;
+    let mut include = netlist::contact_include(&waveform, subckt, element)?;
+    if let Some(arc) = &scenario.arc {
+        include = chatterspice::arc::element::with_arc(include, &arc.model(), &gap)?;
+    }
     if !include.data_files.is_empty() {
         let Some(output) = &args.output else {
             bail!(

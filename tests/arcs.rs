@@ -439,3 +439,35 @@ fn a_contact_inside_a_subcircuit_arcs_too() {
         result.chatter.bounce_count
     );
 }
+
+/// `pwl` writes the include a user's own deck needs: with `[arc]`, the
+/// arc element too.
+#[test]
+fn pwl_emits_the_arc_element_with_arc() {
+    let with = cli()
+        .args([
+            "pwl",
+            data("examples/scenarios/lamp-arc.toml").to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(with.status.success());
+    let text = String::from_utf8(with.stdout).unwrap();
+    for needle in [
+        ".subckt CONTACT ax b",
+        "Vs ax a 0",
+        "Barc ac b",
+        ".options method=gear",
+    ] {
+        assert!(text.contains(needle), "{needle}");
+    }
+    let without = cli()
+        .args([
+            "pwl",
+            data("examples/scenarios/lamp.toml").to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let text = String::from_utf8(without.stdout).unwrap();
+    assert!(text.contains(".subckt CONTACT a b") && !text.contains("Barc"));
+}
