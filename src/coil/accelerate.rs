@@ -31,9 +31,9 @@
 //! ngspice run is the fixed point of this cheap map, found by relaxation
 //! among the mechanics runs alone.
 
-use super::cycle::{Cycle, Stops};
-use super::forced::simulate_cycle;
 use super::{Coil, CoilError};
+use crate::mechanics::cycle::{Cycle, Stops};
+use crate::mechanics::forced::simulate_cycle;
 use crate::mechanics::{Mechanics, Settings};
 
 /// One ngspice run of the coil: its time points, the voltage across the

@@ -28,14 +28,14 @@ use std::time::{Duration, Instant};
 use thiserror::Error;
 
 use super::accelerate::{CircuitRun, Tolerances, settle};
-use super::cycle::Stops;
-use super::forced::simulate_cycle;
 use super::timing::{Operation, Switching, operations};
 use super::{Coil, CoilError};
 use crate::arc::GapProfile;
 use crate::arc::element::{ArcVectors, with_arc};
 use crate::chatter::{Chatter, ContactState, Interval};
 use crate::mechanics::Mechanics;
+use crate::mechanics::cycle::Stops;
+use crate::mechanics::forced::simulate_cycle;
 use crate::netlist::coil::coil_include;
 use crate::netlist::{
     self, ContactElement, Deck, DeckRequest, NetlistError, contact_include, instances_of,

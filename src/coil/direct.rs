@@ -14,7 +14,7 @@
 //! which is `V = R i + L(x) di/dt + i L'(x) ẋ` written in the flux. The
 //! armature sits on its rest stop until `F_m > p`, flies, and chatters on
 //! the fixed contact by the surface law, as in the step-force engine; the
-//! events and endings are those of `sequence`, whose sticking test freezes
+//! events and endings are those of `mechanics::driven`, whose sticking test freezes
 //! the coil current at the smaller of its present value and `V/R`.
 //!
 //! The result adds to the [`Chatter`] the coil current over time, the
@@ -23,9 +23,9 @@
 //! `∫V i dt = ∫R i² dt + Δ(½ L i²) + ∫F_m ẋ dt`, and the mechanical work
 //! goes into the armature's energy and its losses.
 
-use super::sequence::{self, Drive, Phase, Piece, State};
 use super::{Coil, CoilError};
 use crate::chatter::Chatter;
+use crate::mechanics::driven::{self, Drive, Phase, Piece, State};
 use crate::mechanics::{self, Mechanics, Settings, Surface};
 
 /// The ideal voltage source the coil is switched onto at t = 0.
@@ -196,7 +196,7 @@ pub fn simulate_direct(
         });
     }
     let drive = CoilDrive::new(coil, source, m.gap);
-    let run = sequence::run(&m, surface, settings, &drive, 0.0)?;
+    let run = driven::run(&m, surface, settings, &drive, 0.0)?;
     let events = drive.events(&run, &m);
     let energy = drive.energy(&run, &m, surface);
     let current = current_trace(&drive, &run.steps, m.gap);
@@ -249,7 +249,7 @@ impl CoilDrive {
         (self.rate(0.0, x, y[2]) * (self.a - x) - y[2] * y[1]) / self.k
     }
 
-    fn events(&self, run: &sequence::Run, m: &Mechanics) -> CoilEvents {
+    fn events(&self, run: &driven::Run, m: &Mechanics) -> CoilEvents {
         let first = run.chatter.impacts.first();
         let first_make = first.map(|i| i.impact_time);
         let tau0 = self.coil.inductance(0.0) / self.resistance;
@@ -294,7 +294,7 @@ impl CoilDrive {
                 return Some(at(piece.t0(), &y0));
             }
             if d0 < 0.0 && d1 >= 0.0 {
-                let t = sequence::first_true(
+                let t = driven::first_true(
                     |t| self.current_rate(&piece.at(t)) >= 0.0,
                     piece.t0(),
                     piece.t1,
@@ -309,7 +309,7 @@ impl CoilDrive {
     /// The energy balance, each integral by 5-point Gauss–Legendre on each
     /// step's interpolant (which is smooth inside a step: events end
     /// steps).
-    fn energy(&self, run: &sequence::Run, m: &Mechanics, surface: &Surface) -> EnergyBalance {
+    fn energy(&self, run: &driven::Run, m: &Mechanics, surface: &Surface) -> EnergyBalance {
         const GL5: [(f64, f64); 5] = [
             (-0.906_179_845_938_664, 0.236_926_885_056_189_1),
             (-0.538_469_310_105_683_1, 0.478_628_670_499_366_5),
@@ -332,7 +332,7 @@ impl CoilDrive {
                     lost += wh * m.damping * y[1] * y[1];
                 }
                 if *phase == Phase::Contact {
-                    lost += wh * sequence::surface_loss(surface, y[0], y[1]);
+                    lost += wh * crate::mechanics::surface::surface_loss(surface, y[0], y[1]);
                 }
             }
         }
@@ -346,7 +346,7 @@ impl CoilDrive {
             0.5 * m.mass * y[1] * y[1]
                 + 0.5 * m.stiffness * x * x
                 + m.preload * x
-                + sequence::surface_energy(surface, y[0])
+                + crate::mechanics::surface::surface_energy(surface, y[0])
         };
         let y_start = State::new(-self.gap, 0.0, 0.0);
         EnergyBalance {
@@ -372,7 +372,7 @@ impl Drive for CoilDrive {
     fn frozen_work(&self, _t: f64, psi: f64, from: f64, to: f64) -> f64 {
         // At constant current c the pull ½c²L'(x) integrates to
         // ½c²(L(to) − L(from)); the current is frozen at the smaller of
-        // its present and final values (see `sequence`).
+        // its present and final values (see `mechanics::driven`).
         let c = self
             .current(psi, to)
             .abs()

@@ -22,39 +22,34 @@
 //! back-EMF `i L'(x) ẋ` — which makes the well-known dip of the current
 //! while the armature pulls in — needs no term of its own.
 //!
+//! This module keeps the magnet ([`Coil`]), the coil's electrical state
+//! and the coupling with the circuit; the armature's event rules under a
+//! drive that varies (the closing, the whole cycle, a force `F(t, x)`)
+//! live with the rest of the mechanics in [`crate::mechanics`]
+//! ([`crate::mechanics::driven`], [`crate::mechanics::cycle`],
+//! [`crate::mechanics::forced`]).
+//!
 //! - [`direct`]: a coil switched onto an ideal voltage source, solved as
 //!   one ODE in (ψ, x, ẋ) with no circuit simulator: the independent
 //!   cross-check of the coupled ngspice runs, and the reference case of
 //!   docs/model.md §7.
-//! - [`forced`]: the mechanics under a drive force that varies in time and
-//!   position, `F(t, x)`: what the waveform-relaxation coupling with
-//!   ngspice feeds with `F_m(i(t), x)`.
-//!
-//! Both share one event-driven integrator (`sequence`): Dormand–Prince
-//! 5(4) with dense output ([`crate::mechanics::integrate`]), every event
-//! (lift-off, impact, release, landing on the rest stop, turning points,
-//! force extrema) bracketed on one step and polished by bisection on the
-//! step's interpolant.
+//! - [`coupled`] and [`accelerate`]: the waveform relaxation with ngspice,
+//!   which feeds the mechanics `F_m(i(t), x)`.
+//! - [`timing`]: each operation's times as datasheets define them.
 
 pub mod accelerate;
 pub mod coupled;
-pub mod cycle;
 pub mod direct;
-pub mod forced;
-mod sequence;
 pub mod timing;
 
+pub use crate::mechanics::cycle::{Cycle, Stops, Stroke};
+pub use crate::mechanics::forced::{simulate_cycle, simulate_forced, simulate_forced_path};
 pub use coupled::{Coupled, CouplingError, CouplingOptions, run_coupled};
-pub use cycle::{Cycle, Stops, Stroke};
 pub use direct::{
     CoilEvents, CoilRun, CoilState, EnergyBalance, PullInDip, Source, simulate_direct,
 };
-pub use forced::{simulate_cycle, simulate_forced, simulate_forced_path};
 pub use timing::{Closing, Operation, Switching, operations};
 
-use thiserror::Error;
-
-use crate::mechanics::MechanicsError;
 use crate::scenario::CoilSection;
 
 /// H/m, the vacuum permeability (CODATA 2018; 4π·10⁻⁷ to 6e-10).
@@ -165,34 +160,10 @@ impl Coil {
     }
 }
 
-/// What the coupled solvers can fail on. Parameter errors name the key to
-/// change; run-time errors carry the time and state.
-#[derive(Debug, Error, Clone, PartialEq)]
-pub enum CoilError {
-    #[error("`{name}` = {value} is not valid: {requirement}")]
-    InvalidParameter {
-        name: &'static str,
-        value: f64,
-        requirement: &'static str,
-    },
-    #[error(transparent)]
-    Mechanics(#[from] MechanicsError),
-    #[error(
-        "the armature reached the pole face (x = {position} m ≥ `coil.air_gap` = {pole} m) \
-         at t = {time} s: the contact cannot hold the magnetic pull; stiffen \
-         `surface.stiffness`, lower the drive, or end the run earlier with `simulation.t_end`"
-    )]
-    ArmatureAtPole { time: f64, position: f64, pole: f64 },
-    #[error(
-        "the drive force is {value} N at t = {time} s, x = {position} m: \
-         the force function must return a finite force for every time and position"
-    )]
-    DriveNotFinite {
-        time: f64,
-        position: f64,
-        value: f64,
-    },
-}
+/// What the coupled solvers can fail on: the driven mechanics' own
+/// errors ([`crate::mechanics::DriveError`], under the name the coil has
+/// always used).
+pub use crate::mechanics::DriveError as CoilError;
 
 fn check(
     name: &'static str,

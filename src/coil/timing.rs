@@ -21,8 +21,8 @@
 
 use serde::Serialize;
 
-use super::cycle::Stroke;
 use crate::chatter::Chatter;
+use crate::mechanics::cycle::Stroke;
 
 /// The instants the coil was switched, in s.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]

@@ -18,13 +18,22 @@
 //!   ([`dop853`]), in variables that keep the motion smooth through touch
 //!   and release ([`hunt_crossley`]).
 //!
+//! Under a drive that varies in time and position (a coil), the same
+//! events, surface laws and endings are integrated with event location:
+//! [`driven`] (one closing), [`cycle`] (the whole operating cycle: make,
+//! hold, release, the rest stop), [`forced`] (their entry points for a
+//! force `F(t, x)`).
+//!
 //! Sign conventions: `x` is the displacement toward the fixed contact
 //! (m), velocities are positive toward it, and contact forces are the
 //! force the fixed contact puts on the moving one, positive pushing back.
 
+pub mod cycle;
 pub mod dop853;
+pub mod driven;
 pub mod engine;
 pub mod force;
+pub mod forced;
 pub mod hunt_crossley;
 pub mod integrate;
 pub mod linear;
@@ -186,3 +195,33 @@ pub const MAX_EVENTS: usize = 100_000;
 /// The most integration steps one contact of a nonlinear surface takes
 /// before it is given up as unphysical.
 pub const MAX_CONTACT_STEPS: usize = 2_000_000;
+
+/// What the driven mechanics (a drive that varies in time and position:
+/// the coil) can fail on. Parameter errors name the key to change;
+/// run-time errors carry the time and state.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum DriveError {
+    #[error("`{name}` = {value} is not valid: {requirement}")]
+    InvalidParameter {
+        name: &'static str,
+        value: f64,
+        requirement: &'static str,
+    },
+    #[error(transparent)]
+    Mechanics(#[from] MechanicsError),
+    #[error(
+        "the armature reached the pole face (x = {position} m ≥ `coil.air_gap` = {pole} m) \
+         at t = {time} s: the contact cannot hold the magnetic pull; stiffen \
+         `surface.stiffness`, lower the drive, or end the run earlier with `simulation.t_end`"
+    )]
+    ArmatureAtPole { time: f64, position: f64, pole: f64 },
+    #[error(
+        "the drive force is {value} N at t = {time} s, x = {position} m: \
+         the force function must return a finite force for every time and position"
+    )]
+    DriveNotFinite {
+        time: f64,
+        position: f64,
+        value: f64,
+    },
+}

@@ -105,3 +105,48 @@ pub fn hunt_crossley_restitution(chi: f64, v: f64) -> Option<f64> {
     }
     super::root::bisect(g, 0.0, hi, 1e-15)
 }
+
+/// N, a surface's force at penetration `u` (m) and rate `v` (m/s); zero
+/// off the surface and for a rigid one.
+pub(crate) fn surface_force(surface: &Surface, u: f64, v: f64) -> f64 {
+    match *surface {
+        Surface::Rigid { .. } => 0.0,
+        // The paper's rule: no clamp, the surface may pull before release.
+        Surface::KelvinVoigt { stiffness, damping } => stiffness * u + damping * v,
+        Surface::HuntCrossley { .. } if u <= 0.0 => 0.0,
+        _ => surface.force(u, v),
+    }
+}
+
+/// W, the power a surface dissipates at penetration `u` and rate `v`: its
+/// force times the rate, less what its spring stores.
+pub(crate) fn surface_loss(surface: &Surface, u: f64, v: f64) -> f64 {
+    match *surface {
+        Surface::Rigid { .. } => 0.0,
+        Surface::KelvinVoigt { damping, .. } => damping * v * v,
+        Surface::HuntCrossley {
+            stiffness,
+            exponent,
+            ..
+        } => {
+            if u <= 0.0 {
+                0.0
+            } else {
+                (surface_force(surface, u, v) - stiffness * u.powf(exponent)) * v
+            }
+        }
+    }
+}
+
+/// J, the energy a surface stores at penetration `u`.
+pub(crate) fn surface_energy(surface: &Surface, u: f64) -> f64 {
+    match *surface {
+        Surface::Rigid { .. } => 0.0,
+        Surface::KelvinVoigt { stiffness, .. } => 0.5 * stiffness * u.max(0.0).powi(2),
+        Surface::HuntCrossley {
+            stiffness,
+            exponent,
+            ..
+        } => stiffness * u.max(0.0).powf(exponent + 1.0) / (exponent + 1.0),
+    }
+}

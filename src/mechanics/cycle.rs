@@ -4,14 +4,14 @@
 //! the armature on its rest stop (the normally-closed contact), and so on
 //! for as many pulses as the drive gives (docs/model.md §7).
 //!
-//! The closing engine (`coil::sequence`) simulates one closing and ends when the contact has
+//! The closing engine ([`super::driven`]) simulates one closing and ends when the contact has
 //! stuck, on the understanding that the drive does not weaken afterwards.
 //! Here nothing ends before `t_end`: a stuck contact stays in its contact
 //! phase and releases by the same rule that ends every contact (the
 //! moving contact back at the surface, moving out), so the break of the
 //! normally-open (NO) contact is found where the pull no longer holds it.
 //!
-//! The state is the one of `sequence`, `(u = x − g, v, e)`, and so are the
+//! The state is the one of [`super::driven`], `(u = x − g, v, e)`, and so are the
 //! numerics: Dormand–Prince 5(4) with dense output, each step split at its
 //! velocity zero, every crossing bracketed on a monotonic part and
 //! polished by bisection on the interpolant. The phases:
@@ -40,11 +40,12 @@
 //! at the ends of the steps and at the zeros of the force's rate inside
 //! them, bisected on the interpolant, as the closing engine does.
 
-use super::CoilError;
-use super::sequence::{self, Drive, State, first_true, monotone_parts, state_on, surface_force};
+use super::DriveError;
+use super::driven::{self, Drive, State, first_true, monotone_parts, state_on};
+use super::integrate::{Dopri5, Step, Tolerance};
+use super::surface::surface_force;
+use super::{Mechanics, Settings, Surface};
 use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome};
-use crate::mechanics::integrate::{Dopri5, Step, Tolerance};
-use crate::mechanics::{Mechanics, Settings, Surface};
 
 /// One stroke of the armature: from leaving the rest stop (lift-off) to
 /// leaving it again, or to the end of the run. All times in s from t = 0.
@@ -121,8 +122,8 @@ pub(crate) fn run<D: Drive>(
     settings: &Settings,
     drive: &D,
     e0: f64,
-) -> Result<Cycle, CoilError> {
-    let tol = sequence::start(m, drive, e0)?;
+) -> Result<Cycle, DriveError> {
+    let tol = driven::start(m, drive, e0)?;
     let x0 = m.initial_position;
     let held = x0 == 0.0 && m.initial_velocity <= 0.0;
     let back_state = if held {
@@ -441,7 +442,7 @@ impl<D: Drive> Model<'_, D> {
 
 impl<D: Drive> Sim<'_, D> {
     /// Run the phases from `phase` at (0, y) to `t_end`.
-    fn simulate(&mut self, mut phase: Phase, mut y: State) -> Result<(), CoilError> {
+    fn simulate(&mut self, mut phase: Phase, mut y: State) -> Result<(), DriveError> {
         let g = self.model.g();
         let mut t = 0.0;
         loop {
@@ -567,7 +568,7 @@ impl<D: Drive> Sim<'_, D> {
         phase: Phase,
         t0: f64,
         y0: State,
-    ) -> Result<(Event, f64, State), CoilError> {
+    ) -> Result<(Event, f64, State), DriveError> {
         let (model, rec) = (&self.model, &mut self.rec);
         let g = model.g();
         let t_end = model.settings.t_end;
@@ -669,7 +670,7 @@ fn moving_event<D: Drive>(
     rec: &mut Record,
     phase: Phase,
     step: &Step<3>,
-) -> Result<Option<(Event, f64, State)>, CoilError> {
+) -> Result<Option<(Event, f64, State)>, DriveError> {
     let g = model.g();
     let parts = monotone_parts(step);
     // A crossing of `level` (in u) in the given direction on a monotonic
@@ -727,7 +728,7 @@ fn moving_event<D: Drive>(
             model.force_rate(side, t, &y)
         };
         let mut seen = vec![y_last];
-        if let Some(tz) = sequence::sign_change(rate, step.t0, t_last) {
+        if let Some(tz) = driven::sign_change(rate, step.t0, t_last) {
             seen.push(state_on(step, tz));
         }
         for y in seen {
@@ -742,7 +743,7 @@ fn moving_event<D: Drive>(
             let pole = model.drive.pole();
             if g + y_last[0] >= pole {
                 let tp = first_true(|t| g + step.at(t)[0] >= pole, step.t0, t_last);
-                return Err(CoilError::ArmatureAtPole {
+                return Err(DriveError::ArmatureAtPole {
                     time: tp,
                     position: g + state_on(step, tp)[0],
                     pole,

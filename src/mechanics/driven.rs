@@ -1,6 +1,6 @@
 //! The event-driven chatter of an armature under a drive that varies in
 //! time and position, and that may carry a state of its own (the coil's
-//! flux). Shared by [`super::direct`] and [`super::forced`].
+//! flux). Shared by [`crate::coil::direct`] and [`super::forced`].
 //!
 //! The state is `(u, v, e)`: `u = x − g` (m, the position relative to the
 //! fixed contact, so that the µm penetrations keep their precision), the
@@ -34,7 +34,7 @@
 //! (`W_s` the surface's stored energy) never increases in contact, and a
 //! release needs `M = ½mv² ≥ 0` at δ = 0; so `M < 0` means stuck for good.
 //! A drive that varies has no such invariant, so the test is quasi-static:
-//! the drive is frozen where it stands ([`Drive::frozen_work`]) and the
+//! the drive is frozen where it stands (`Drive::frozen_work`) and the
 //! contact is stuck when, under that frozen drive, it could not reach the
 //! edge of the surface again. It is checked at step ends once moving out
 //! (past the deepest point, so the force peak has been seen). This is
@@ -55,11 +55,12 @@
 
 use nalgebra::Vector3;
 
-use super::CoilError;
+use super::DriveError;
+use super::integrate::{Dopri5, Step, Tolerance};
+use super::linear::LinearPiece;
+use super::surface::{surface_energy, surface_force};
+use super::{Mechanics, Settings, Surface};
 use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome, bounces};
-use crate::mechanics::integrate::{Dopri5, Step, Tolerance};
-use crate::mechanics::linear::LinearPiece;
-use crate::mechanics::{Mechanics, Settings, Surface};
 
 /// `(u = x − g, v, e)`: m, m/s, and the drive's own state.
 pub(crate) type State = Vector3<f64>;
@@ -222,7 +223,7 @@ pub(crate) fn run<D: Drive>(
     settings: &Settings,
     drive: &D,
     e0: f64,
-) -> Result<Run, CoilError> {
+) -> Result<Run, DriveError> {
     let tol = start(m, drive, e0)?;
     let model = Model {
         m: *m,
@@ -253,11 +254,11 @@ pub(crate) fn start<D: Drive>(
     m: &Mechanics,
     drive: &D,
     e0: f64,
-) -> Result<Tolerance<3>, CoilError> {
+) -> Result<Tolerance<3>, DriveError> {
     let x0 = m.initial_position;
     let f0 = drive.force(0.0, x0, e0);
     if !f0.is_finite() {
-        return Err(CoilError::DriveNotFinite {
+        return Err(DriveError::DriveNotFinite {
             time: 0.0,
             position: x0,
             value: f0,
@@ -450,51 +451,6 @@ impl<D: Drive> Model<'_, D> {
     }
 }
 
-/// N, a surface's force at penetration `u` (m) and rate `v` (m/s); zero
-/// off the surface and for a rigid one.
-pub(crate) fn surface_force(surface: &Surface, u: f64, v: f64) -> f64 {
-    match *surface {
-        Surface::Rigid { .. } => 0.0,
-        // The paper's rule: no clamp, the surface may pull before release.
-        Surface::KelvinVoigt { stiffness, damping } => stiffness * u + damping * v,
-        Surface::HuntCrossley { .. } if u <= 0.0 => 0.0,
-        _ => surface.force(u, v),
-    }
-}
-
-/// W, the power a surface dissipates at penetration `u` and rate `v`: its
-/// force times the rate, less what its spring stores.
-pub(crate) fn surface_loss(surface: &Surface, u: f64, v: f64) -> f64 {
-    match *surface {
-        Surface::Rigid { .. } => 0.0,
-        Surface::KelvinVoigt { damping, .. } => damping * v * v,
-        Surface::HuntCrossley {
-            stiffness,
-            exponent,
-            ..
-        } => {
-            if u <= 0.0 {
-                0.0
-            } else {
-                (surface_force(surface, u, v) - stiffness * u.powf(exponent)) * v
-            }
-        }
-    }
-}
-
-/// J, the energy a surface stores at penetration `u`.
-pub(crate) fn surface_energy(surface: &Surface, u: f64) -> f64 {
-    match *surface {
-        Surface::Rigid { .. } => 0.0,
-        Surface::KelvinVoigt { stiffness, .. } => 0.5 * stiffness * u.max(0.0).powi(2),
-        Surface::HuntCrossley {
-            stiffness,
-            exponent,
-            ..
-        } => stiffness * u.max(0.0).powf(exponent + 1.0) / (exponent + 1.0),
-    }
-}
-
 /// The first time in `[lo, hi]` at which `cond` holds, given that it does
 /// not at `lo` and does at `hi`: bisection down to adjacent floats, so the
 /// answer is the upper end of a bracket no wider than one ulp.
@@ -603,7 +559,7 @@ struct Record {
 }
 
 impl<D: Drive> Sequence<'_, D> {
-    fn run(mut self, y0: State) -> Result<Run, CoilError> {
+    fn run(mut self, y0: State) -> Result<Run, DriveError> {
         let g = self.model.g();
         let t_end = self.model.settings.t_end;
         let (mut t, mut y) = (0.0, y0);
@@ -722,7 +678,7 @@ impl<D: Drive> Sequence<'_, D> {
     }
 
     /// Held at x = 0 until the drive beats the preload.
-    fn held(&mut self, t0: f64, y0: State) -> Result<End, CoilError> {
+    fn held(&mut self, t0: f64, y0: State) -> Result<End, DriveError> {
         let model = &self.model;
         let t_end = model.settings.t_end;
         let lifts = |t: f64, y: &State| model.drive.force(t, 0.0, y[2]) > model.m.preload;
@@ -757,7 +713,7 @@ impl<D: Drive> Sequence<'_, D> {
 
     /// Free flight from (t0, y0) to the next impact or landing; `lowest`
     /// tracks the smallest x on the way.
-    fn flight(&mut self, t0: f64, y0: State, lowest: &mut f64) -> Result<End, CoilError> {
+    fn flight(&mut self, t0: f64, y0: State, lowest: &mut f64) -> Result<End, DriveError> {
         let model = &self.model;
         let rec = &mut self.rec;
         let g = model.g();
@@ -813,7 +769,7 @@ impl<D: Drive> Sequence<'_, D> {
 
     /// One contact from the touch at (t_hit, y_hit); fills the force
     /// fields of the last impact.
-    fn contact(&mut self, t_hit: f64, y_hit: State) -> Result<End, CoilError> {
+    fn contact(&mut self, t_hit: f64, y_hit: State) -> Result<End, DriveError> {
         let model = &self.model;
         let rec = &mut self.rec;
         let last = rec.impacts.last_mut().expect("the impact was pushed");
@@ -857,7 +813,7 @@ impl<D: Drive> Sequence<'_, D> {
             }
             if g + step.y1[0] >= pole {
                 let tp = first_true(|t| g + step.at(t)[0] >= pole, step.t0, step.t1);
-                return Err(CoilError::ArmatureAtPole {
+                return Err(DriveError::ArmatureAtPole {
                     time: tp,
                     position: g + state_on(&step, tp)[0],
                     pole,
@@ -1014,6 +970,7 @@ impl<D: Drive> Sequence<'_, D> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mechanics::surface::surface_loss;
 
     #[test]
     fn first_true_brackets_to_one_ulp() {

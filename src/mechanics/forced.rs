@@ -2,17 +2,17 @@
 //!
 //! This is the mechanical half of the waveform-relaxation coupling with
 //! ngspice: the circuit gives the coil current `i(t)`, the coil turns it
-//! into `F_m(i(t), x)` ([`super::Coil::force`]), and this integrates the
+//! into `F_m(i(t), x)` ([`crate::coil::Coil::force`]), and this integrates the
 //! armature under it, with the same events, surface laws and endings as
-//! the step-force engine (see `sequence` for the numerics and the sticking
+//! the step-force engine (see [`super::driven`] for the numerics and the sticking
 //! argument). With a constant force it reproduces
 //! [`crate::mechanics::simulate`].
 
-use super::CoilError;
+use super::DriveError;
 use super::cycle::{self, Cycle, Stops};
-use super::sequence::{self, Drive};
+use super::driven::{self, Drive};
+use super::{self as mechanics, Mechanics, Settings, Surface};
 use crate::chatter::Chatter;
-use crate::mechanics::{self, Mechanics, Settings, Surface};
 
 /// Simulate one closing under `force(t, x)` (s, m → N, toward closing),
 /// which replaces `mechanics.force`; the preload still holds the armature
@@ -30,7 +30,7 @@ pub fn simulate_forced(
     surface: &Surface,
     settings: &Settings,
     force: impl Fn(f64, f64) -> f64,
-) -> Result<Chatter, CoilError> {
+) -> Result<Chatter, DriveError> {
     simulate_forced_path(mechanics, surface, settings, force).map(|(chatter, _)| chatter)
 }
 
@@ -43,10 +43,10 @@ pub fn simulate_forced_path(
     surface: &Surface,
     settings: &Settings,
     force: impl Fn(f64, f64) -> f64,
-) -> Result<(Chatter, Vec<(f64, f64)>), CoilError> {
+) -> Result<(Chatter, Vec<(f64, f64)>), DriveError> {
     validate(mechanics, &[surface], settings)?;
     let drive = Forced::new(mechanics, force);
-    let run = sequence::run(mechanics, surface, settings, &drive, 0.0)?;
+    let run = driven::run(mechanics, surface, settings, &drive, 0.0)?;
     let gap = mechanics.gap;
     let mut path: Vec<(f64, f64)> = Vec::with_capacity(run.steps.len() + 1);
     if let Some(first) = run.steps.first() {
@@ -71,7 +71,7 @@ pub fn simulate_cycle(
     stops: &Stops,
     settings: &Settings,
     force: impl Fn(f64, f64) -> f64,
-) -> Result<Cycle, CoilError> {
+) -> Result<Cycle, DriveError> {
     let surfaces: Vec<&Surface> = std::iter::once(&stops.make).chain(&stops.back).collect();
     validate(mechanics, &surfaces, settings)?;
     let drive = Forced::new(mechanics, force);
@@ -85,7 +85,7 @@ fn validate(
     mechanics: &Mechanics,
     surfaces: &[&Surface],
     settings: &Settings,
-) -> Result<(), CoilError> {
+) -> Result<(), DriveError> {
     let unforced = Mechanics {
         force: 0.0,
         ..*mechanics
@@ -94,7 +94,7 @@ fn validate(
         mechanics::validate(&unforced, surface, settings)?;
     }
     if mechanics.initial_position < 0.0 {
-        return Err(CoilError::InvalidParameter {
+        return Err(DriveError::InvalidParameter {
             name: "mechanics.initial_position",
             value: mechanics.initial_position,
             requirement: "a position in m at or above the rest stop at 0 (and below the gap)",
@@ -233,7 +233,7 @@ mod tests {
         let s = Surface::Rigid { restitution: 0.5 };
         let err = simulate_forced(&relay(), &s, &Settings::default(), |_, _| f64::NAN);
         assert!(
-            matches!(err, Err(CoilError::DriveNotFinite { .. })),
+            matches!(err, Err(DriveError::DriveNotFinite { .. })),
             "{err:?}"
         );
     }
