@@ -93,8 +93,8 @@ pub fn settle(
         let estimate: Vec<(f64, f64)> = (0..run.time.len())
             .map(|j| (run.time[j], run.flux[j] + phi[j] - base[j]))
             .collect();
-        let pull =
-            |t: f64, _x: f64| coil.force_from_flux(super::coupled::interpolate(&estimate, t));
+        let flux_at = super::coupled::Cursor::new(&estimate);
+        let pull = |t: f64, _x: f64| coil.force_from_flux(flux_at.at(t));
         let next = simulate_cycle(mechanics, stops, settings, pull)?;
         let moved = super::coupled::event_change(&current.make, &next.make)
             .max(super::coupled::event_change(&current.back, &next.back));

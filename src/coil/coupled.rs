@@ -376,7 +376,8 @@ pub fn run_coupled(
             iteration,
             vector: psi.clone(),
         })?;
-        let pull = |t: f64, _x: f64| coil.force_from_flux(interpolate(&flux, t));
+        let flux_at = Cursor::new(&flux);
+        let pull = |t: f64, _x: f64| coil.force_from_flux(flux_at.at(t));
         let cycle = simulate_cycle(&mechanics, &stops, &settings, pull).map_err(|source| {
             CouplingError::Coil {
                 path: origin.clone(),
@@ -492,19 +493,30 @@ pub fn thin(path: &[(f64, f64)], tolerance: f64) -> Vec<(f64, f64)> {
     let mut out = vec![first];
     let mut start = 0;
     let mut end = 2;
+    // The chord from `start` passes within `tolerance` of an intermediate
+    // point (t, x) exactly when its slope lies in
+    // [(x − tol − x0)/(t − t0), (x + tol − x0)/(t − t0)]: keep the
+    // intersection over the points passed so far, one point per step.
+    let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
     while end < path.len() {
         let (t0, x0) = path[start];
+        let (tm, xm) = path[end - 1];
+        let dt = tm - t0;
+        if dt > 0.0 {
+            lo = lo.max((xm - tolerance - x0) / dt);
+            hi = hi.min((xm + tolerance - x0) / dt);
+        } else if (xm - x0).abs() > tolerance {
+            (lo, hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        }
         let (t1, x1) = path[end];
-        let fits = path[start + 1..end].iter().all(|&(t, x)| {
-            let line = x0 + (x1 - x0) * (t - t0) / (t1 - t0);
-            (x - line).abs() <= tolerance
-        });
-        if fits {
+        let slope = (x1 - x0) / (t1 - t0);
+        if slope >= lo && slope <= hi {
             end += 1;
         } else {
             start = end - 1;
             out.push(path[start]);
             end = start + 2;
+            (lo, hi) = (f64::NEG_INFINITY, f64::INFINITY);
         }
     }
     if path.len() > 1 {
@@ -570,7 +582,47 @@ fn series(plot: &Plot, name: &str) -> Option<Vec<(f64, f64)>> {
 
 /// Linear interpolation in (time, value) samples, held beyond both ends.
 pub(super) fn interpolate(samples: &[(f64, f64)], t: f64) -> f64 {
-    let k = samples.partition_point(|&(s, _)| s <= t);
+    interpolate_at(samples, t, samples.partition_point(|&(s, _)| s <= t))
+}
+
+/// [`interpolate`] for a caller that asks at times close to the last
+/// (an integrator stepping through the record): it first tries the
+/// interval of the previous call and its neighbour before searching, with
+/// the same result.
+pub(super) struct Cursor<'a> {
+    samples: &'a [(f64, f64)],
+    hint: std::cell::Cell<usize>,
+}
+
+impl<'a> Cursor<'a> {
+    pub(super) fn new(samples: &'a [(f64, f64)]) -> Self {
+        Cursor {
+            samples,
+            hint: std::cell::Cell::new(1),
+        }
+    }
+
+    /// The sample value at `t`, as [`interpolate`] gives it.
+    pub(super) fn at(&self, t: f64) -> f64 {
+        let s = self.samples;
+        // k is the first index whose time is past t: unique, so a hint
+        // that brackets t is the answer the search would give.
+        let brackets = |k: usize| k > 0 && k < s.len() && s[k - 1].0 <= t && s[k].0 > t;
+        let hint = self.hint.get();
+        let k = if brackets(hint) {
+            hint
+        } else if brackets(hint + 1) {
+            hint + 1
+        } else {
+            s.partition_point(|&(ts, _)| ts <= t)
+        };
+        self.hint.set(k);
+        interpolate_at(s, t, k)
+    }
+}
+
+/// The value at `t` given `k`, the first sample past `t`.
+fn interpolate_at(samples: &[(f64, f64)], t: f64, k: usize) -> f64 {
     if k == 0 {
         return samples.first().map_or(0.0, |&(_, v)| v);
     }
@@ -589,6 +641,66 @@ pub(super) fn interpolate(samples: &[(f64, f64)], t: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_cursor_gives_what_the_search_gives_in_any_order() {
+        let samples: Vec<(f64, f64)> = (0..200)
+            .map(|k| {
+                let t = f64::from(k) * 1e-3 + if k % 7 == 0 { 5e-4 } else { 0.0 };
+                (t, (f64::from(k) * 0.37).sin())
+            })
+            .collect();
+        let cursor = Cursor::new(&samples);
+        // Forward, backward, repeated, out of range, exactly on samples.
+        let mut times: Vec<f64> = (0..2000).map(|k| f64::from(k) * 1.1e-4 - 0.01).collect();
+        times.extend(times.clone().into_iter().rev());
+        times.extend(samples.iter().map(|s| s.0));
+        times.extend([0.1, 0.05, 0.1500001, -1.0, 1.0, 0.05]);
+        for t in times {
+            assert_eq!(cursor.at(t), interpolate(&samples, t), "at {t}");
+        }
+    }
+
+    /// The thinning as first written: every chord checked against every
+    /// point it passes (quadratic in a long straight stretch).
+    fn thin_by_rescanning(path: &[(f64, f64)], tolerance: f64) -> Vec<(f64, f64)> {
+        let mut out = vec![path[0]];
+        let (mut start, mut end) = (0, 2);
+        while end < path.len() {
+            let ((t0, x0), (t1, x1)) = (path[start], path[end]);
+            let fits = path[start + 1..end].iter().all(|&(t, x)| {
+                let line = x0 + (x1 - x0) * (t - t0) / (t1 - t0);
+                (x - line).abs() <= tolerance
+            });
+            if fits {
+                end += 1;
+            } else {
+                start = end - 1;
+                out.push(path[start]);
+                end = start + 2;
+            }
+        }
+        if path.len() > 1 {
+            out.push(path[path.len() - 1]);
+        }
+        out
+    }
+
+    #[test]
+    fn thinning_in_one_pass_keeps_the_points_the_rescan_kept() {
+        // A bouncing path: flights, flat holds and noise at the tolerance.
+        let path: Vec<(f64, f64)> = (0..5000)
+            .map(|k| {
+                let t = f64::from(k) * 1e-6;
+                let x = (4e-4 * (t * 2e3).sin().abs()).min(3e-4)
+                    + 1e-9 * (f64::from(k) * 12.9898).sin();
+                (t, x)
+            })
+            .collect();
+        for tol in [1e-10, 1e-9, 1e-8, 1e-6] {
+            assert_eq!(thin(&path, tol), thin_by_rescanning(&path, tol), "{tol}");
+        }
+    }
 
     #[test]
     fn thinning_keeps_the_shape_within_the_tolerance() {
