@@ -416,7 +416,7 @@ fn bad_arc_sections_name_the_key() {
 }
 
 /// A contact instantiated inside the user's own subcircuit: ngspice names
-/// its vectors with the path (`i(v.x_board.x_relay.vs)`), and the arcs are
+/// its vectors with the path (`i(v.x_board.x_relay.vsense)`), and the arcs are
 /// found there.
 #[test]
 fn a_contact_inside_a_subcircuit_arcs_too() {
@@ -455,7 +455,7 @@ fn pwl_emits_the_arc_element_with_arc() {
     let text = String::from_utf8(with.stdout).unwrap();
     for needle in [
         ".subckt CONTACT ax b",
-        "Vs ax a 0",
+        "Vsense ax a 0",
         "Barc ac b",
         ".options method=gear",
     ] {
@@ -470,4 +470,41 @@ fn pwl_emits_the_arc_element_with_arc() {
         .unwrap();
     let text = String::from_utf8(without.stdout).unwrap();
     assert!(text.contains(".subckt CONTACT a b") && !text.contains("Barc"));
+}
+
+/// The arc element wraps whichever conductance element carries the
+/// contact: each gives the lamp's seven bounce arcs and their energy.
+#[test]
+fn every_contact_element_carries_the_arc() {
+    let Some(_) = common::ngspice() else { return };
+    let mut energies = Vec::new();
+    for element in ["pwl", "event-ramp", "switch"] {
+        let out = cli()
+            .args([
+                "run",
+                data("examples/scenarios/lamp-arc.toml").to_str().unwrap(),
+                "--element",
+                element,
+                "--format",
+                "json",
+            ])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{element}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let bounces = v["bounce"]["bounce_count"].as_u64().unwrap();
+        assert_eq!(
+            v["arc_totals"]["count"].as_u64(),
+            Some(bounces),
+            "{element}"
+        );
+        energies.push(v["arc_totals"]["energy"].as_f64().unwrap());
+    }
+    for e in &energies[1..] {
+        assert!((e / energies[0] - 1.0).abs() < 0.05, "{energies:?}");
+    }
 }

@@ -2,11 +2,11 @@
 //!
 //! The contact's own element (the time-varying conductance) stays as it
 //! is, between internal node `a` and terminal `b`; the subcircuit's first
-//! terminal becomes `ax`, joined to `a` by a 0 V source `Vs` that senses
+//! terminal becomes `ax`, joined to `a` by a 0 V source `Vsense` that senses
 //! the whole contact current. In parallel with the conductance:
 //!
 //! - the **arc state** `st` (1 burning or able to burn, 0 not): a
-//!   voltage-controlled switch `Sst` on `|i(Vs)|` (seen through a lag of
+//!   voltage-controlled switch `Sst` on `|i(Vsense)|` (seen through a lag of
 //!   [`STATE_LAG`]) with its threshold at
 //!   I_min, closing at I_min and opening 0.4 % below it. A closed contact
 //!   carrying at least I_min holds the state on, so a separation under
@@ -21,7 +21,7 @@
 //!   can exceed th only by a few millivolts (softplus of width
 //!   [`CLAMP_SOFTNESS`]; at 1 A it holds th − 20 mV, at 100 A th + 9 mV).
 //!
-//! Its current is sensed by `Vc`, and `Bva` copies the contact voltage to
+//! Its current is sensed by `Vclamp`, and `Bva` copies the contact voltage to
 //! a node, so the raw file has what the arc analysis needs.
 //!
 //! The include also sets `.options method=gear`: against a capacitance
@@ -82,10 +82,10 @@ pub struct ArcVectors {
 impl ArcVectors {
     pub fn of(instance: &str) -> ArcVectors {
         ArcVectors {
-            current: format!("i(v.{instance}.vs)"),
+            current: format!("i(v.{instance}.vsense)"),
             voltage: format!("v({instance}.va)"),
             state: format!("v({instance}.st)"),
-            clamp: format!("i(v.{instance}.vc)"),
+            clamp: format!("i(v.{instance}.vclamp)"),
         }
     }
 
@@ -94,8 +94,8 @@ impl ArcVectors {
     }
 
     /// The vectors of `instance` as `plot` names them: at the top level
-    /// (`i(v.x1.vs)`), or inside the user's own subcircuits, where ngspice
-    /// prefixes the path (`i(v.x_board.x1.vs)`; the first such path in
+    /// (`i(v.x1.vsense)`), or inside the user's own subcircuits, where ngspice
+    /// prefixes the path (`i(v.x_board.x1.vsense)`; the first such path in
     /// the raw file's order). `None` when the plot has no complete set.
     pub fn in_plot(instance: &str, plot: &crate::rawfile::Plot) -> Option<ArcVectors> {
         let complete = |v: &ArcVectors| v.all().iter().all(|n| plot.index_of(n).is_some());
@@ -108,7 +108,10 @@ impl ArcVectors {
             .iter()
             .filter_map(|v| {
                 let name = v.name.to_ascii_lowercase();
-                let path = name.strip_prefix("i(v.")?.strip_suffix(".vs)")?.to_owned();
+                let path = name
+                    .strip_prefix("i(v.")?
+                    .strip_suffix(".vsense)")?
+                    .to_owned();
                 path.ends_with(&suffix).then_some(path)
             })
             .map(|path| ArcVectors::of(&path))
@@ -134,7 +137,7 @@ pub fn with_arc(
     comment(
         &mut arc,
         &format!(
-            "Arc: V_min = {} V, I_min = {} A, column gradient {} V/m. Vs senses the \
+            "Arc: V_min = {} V, I_min = {} A, column gradient {} V/m. Vsense senses the \
              contact current; switch Sst holds the arc state V(st) on from I_min; the \
              clamp Barc holds |V(a,b)| at V_arc = V_min + E*gap(t) while the state is \
              on, at the gap's breakdown voltage while it is off.",
@@ -143,8 +146,8 @@ pub fn with_arc(
             format_time(model.field)
         ),
     );
-    line(&mut arc, "Vs ax a 0");
-    line(&mut arc, "Vc a ac 0");
+    line(&mut arc, "Vsense ax a 0");
+    line(&mut arc, "Vclamp a ac 0");
     let samples = gap.samples();
     line(&mut arc, "Vvarc varc 0 PWL(");
     pairs(
@@ -156,7 +159,7 @@ pub fn with_arc(
         &mut arc,
         samples.iter().map(|&(t, g)| (t, model.hold_voltage(g))),
     );
-    line(&mut arc, "Bia iar 0 V = abs(i(Vs))");
+    line(&mut arc, "Bia iar 0 V = abs(i(Vsense))");
     line(&mut arc, "Ria iar ia 1");
     line(
         &mut arc,
