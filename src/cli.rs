@@ -425,6 +425,11 @@ fn check(args: &CheckArgs) -> Result<Status> {
             report::table::render_check(&verdict, evidence.chatter(), evidence.operations())
         }
     };
+    if let check::Evidence::Run(run) = &evidence {
+        for warning in &run.warnings {
+            eprintln!("warning: {warning}");
+        }
+    }
     emit(&text, None, false)?;
     Ok(if verdict.passed {
         Status::Success

@@ -606,20 +606,30 @@ fn arc_warnings(
     gap: &GapProfile,
 ) -> Vec<String> {
     if let Some(report) = arcs {
-        return report
-            .arcs
-            .iter()
-            .filter(|a| a.ends == "run_end")
-            .map(|a| {
-                format!(
-                    "the arc at {} (from {:.4} ms) still burns when the simulation stops: \
+        let mut warnings = Vec::new();
+        if let Some(circuit) = &scenario.circuit {
+            let instances = netlist::instances_of(netlist_text, &circuit.subckt);
+            if instances.len() > 1 {
+                warnings.push(format!(
+                    "the netlist has {} instances of {}: each carries the arc, but the arcs \
+                     reported are those of `{}` only",
+                    instances.len(),
+                    circuit.subckt,
+                    instances[0]
+                ));
+            }
+        }
+        let burning = report.arcs.iter().filter(|a| a.ends == "run_end").map(|a| {
+            format!(
+                "the arc at {} (from {:.4} ms) still burns when the simulation stops: \
                      the circuit drives more than V_arc = V_min + field·gap across the \
                      widest gap; extend .tran, or the contact cannot break this load",
-                    a.opening,
-                    a.start * 1e3
-                )
-            })
-            .collect();
+                a.opening,
+                a.start * 1e3
+            )
+        });
+        warnings.extend(burning);
+        return warnings;
     }
     let Some(circuit) = &scenario.circuit else {
         return Vec::new();
