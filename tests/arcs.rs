@@ -508,3 +508,47 @@ fn every_contact_element_carries_the_arc() {
         assert!((e / energies[0] - 1.0).abs() < 0.05, "{energies:?}");
     }
 }
+
+/// The arc numbers are sweepable: below the lamp's 12 V supply an arc can
+/// burn for the whole bounce opening, above it only while the wiring
+/// inductance gives up its current.
+#[test]
+fn a_sweep_over_v_min_shows_where_the_supply_sustains_the_arc() {
+    let Some(_) = common::ngspice() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(data("examples/scenarios/lamp-arc.toml"))
+        .unwrap()
+        .replace("../../netlists", data("netlists").to_str().unwrap());
+    let path = dir.path().join("s.toml");
+    std::fs::write(
+        &path,
+        format!("{text}\n[sweep]\n[sweep.grid]\n\"arc.v_min\" = {{ from = 10.0, to = 14.0, steps = 2 }}\n"),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    cli()
+        .args([
+            "sweep",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .assert()
+        .success();
+    let csv = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+    let mut rows = csv.lines();
+    let header: Vec<&str> = rows.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let energy: Vec<f64> = rows
+        .map(|r| {
+            r.split(',')
+                .nth(col("arc_energy"))
+                .unwrap()
+                .parse()
+                .unwrap()
+        })
+        .collect();
+    assert_eq!(energy.len(), 2);
+    // 10 V: 2 V left across the lamp, and the arc burns the whole opening.
+    assert!(energy[0] > 50.0 * energy[1], "{energy:?}");
+}

@@ -121,6 +121,20 @@ pub struct ArcSection {
 }
 
 impl ArcSection {
+    /// The section with every number given: the material's (or the
+    /// defaults) where the file left one out. Its [`ArcSection::model`] is
+    /// the same.
+    pub fn resolved(&self) -> ArcSection {
+        let m = self.model();
+        ArcSection {
+            material: self.material,
+            v_min: Some(m.v_min),
+            i_min: Some(m.i_min),
+            field: Some(m.field),
+            opening_speed: Some(m.opening_speed),
+        }
+    }
+
     /// The numbers the run uses.
     pub fn model(&self) -> ArcModel {
         let material = self.material.unwrap_or(REFERENCE_MATERIAL);

@@ -199,7 +199,9 @@ impl Scenario {
             datasheet: document.datasheet,
             fit: document.fit,
             provenance: document.provenance,
-            arc: document.arc,
+            // The material's numbers filled in, so that every arc number
+            // has a value to sweep or fit around.
+            arc: document.arc.map(|a| a.resolved()),
             resolved_surface,
             resolved_back_stop,
             embedded_netlist: None,

@@ -40,6 +40,10 @@ pub const NUMBER_KEYS: &[&str] = &[
     "simulation.t_end",
     "simulation.min_open_time",
     "simulation.min_gap",
+    "arc.v_min",
+    "arc.i_min",
+    "arc.field",
+    "arc.opening_speed",
 ];
 
 /// Every number key, for messages.
@@ -121,6 +125,15 @@ macro_rules! number_field {
             "simulation.t_end" => Field::Plain($($r)* s.simulation.t_end),
             "simulation.min_open_time" => Field::Plain($($r)* s.simulation.min_open_time),
             "simulation.min_gap" => Field::Plain($($r)* s.simulation.min_gap),
+            "arc.v_min" | "arc.i_min" | "arc.field" | "arc.opening_speed" => match $($r)* s.arc {
+                Some(a) => Field::Optional(match $key {
+                    "arc.v_min" => $($r)* a.v_min,
+                    "arc.i_min" => $($r)* a.i_min,
+                    "arc.field" => $($r)* a.field,
+                    _ => $($r)* a.opening_speed,
+                }),
+                None => Field::NoSection("[arc]"),
+            },
             other => match probe_key(other) {
                 Some((i, _)) if i >= s.probes.len() => Field::NoSection("[[probe]] of that number"),
                 Some((i, true)) => Field::Plain($($r)* s.probes[i].low),
@@ -320,6 +333,9 @@ impl Scenario {
         let back_stop = check.back_stop(self.back_stop.as_ref(), self.coil.is_some())?;
         check.contact(&self.contact)?;
         check.simulation(&self.simulation)?;
+        if let Some(arc) = &self.arc {
+            check.arc(arc)?;
+        }
         if probes {
             for (i, probe) in self.probes.iter().enumerate() {
                 check.probe(i, probe)?;
