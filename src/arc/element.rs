@@ -131,7 +131,7 @@ pub fn with_arc(
     let ends = format!(".ends {subckt}\n");
     let (Some(head_at), Some(ends_at)) = (include.text.find(&header), include.text.rfind(&ends))
     else {
-        unreachable!("contact_include writes `.subckt NAME a b` and `.ends NAME`");
+        return Err(NetlistError::NotAContactInclude { subckt });
     };
     let mut arc = String::new();
     comment(
@@ -218,4 +218,58 @@ pub fn with_arc(
     text.push_str(&include.text[ends_at..]);
     include.text = text;
     Ok(include)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::chatter::{ContactState, Interval};
+    use crate::netlist::{ContactElement, contact_include};
+    use crate::waveform::{ContactModel, Waveform};
+
+    fn include() -> ContactInclude {
+        let iv = |state, start, end| Interval { state, start, end };
+        let intervals = [
+            iv(ContactState::Open, 0.0, 1e-3),
+            iv(ContactState::Closed, 1e-3, 2e-3),
+            iv(ContactState::Open, 2e-3, 3e-3),
+        ];
+        let model = ContactModel {
+            r_closed: 0.05,
+            r_open: 1e9,
+            edge_time: 1e-8,
+        };
+        let waveform = Waveform::from_intervals(&intervals, &model).unwrap();
+        contact_include(&waveform, "CONTACT", ContactElement::Pwl).unwrap()
+    }
+
+    #[test]
+    fn the_arc_wraps_the_contact_and_samples_its_hold_voltages() {
+        let arc = ArcModel {
+            v_min: 12.0,
+            i_min: 0.4,
+            field: 1e4,
+            opening_speed: 0.3,
+        };
+        let gap = GapProfile::from_samples([(0.0, 1e-3), (1e-3, 0.0), (2e-3, 0.0), (3e-3, 2e-4)]);
+        let plain = include();
+        let with = with_arc(plain.clone(), &arc, &gap).unwrap();
+        let text = &with.text;
+        assert!(text.contains(".subckt CONTACT ax b\n") && !text.contains(".subckt CONTACT a b"));
+        assert_eq!(text.matches(".ends CONTACT").count(), 1);
+        // The conductance element is untouched, between a and b.
+        assert!(text.contains("B1 a b I = V(a,b) * V(g)"));
+        // V_arc at the last sample: 12 V + 1e4 V/m · 0.2 mm = 14 V; the
+        // breakdown voltage there (Paschen plateau or above) is ≥ 327 V.
+        assert!(text.contains(&format!("{} {}", format_time(3e-3), format_time(14.0))));
+        assert!(text.contains(".model arc_state sw vt=3.992e-1 vh=8e-4"));
+        assert!(text.contains(".options method=gear"));
+        // Not a contact include: an error, not a panic.
+        let mut broken = plain;
+        broken.text = broken.text.replace(".subckt CONTACT a b", "* gone");
+        assert!(matches!(
+            with_arc(broken, &arc, &gap),
+            Err(NetlistError::NotAContactInclude { .. })
+        ));
+    }
 }

@@ -59,6 +59,11 @@ pub enum NetlistError {
     #[error("unknown contact element {name:?}: use one of `pwl`, `event-ramp`, `switch`")]
     UnknownElement { name: String },
     #[error(
+        "the include of subcircuit {subckt} has no `.subckt {subckt} a b` ... `.ends {subckt}` \
+         to add the arc to: give the include `contact_include` made"
+    )]
+    NotAContactInclude { subckt: String },
+    #[error(
         "contact element `{element}` cannot represent this waveform: {reason}; use element `pwl`"
     )]
     ElementUnsupported {
