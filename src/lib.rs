@@ -6,8 +6,12 @@
 //! onto a fixed contact whose surface law (rigid, Kelvin–Voigt or
 //! Hunt–Crossley) decides how it rebounds ([`mechanics`]); the engine
 //! returns the exact chatter sequence ([`chatter`]); later stages turn it
-//! into a contact resistance waveform, an ngspice netlist, a batch run and
-//! an analysis of the probed signals.
+//! into a contact resistance waveform ([`waveform`]), an ngspice netlist
+//! ([`netlist`]), a batch run ([`spice`], [`rawfile`]) and an analysis of
+//! the probed signals ([`analysis`]); [`pipeline`] runs them in order.
+//! A coil-driven relay is coupled to its driver circuit ([`coil`]); on a
+//! power load the contact arcs ([`arc`]); scope captures and datasheets
+//! calibrate the model ([`capture`], [`calibrate`]).
 
 pub mod analysis;
 pub mod arc;
