@@ -244,6 +244,50 @@ fn assert_matches(v: &Value, truth: &[Interval], what: &str) {
     assert!((first - want_makes[0]).abs() <= tol, "{what}");
 }
 
+/// Exports from locales with a decimal comma (semicolon-separated), tab
+/// separated files, and headers with units in parentheses or µs/mV.
+#[test]
+fn separators_decimal_commas_and_header_units() {
+    let truth = truth();
+    let (t, v) = trace(&truth, false);
+    let dir = tempfile::tempdir().unwrap();
+    let rows = |f: &dyn Fn(f64, f64) -> String| {
+        t.iter().zip(&v).map(|(&t, &v)| f(t, v)).collect::<String>()
+    };
+    let files = [
+        (
+            "pico_eu.csv",
+            format!(
+                "Time;Channel A\n(us);(V)\n\n{}",
+                rows(&|t, v| format!("{:.5};{v:.6}\n", t * 1e6).replace('.', ","))
+            ),
+        ),
+        (
+            "tabs.txt",
+            format!("time\tvalue\n{}", rows(&|t, v| format!("{t:e}\t{v:.6}\n"))),
+        ),
+        (
+            "units.csv",
+            format!(
+                "Time(s),CH1(V)\n{}",
+                rows(&|t, v| format!("{t:e},{v:.6}\n"))
+            ),
+        ),
+        (
+            "micro.csv",
+            format!(
+                "t (us), v (mV)\n{}",
+                rows(&|t, v| format!("{:.5}, {:.3}\n", t * 1e6, v * 1e3))
+            ),
+        ),
+    ];
+    for (name, text) in files {
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        assert_matches(&capture_json(&path, &[]), &truth, name);
+    }
+}
+
 #[test]
 fn every_layout_gives_every_edge_and_the_bounce_count() {
     let truth = truth();

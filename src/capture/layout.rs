@@ -93,18 +93,47 @@ struct Row {
 
 /// Splits CSV text into rows (quoted fields, CRLF, BOM; blank lines kept
 /// as empty rows, since PicoScope's blank line is part of its layout).
+/// The separator is a comma, or the semicolon or tab that exports in
+/// locales with a decimal comma use (`-1,5E-03;0,052`), whose numbers are
+/// then read with the comma as the decimal point.
 fn rows(text: &str) -> Vec<Row> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let delimiter = delimiter(text);
     text.lines()
         .enumerate()
-        .map(|(i, line)| Row {
-            line: i + 1,
-            cells: split(line.trim_end_matches('\r')),
+        .map(|(i, line)| {
+            let mut cells = split(line.trim_end_matches('\r'), delimiter);
+            if delimiter != ',' {
+                for cell in &mut cells {
+                    if cell.contains(',') && !cell.contains('.') {
+                        let dotted = cell.replace(',', ".");
+                        if number(&dotted).is_some() {
+                            *cell = dotted;
+                        }
+                    }
+                }
+            }
+            Row { line: i + 1, cells }
         })
         .collect()
 }
 
-fn split(line: &str) -> Vec<String> {
+/// `;` or a tab when the file's last lines (its data) are separated by
+/// one of them on every line, else `,`.
+fn delimiter(text: &str) -> char {
+    let tail: Vec<&str> = text
+        .lines()
+        .rev()
+        .filter(|l| !l.trim().is_empty())
+        .take(20)
+        .collect();
+    [';', '\t']
+        .into_iter()
+        .find(|&d| !tail.is_empty() && tail.iter().all(|l| l.contains(d)))
+        .unwrap_or(',')
+}
+
+fn split(line: &str, delimiter: char) -> Vec<String> {
     let mut cells = Vec::new();
     let mut cell = String::new();
     let mut quoted = false;
@@ -116,7 +145,9 @@ fn split(line: &str) -> Vec<String> {
                 chars.next();
             }
             '"' => quoted = !quoted,
-            ',' if !quoted => cells.push(std::mem::take(&mut cell).trim().to_owned()),
+            c if c == delimiter && !quoted => {
+                cells.push(std::mem::take(&mut cell).trim().to_owned());
+            }
             _ => cell.push(c),
         }
     }
