@@ -485,7 +485,7 @@ pub fn needs_circuit(scenario: &Scenario) -> bool {
     let arc_limits = scenario
         .limits
         .as_ref()
-        .is_some_and(|l| l.max_arc_energy.is_some() || l.max_arc_count.is_some());
+        .is_some_and(LimitsSection::has_arc_limits);
     scenario.probes.iter().any(Probe::has_limits) || arc_limits
 }
 

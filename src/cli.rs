@@ -494,12 +494,7 @@ fn pwl(args: &PwlArgs) -> Result<()> {
     let (waveform, gap) = match &args.measured {
         Some(csv) => {
             let intervals = read_measured(csv)?;
-            let speed = scenario
-                .arc
-                .map_or(chatterspice::arc::DEFAULT_OPENING_SPEED, |a| {
-                    a.model().opening_speed
-                });
-            let gap = GapProfile::from_intervals(&intervals, speed, scenario.mechanics.gap);
+            let gap = pipeline::record_gap(&scenario, &intervals);
             (Waveform::from_intervals(&intervals, &model)?, gap)
         }
         None => {

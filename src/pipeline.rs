@@ -263,11 +263,18 @@ pub fn run_measured(
             source,
         }
     })?;
+    let gap = record_gap(scenario, &chatter.intervals);
+    run_chatter(scenario, chatter, waveform, &model, gap, runner, options)
+}
+
+/// gap(t) of a measured record of states, which has no positions: each
+/// opening moves at `arc.opening_speed` (its default without `[arc]`) up
+/// to `mechanics.gap`.
+pub fn record_gap(scenario: &Scenario, intervals: &[Interval]) -> GapProfile {
     let speed = scenario.arc.map_or(crate::arc::DEFAULT_OPENING_SPEED, |a| {
         a.model().opening_speed
     });
-    let gap = GapProfile::from_intervals(&chatter.intervals, speed, scenario.mechanics.gap);
-    run_chatter(scenario, chatter, waveform, &model, gap, runner, options)
+    GapProfile::from_intervals(intervals, speed, scenario.mechanics.gap)
 }
 
 /// The scenario has what `run` needs besides the relay.
@@ -315,13 +322,13 @@ fn run_chatter(
     let include = netlist::contact_include(&waveform, &circuit.subckt, element)?;
     let arc = arc_setup(scenario, &netlist_text);
     let include = match &arc {
-        Some((arc_model, ..)) => with_arc(include, arc_model, &gap)?,
+        Some(a) => with_arc(include, &a.model, &gap)?,
         None => include,
     };
 
     let mut signals: Vec<&str> = scenario.probes.iter().map(|p| p.signal.as_str()).collect();
-    if let Some((_, vectors, _)) = &arc {
-        signals.extend(vectors.all());
+    if let Some(a) = &arc {
+        signals.extend(a.vectors.all());
     }
     let end = chatter_end(&chatter) + model.edge_time;
     let deck = netlist::prepare_deck_with_params(
@@ -386,22 +393,16 @@ fn run_chatter(
 
     let arcs = arc
         .as_ref()
-        .map(|(arc_model, _, instance)| {
-            crate::arc::analysis::analyze(
-                &simulation.plot,
-                instance,
-                arc_model,
+        .map(|a| {
+            a.report(
+                ("bounced", &simulation.plot),
                 &gap,
                 &chatter,
                 &[],
+                &netlist_path,
             )
         })
-        .transpose()
-        .map_err(|source| RunError::Arc {
-            run: "bounced",
-            netlist: netlist_path.clone(),
-            source,
-        })?;
+        .transpose()?;
 
     let mut warnings: Vec<String> = deck.warnings.iter().map(ToString::to_string).collect();
     warnings.extend(simulation.warnings.iter().cloned());
@@ -512,8 +513,8 @@ fn run_coil(
         .as_deref()
         .and_then(|text| arc_setup(scenario, text));
     let gap = GapProfile::from_path(scenario.mechanics.gap, &coupled.path);
-    if let Some((arc_model, ..)) = &arc {
-        include = with_arc(include, arc_model, &gap)?;
+    if let Some(a) = &arc {
+        include = with_arc(include, &a.model, &gap)?;
     }
     // The deck `.include`s the coil too: `--out` writes it beside the
     // contact include, so that the deck runs again by hand.
@@ -536,22 +537,16 @@ fn run_coil(
         .collect();
     let arcs = arc
         .as_ref()
-        .map(|(arc_model, _, instance)| {
-            crate::arc::analysis::analyze(
-                &coupled.plot,
-                instance,
-                arc_model,
+        .map(|a| {
+            a.report(
+                ("coupled", &coupled.plot),
                 &gap,
                 &coupled.chatter,
                 &coil_offs,
+                &circuit.netlist,
             )
         })
-        .transpose()
-        .map_err(|source| RunError::Arc {
-            run: "coupled",
-            netlist: circuit.netlist.clone(),
-            source,
-        })?;
+        .transpose()?;
     let elapsed: f64 = coupled.iterations.iter().map(|i| i.ngspice_elapsed).sum();
     let netlist_path = circuit.netlist.clone();
     let mut warnings: Vec<String> = coupled
@@ -653,17 +648,47 @@ fn arc_warnings(
     .collect()
 }
 
-/// With `[arc]`: the arc numbers and the vectors of the contact instance
-/// the arcs are read from (the first, when the netlist has several).
+/// With `[arc]`: the arc numbers, and the contact instance the arcs are
+/// read from (the first, when the netlist has several) with the vectors
+/// its deck must save.
+struct ArcSetup {
+    model: ArcModel,
+    vectors: ArcVectors,
+    instance: String,
+}
+
 /// `None` without `[arc]`, or when the netlist has no contact instance
 /// (the deck names that error).
-fn arc_setup(scenario: &Scenario, netlist_text: &str) -> Option<(ArcModel, ArcVectors, String)> {
+fn arc_setup(scenario: &Scenario, netlist_text: &str) -> Option<ArcSetup> {
     let section = scenario.arc.as_ref()?;
     let circuit = scenario.circuit.as_ref()?;
     let instance = netlist::instances_of(netlist_text, &circuit.subckt)
         .into_iter()
         .next()?;
-    Some((section.model(), ArcVectors::of(&instance), instance))
+    Some(ArcSetup {
+        model: section.model(),
+        vectors: ArcVectors::of(&instance),
+        instance,
+    })
+}
+
+impl ArcSetup {
+    /// Every arc and breakdown of run `run` (named in errors) in `plot`.
+    fn report(
+        &self,
+        (run, plot): (&'static str, &Plot),
+        gap: &GapProfile,
+        chatter: &Chatter,
+        coil_offs: &[f64],
+        netlist: &std::path::Path,
+    ) -> Result<ArcReport, RunError> {
+        crate::arc::analysis::analyze(plot, &self.instance, &self.model, gap, chatter, coil_offs)
+            .map_err(|source| RunError::Arc {
+                run,
+                netlist: netlist.to_owned(),
+                source,
+            })
+    }
 }
 
 /// The contact waveform of `chatter` as `scenario`'s `[contact]` section

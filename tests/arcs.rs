@@ -259,9 +259,11 @@ fn cli() -> assert_cmd::Command {
     assert_cmd::Command::cargo_bin("chatterspice").unwrap()
 }
 
-fn run_json(scenario: &Path) -> serde_json::Value {
+/// `run SCENARIO --format json` with `extra` arguments; it must succeed.
+fn run_json_with(scenario: &Path, extra: &[&str]) -> serde_json::Value {
     let out = cli()
         .args(["run", scenario.to_str().unwrap(), "--format", "json"])
+        .args(extra)
         .output()
         .unwrap();
     assert!(
@@ -270,6 +272,18 @@ fn run_json(scenario: &Path) -> serde_json::Value {
         String::from_utf8_lossy(&out.stderr)
     );
     serde_json::from_slice(&out.stdout).unwrap()
+}
+
+fn run_json(scenario: &Path) -> serde_json::Value {
+    run_json_with(scenario, &[])
+}
+
+/// The lamp-arc example's text, its netlist path made absolute so that
+/// the scenario can be written anywhere.
+fn lamp_arc_text() -> String {
+    std::fs::read_to_string(data("examples/scenarios/lamp-arc.toml"))
+        .unwrap()
+        .replace("../../netlists", data("netlists").to_str().unwrap())
 }
 
 /// The coil-driven examples: the solenoid's break arcs and, without a
@@ -362,9 +376,7 @@ fn without_arc_a_power_run_warns_and_a_signal_run_does_not() {
 fn arc_limits_pass_and_fail_in_check() {
     let Some(_) = common::ngspice() else { return };
     let dir = tempfile::tempdir().unwrap();
-    let text = std::fs::read_to_string(data("examples/scenarios/lamp-arc.toml"))
-        .unwrap()
-        .replace("../../netlists", data("netlists").to_str().unwrap());
+    let text = lamp_arc_text();
     for (limits, code) in [
         ("max_arc_energy = 1.0e-3\nmax_arc_count = 7\n", 0),
         ("max_arc_energy = 1.0e-4\n", 1),
@@ -479,23 +491,10 @@ fn every_contact_element_carries_the_arc() {
     let Some(_) = common::ngspice() else { return };
     let mut energies = Vec::new();
     for element in ["pwl", "event-ramp", "switch"] {
-        let out = cli()
-            .args([
-                "run",
-                data("examples/scenarios/lamp-arc.toml").to_str().unwrap(),
-                "--element",
-                element,
-                "--format",
-                "json",
-            ])
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{element}: {}",
-            String::from_utf8_lossy(&out.stderr)
+        let v = run_json_with(
+            &data("examples/scenarios/lamp-arc.toml"),
+            &["--element", element],
         );
-        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         let bounces = v["bounce"]["bounce_count"].as_u64().unwrap();
         assert_eq!(
             v["arc_totals"]["count"].as_u64(),
@@ -516,9 +515,7 @@ fn every_contact_element_carries_the_arc() {
 fn a_sweep_over_v_min_shows_where_the_supply_sustains_the_arc() {
     let Some(_) = common::ngspice() else { return };
     let dir = tempfile::tempdir().unwrap();
-    let text = std::fs::read_to_string(data("examples/scenarios/lamp-arc.toml"))
-        .unwrap()
-        .replace("../../netlists", data("netlists").to_str().unwrap());
+    let text = lamp_arc_text();
     let path = dir.path().join("s.toml");
     std::fs::write(
         &path,

@@ -31,7 +31,7 @@
 //! into account to first order: where the run shows the terminal voltage
 //! following the current (a conducting flyback diode or zener), the slope
 //! dv/di read along the run makes the estimate's driver a source with
-//! that resistance (`driver_slope`); on the diode example this saves one
+//! that resistance (`Driver`); on the diode example this saves one
 //! of five ngspice passes. The path for the next
 //! ngspice run is the fixed point of this cheap map, found by relaxation
 //! among the mechanics runs alone.
@@ -84,15 +84,17 @@ pub fn settle(
     settings: &Settings,
     tolerances: Tolerances,
 ) -> Result<(Cycle, usize), CoilError> {
-    let base = flux_along(coil, run, run.path);
+    let driver = Driver::of(coil, run);
+    let base = flux_under(coil, run, &driver, run.path);
     let mut current = start;
     for inner in 1..=MAX_INNER {
         // The path as ngspice would be given it (thinned like `run.path`):
         // at the fixed point the correction must vanish exactly, or its
         // leftover would bias the next run's events.
-        let phi = flux_along(
+        let phi = flux_under(
             coil,
             run,
+            &driver,
             &super::coupled::thin(&current.path, tolerances.path),
         );
         let estimate: Vec<(f64, f64)> = (0..run.time.len())
@@ -116,6 +118,12 @@ pub fn settle(
 /// trapezoidal rule, which for this linear equation in ψ is solved for
 /// the new value in closed form, from ngspice's own first value.
 pub fn flux_along(coil: &Coil, run: &CircuitRun, path: &[(f64, f64)]) -> Vec<f64> {
+    flux_under(coil, run, &Driver::of(coil, run), path)
+}
+
+/// [`flux_along`] with the run's driver already read (it depends on the
+/// run only, not on the path being tried).
+fn flux_under(coil: &Coil, run: &CircuitRun, driver: &Driver, path: &[(f64, f64)]) -> Vec<f64> {
     let n = run.time.len();
     let mut out = Vec::with_capacity(n);
     let Some(&first) = run.flux.first() else {
@@ -123,57 +131,66 @@ pub fn flux_along(coil: &Coil, run: &CircuitRun, path: &[(f64, f64)]) -> Vec<f64
     };
     let k = coil.permeance_length();
     let a = coil.air_gap + coil.iron_gap;
-    let slope = driver_slope(coil, run);
-    // The run's own current, and the driver's answer to a change of it:
-    // v = v_k + s (i − i_k), so dψ/dt = (v_k − s i_k) − c ψ with
-    // c = (R − s)(a − x)/k.
-    let run_current =
-        |j: usize| run.flux[j] * (a - super::coupled::interpolate(run.path, run.time[j])) / k;
-    let rate = |j: usize| {
-        (coil.resistance - slope[j]) * (a - super::coupled::interpolate(path, run.time[j])) / k
-    };
-    let source = |j: usize| run.volts[j] - slope[j] * run_current(j);
+    // dψ/dt = u − c ψ with c = (R − s)(a − x)/k (see [`Driver`]).
+    let x = super::coupled::Cursor::new(path);
+    let rate = |j: usize| (coil.resistance - driver.slope[j]) * (a - x.at(run.time[j])) / k;
     let mut psi = first;
     let mut c0 = rate(0);
-    let mut u0 = source(0);
     out.push(psi);
     for j in 1..n {
         let h = run.time[j] - run.time[j - 1];
         let c1 = rate(j);
-        let u1 = source(j);
-        let rhs = psi + 0.5 * h * (u0 - c0 * psi + u1);
+        let rhs = psi + 0.5 * h * (driver.source[j - 1] - c0 * psi + driver.source[j]);
         psi = rhs / (1.0 + 0.5 * h * c1);
         out.push(psi);
-        (c0, u0) = (c1, u1);
+        c0 = c1;
     }
     out
 }
 
-/// Ω, dv/di of the driver at each time point of the run, read along the
-/// run itself: where the coil's terminal voltage is a static function of
-/// its current (a conducting flyback diode or zener, a saturated
-/// transistor), the ratio of their changes between neighbouring points is
-/// its slope. A driver only ever lowers the voltage as it gives more
-/// current, so the slope is kept within [−SLOPE_LIMIT·R, 0]; where the
-/// current barely moves (a switching edge) it is taken as 0.
-fn driver_slope(coil: &Coil, run: &CircuitRun) -> Vec<f64> {
-    let n = run.time.len();
-    let k = coil.permeance_length();
-    let a = coil.air_gap + coil.iron_gap;
-    let current: Vec<f64> = (0..n)
-        .map(|j| run.flux[j] * (a - super::coupled::interpolate(run.path, run.time[j])) / k)
-        .collect();
-    let scale = current.iter().fold(0.0f64, |m, i| m.max(i.abs()));
-    (0..n)
-        .map(|j| {
-            let (lo, hi) = (j.saturating_sub(1), (j + 1).min(n.saturating_sub(1)));
-            let di = current[hi] - current[lo];
-            if hi == lo || di.abs() <= 1e-6 * scale {
-                return 0.0;
-            }
-            ((run.volts[hi] - run.volts[lo]) / di).clamp(-SLOPE_LIMIT * coil.resistance, 0.0)
-        })
-        .collect()
+/// The coil's terminal as the run shows it: `v = v_k + s (i − i_k)`, the
+/// run's voltage plus the driver's answer to a change of current, at each
+/// of the run's time points. The coil equation then reads
+/// `dψ/dt = u − (R − s)(a − x)/k · ψ` with `u = v_k − s i_k`.
+struct Driver {
+    /// Ω, dv/di of the driver.
+    slope: Vec<f64>,
+    /// V, `u = v_k − s i_k`.
+    source: Vec<f64>,
+}
+
+impl Driver {
+    /// dv/di is read along the run itself: where the coil's terminal
+    /// voltage is a static function of its current (a conducting flyback
+    /// diode or zener, a saturated transistor), the ratio of their changes
+    /// between neighbouring points is its slope. A driver only ever lowers
+    /// the voltage as it gives more current, so the slope is kept within
+    /// [−SLOPE_LIMIT·R, 0]; where the current barely moves (a switching
+    /// edge) it is taken as 0.
+    fn of(coil: &Coil, run: &CircuitRun) -> Driver {
+        let n = run.time.len();
+        let k = coil.permeance_length();
+        let a = coil.air_gap + coil.iron_gap;
+        let x = super::coupled::Cursor::new(run.path);
+        let current: Vec<f64> = (0..n)
+            .map(|j| run.flux[j] * (a - x.at(run.time[j])) / k)
+            .collect();
+        let scale = current.iter().fold(0.0f64, |m, i| m.max(i.abs()));
+        let slope: Vec<f64> = (0..n)
+            .map(|j| {
+                let (lo, hi) = (j.saturating_sub(1), (j + 1).min(n.saturating_sub(1)));
+                let di = current[hi] - current[lo];
+                if hi == lo || di.abs() <= 1e-6 * scale {
+                    return 0.0;
+                }
+                ((run.volts[hi] - run.volts[lo]) / di).clamp(-SLOPE_LIMIT * coil.resistance, 0.0)
+            })
+            .collect();
+        let source = (0..n)
+            .map(|j| run.volts[j] - slope[j] * current[j])
+            .collect();
+        Driver { slope, source }
+    }
 }
 
 /// The steepest driver slope believed, in coil resistances.
@@ -213,7 +230,7 @@ mod tests {
                 flux: &flux,
                 path: &path,
             };
-            for s in driver_slope(&coil, &run) {
+            for s in Driver::of(&coil, &run).slope {
                 assert!((s - want).abs() < 1e-6, "{s} vs {want}");
             }
         }
@@ -228,7 +245,7 @@ mod tests {
             flux: &held,
             path: &path,
         };
-        assert!(driver_slope(&coil, &run).iter().all(|&s| s == 0.0));
+        assert!(Driver::of(&coil, &run).slope.iter().all(|&s| s == 0.0));
     }
 
     #[test]

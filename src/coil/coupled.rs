@@ -580,15 +580,10 @@ fn series(plot: &Plot, name: &str) -> Option<Vec<(f64, f64)>> {
     Some(time.iter().copied().zip(values.iter().copied()).collect())
 }
 
-/// Linear interpolation in (time, value) samples, held beyond both ends.
-pub(super) fn interpolate(samples: &[(f64, f64)], t: f64) -> f64 {
-    interpolate_at(samples, t, samples.partition_point(|&(s, _)| s <= t))
-}
-
-/// [`interpolate`] for a caller that asks at times close to the last
+/// Linear interpolation in (time, value) samples, held before the first
+/// and after the last, for a caller that asks at times close to the last
 /// (an integrator stepping through the record): it first tries the
-/// interval of the previous call and its neighbour before searching, with
-/// the same result.
+/// interval of the previous call and its neighbour before searching.
 pub(super) struct Cursor<'a> {
     samples: &'a [(f64, f64)],
     hint: std::cell::Cell<usize>,
@@ -602,7 +597,7 @@ impl<'a> Cursor<'a> {
         }
     }
 
-    /// The sample value at `t`, as [`interpolate`] gives it.
+    /// The sample value at `t`.
     pub(super) fn at(&self, t: f64) -> f64 {
         let s = self.samples;
         // k is the first index whose time is past t: unique, so a hint
@@ -641,6 +636,11 @@ fn interpolate_at(samples: &[(f64, f64)], t: f64, k: usize) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Linear interpolation in (time, value) samples, held beyond both ends.
+    fn interpolate(samples: &[(f64, f64)], t: f64) -> f64 {
+        interpolate_at(samples, t, samples.partition_point(|&(s, _)| s <= t))
+    }
 
     #[test]
     fn the_cursor_gives_what_the_search_gives_in_any_order() {

@@ -33,6 +33,13 @@ pub struct LimitsSection {
     pub max_arc_count: Option<u64>,
 }
 
+impl LimitsSection {
+    /// Whether an arc limit is set: those need `[arc]` and the circuit run.
+    pub fn has_arc_limits(&self) -> bool {
+        self.max_arc_energy.is_some() || self.max_arc_count.is_some()
+    }
+}
+
 impl Check<'_> {
     pub(super) fn limits(&self, l: &LimitsSection) -> Result<(), ScenarioError> {
         for (key, value, what) in [

@@ -131,11 +131,7 @@ pub fn run(
                 path: scenario.origin.clone(),
             });
         }
-        Mode::Mechanics
-            if scenario
-                .limits
-                .is_some_and(|l| l.max_arc_energy.is_some() || l.max_arc_count.is_some()) =>
-        {
+        Mode::Mechanics if scenario.limits.is_some_and(|l| l.has_arc_limits()) => {
             return Err(SweepError::ArcLimitsNeedCircuit {
                 path: scenario.origin.clone(),
             });
