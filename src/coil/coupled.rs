@@ -12,7 +12,10 @@
 //! mechanics have been settled against that run's coil voltage with no
 //! ngspice ([`super::accelerate`], unless `accelerate` is off): the same
 //! fixed point in fewer runs. The first iteration holds
-//! the armature at rest. The loop stops when no event time (lift-off
+//! the armature closed, at the fixed contact: it probes the driver's
+//! voltage with the coil's inductance of the long held stretch and of the
+//! release tail, where the driver's voltage depends most on the coil
+//! (a flyback diode conducting). The loop stops when no event time (lift-off
 //! excluded: every impact and release) moves by more than the tolerance
 //! between two iterations, and fails when it has not after the allowed
 //! number of iterations, reporting the last change.
@@ -302,11 +305,13 @@ pub fn run_coupled(
         signals.extend(vectors.all());
     }
 
-    // Iteration 0: the armature at rest, the contact open.
+    // Iteration 0, the probe of the driver: the coil with the armature
+    // held closed (its inductance while the contact is held and through the
+    // release tail, the slow part of the coupling; docs/coupling.md), the
+    // contacts as before any motion: NO open, NC closed.
     let mut chatter = steady_chatter(ContactState::Open, settings.t_end);
-    // The armature starts on its rest stop: the NC contact closed.
     let mut back = steady_chatter(ContactState::Closed, settings.t_end);
-    let mut path = vec![(0.0, m.initial_position)];
+    let mut path = vec![(0.0, m.gap)];
     let mut iterations: Vec<Iteration> = Vec::new();
     for iteration in 1..=options.max_iterations {
         let waveform =
@@ -320,7 +325,14 @@ pub fn run_coupled(
             ContactElement::for_waveform(&waveform),
         )?;
         if let Some(arc) = &arc {
-            contact = with_arc(contact, arc, &GapProfile::from_path(m.gap, &path))?;
+            // The probe's contact is open at its rest gap, whatever the
+            // coil's armature does.
+            let gap = if iteration == 1 {
+                GapProfile::from_path(m.gap, &[(0.0, m.initial_position)])
+            } else {
+                GapProfile::from_path(m.gap, &path)
+            };
+            contact = with_arc(contact, arc, &gap)?;
         }
         if let Some(nc) = &circuit.nc_subckt {
             contact
