@@ -22,7 +22,7 @@ use chatterspice::arc::GapProfile;
 use chatterspice::chatter::Chatter;
 use chatterspice::check;
 use chatterspice::coil::CouplingOptions;
-use chatterspice::mechanics::Dimensionless;
+use chatterspice::mechanics::{Dimensionless, Trajectory};
 use chatterspice::netlist::{self, ContactElement};
 use chatterspice::pipeline::{self, RunOptions};
 use chatterspice::report::{self, Format};
@@ -498,18 +498,21 @@ fn pwl(args: &PwlArgs) -> Result<()> {
             (Waveform::from_intervals(&intervals, &model)?, gap)
         }
         None => {
-            let chatter = simulate(
-                &scenario.mechanics()?,
-                &scenario.surface(),
-                &scenario.settings(),
-            )
-            .with_context(|| {
-                format!(
-                    "{}: the mechanics simulation failed",
-                    scenario.origin.display()
-                )
-            })?;
-            let gap = GapProfile::from_step_force(&scenario.mechanics()?, &chatter);
+            let (mechanics, surface, settings) = (
+                scenario.mechanics()?,
+                scenario.surface(),
+                scenario.settings(),
+            );
+            let trajectory = simulate(&mechanics, &surface, &settings)
+                .and_then(|chatter| Trajectory::of_step(&mechanics, &surface, &settings, chatter))
+                .with_context(|| {
+                    format!(
+                        "{}: the mechanics simulation failed",
+                        scenario.origin.display()
+                    )
+                })?;
+            let gap = GapProfile::from_trajectory(&trajectory);
+            let chatter = trajectory.into_chatter();
             (pipeline::contact_waveform(&scenario, &chatter)?.0, gap)
         }
     };

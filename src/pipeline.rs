@@ -29,7 +29,7 @@ use crate::chatter::{Chatter, ContactState, Interval};
 use crate::coil::coupled::Iteration;
 use crate::coil::coupled::nc_include;
 use crate::coil::{CouplingError, CouplingOptions, Operation, run_coupled};
-use crate::mechanics::{MechanicsError, contact_forces, simulate};
+use crate::mechanics::{MechanicsError, Trajectory, contact_forces, simulate};
 use crate::netlist::{self, ContactElement, ContactInclude, Deck, DeckRequest, NetlistError};
 use crate::rawfile::Plot;
 use crate::scenario::{Probe, Scenario, ScenarioError};
@@ -225,15 +225,16 @@ pub fn run(
         return run_coil(scenario, runner, options);
     }
     let mechanics = scenario.mechanics()?;
-    let chatter =
-        simulate(&mechanics, &scenario.surface(), &scenario.settings()).map_err(|source| {
-            RunError::Mechanics {
-                path: scenario.origin.clone(),
-                source,
-            }
+    let (surface, settings) = (scenario.surface(), scenario.settings());
+    let trajectory = simulate(&mechanics, &surface, &settings)
+        .and_then(|chatter| Trajectory::of_step(&mechanics, &surface, &settings, chatter))
+        .map_err(|source| RunError::Mechanics {
+            path: scenario.origin.clone(),
+            source,
         })?;
+    let gap = GapProfile::from_trajectory(&trajectory);
+    let chatter = trajectory.into_chatter();
     let (waveform, model) = contact_waveform(scenario, &chatter)?;
-    let gap = GapProfile::from_step_force(&mechanics, &chatter);
     run_chatter(scenario, chatter, waveform, &model, gap, runner, options)
 }
 

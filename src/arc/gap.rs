@@ -3,9 +3,8 @@
 //! a coil-driven relay's path), or, for a measured record of states that
 //! carries no positions, from an opening speed.
 
-use crate::chatter::{Chatter, ContactState, Interval};
-use crate::mechanics::Mechanics;
-use crate::mechanics::linear::{LinearPiece, Mode};
+use crate::chatter::{ContactState, Interval};
+use crate::mechanics::Trajectory;
 
 /// Samples per opening: spaced densely at both ends, where the gap and
 /// the breakdown voltage change fastest relative to their size.
@@ -73,44 +72,10 @@ impl GapProfile {
             .fold(self.at(t0).max(self.at(t1)), f64::max)
     }
 
-    /// A step-force closing: every opening follows the free flight of the
-    /// engine (`m ẍ + r ẋ + s x = f − p`) from the state it started in,
-    /// the initial state before the first impact and the release state
-    /// after each bounce.
-    pub fn from_step_force(m: &Mechanics, chatter: &Chatter) -> GapProfile {
-        let flight = Mode::new(m.mass, m.damping, m.stiffness, m.force - m.preload);
-        let at_rest =
-            m.initial_position == 0.0 && m.initial_velocity == 0.0 && m.force <= m.preload;
-        let mut samples = Vec::new();
-        for (k, iv) in chatter.intervals.iter().enumerate() {
-            match iv.state {
-                ContactState::Closed => {
-                    samples.push((iv.start, 0.0));
-                    samples.push((iv.end, 0.0));
-                }
-                ContactState::Open if k == 0 => {
-                    if at_rest {
-                        samples.push((iv.start, m.gap));
-                        samples.push((iv.end, m.gap));
-                    } else {
-                        let piece =
-                            LinearPiece::start(&flight, m.initial_position, m.initial_velocity);
-                        sample_opening(&mut samples, iv, |t| m.gap - piece.state(t - iv.start).0);
-                    }
-                }
-                ContactState::Open => {
-                    let release = chatter
-                        .impacts
-                        .iter()
-                        .filter_map(|i| Some((i.release_time?, i.release_velocity?)))
-                        .min_by(|a, b| (a.0 - iv.start).abs().total_cmp(&(b.0 - iv.start).abs()));
-                    let v0 = release.map_or(0.0, |(_, v)| v);
-                    let piece = LinearPiece::start(&flight, m.gap, v0);
-                    sample_opening(&mut samples, iv, |t| m.gap - piece.state(t - iv.start).0);
-                }
-            }
-        }
-        GapProfile::from_samples(samples)
+    /// The gap along an armature trajectory (a step force's exact
+    /// pieces, or a driven cycle), sampled densely across every opening.
+    pub fn from_trajectory(trajectory: &Trajectory) -> GapProfile {
+        GapProfile::from_samples(trajectory.gap_samples(SAMPLES_PER_OPENING + 1))
     }
 
     /// A coil-driven relay: `path` is (s, m) of the armature, `travel` the
@@ -179,7 +144,8 @@ fn sample_opening(samples: &mut Vec<(f64, f64)>, iv: &Interval, gap: impl Fn(f64
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mechanics::{Settings, Surface, simulate};
+    use crate::mechanics::cycle::Stops;
+    use crate::mechanics::{Drive, Mechanics, Settings, Surface, simulate_drive};
 
     #[test]
     fn a_step_force_opening_follows_the_flight() {
@@ -193,14 +159,15 @@ mod tests {
             initial_velocity: 0.0,
             preload: 0.0,
         };
-        let chatter = simulate(
-            &m,
-            &Surface::Rigid { restitution: 0.6 },
-            &Settings::default(),
-        )
-        .expect("simulates");
+        let stops = Stops {
+            make: Surface::Rigid { restitution: 0.6 },
+            back: None,
+        };
+        let trajectory =
+            simulate_drive(&m, &stops, &Settings::default(), Drive::Step).expect("simulates");
+        let chatter = trajectory.chatter();
         assert!(chatter.bounce_count >= 2);
-        let profile = GapProfile::from_step_force(&m, &chatter);
+        let profile = GapProfile::from_trajectory(&trajectory);
         // Zero at every impact and release, the full gap at t = 0.
         assert_eq!(profile.at(0.0), m.gap);
         for i in &chatter.impacts[..3] {

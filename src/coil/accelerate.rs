@@ -37,9 +37,8 @@
 //! among the mechanics runs alone.
 
 use super::{Coil, CoilError};
-use crate::mechanics::cycle::{Cycle, Stops};
-use crate::mechanics::forced::simulate_cycle;
-use crate::mechanics::{Mechanics, Settings};
+use crate::mechanics::cycle::Stops;
+use crate::mechanics::{Drive, Mechanics, Settings, Trajectory, simulate_drive};
 
 /// One ngspice run of the coil: its time points, the voltage across the
 /// coil and its flux linkage there, and the armature path it followed.
@@ -78,12 +77,12 @@ const INNER_FRACTION: f64 = 0.1;
 pub fn settle(
     coil: &Coil,
     run: &CircuitRun,
-    start: Cycle,
+    start: Trajectory,
     mechanics: &Mechanics,
     stops: &Stops,
     settings: &Settings,
     tolerances: Tolerances,
-) -> Result<(Cycle, usize), CoilError> {
+) -> Result<(Trajectory, usize), CoilError> {
     let driver = Driver::of(coil, run);
     let base = flux_under(coil, run, &driver, run.path);
     let mut current = start;
@@ -95,16 +94,20 @@ pub fn settle(
             coil,
             run,
             &driver,
-            &super::coupled::thin(&current.path, tolerances.path),
+            &super::coupled::thin(&current.path(), tolerances.path),
         );
         let estimate: Vec<(f64, f64)> = (0..run.time.len())
             .map(|j| (run.time[j], run.flux[j] + phi[j] - base[j]))
             .collect();
         let flux_at = super::coupled::Cursor::new(&estimate);
         let pull = |t: f64, _x: f64| coil.force_from_flux(flux_at.at(t));
-        let next = simulate_cycle(mechanics, stops, settings, pull)?;
-        let moved = super::coupled::event_change(&current.make, &next.make)
-            .max(super::coupled::event_change(&current.back, &next.back));
+        let next = simulate_drive(mechanics, stops, settings, Drive::Force(&pull))?;
+        let moved = super::coupled::event_change(current.chatter(), next.chatter()).max(
+            super::coupled::event_change(
+                super::coupled::back_of(&current),
+                super::coupled::back_of(&next),
+            ),
+        );
         current = next;
         if moved <= INNER_FRACTION * tolerances.events {
             return Ok((current, inner));

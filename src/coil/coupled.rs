@@ -37,8 +37,8 @@ use crate::arc::GapProfile;
 use crate::arc::element::{ArcVectors, with_arc};
 use crate::chatter::{Chatter, ContactState, Interval};
 use crate::mechanics::Mechanics;
-use crate::mechanics::cycle::Stops;
-use crate::mechanics::forced::simulate_cycle;
+use crate::mechanics::cycle::{Stops, Stroke};
+use crate::mechanics::{Drive, Trajectory, simulate_drive};
 use crate::netlist::coil::coil_include;
 use crate::netlist::{
     self, ContactElement, Deck, DeckRequest, NetlistError, contact_include, instances_of,
@@ -390,24 +390,27 @@ pub fn run_coupled(
         })?;
         let flux_at = Cursor::new(&flux);
         let pull = |t: f64, _x: f64| coil.force_from_flux(flux_at.at(t));
-        let cycle = simulate_cycle(&mechanics, &stops, &settings, pull).map_err(|source| {
-            CouplingError::Coil {
+        let cycle = simulate_drive(&mechanics, &stops, &settings, Drive::Force(&pull)).map_err(
+            |source| CouplingError::Coil {
                 path: origin.clone(),
                 iteration,
                 source,
-            }
-        })?;
-        let change = event_change(&chatter, &cycle.make).max(event_change(&back, &cycle.back));
+            },
+        )?;
+        let change =
+            event_change(&chatter, cycle.chatter()).max(event_change(&back, back_of(&cycle)));
         iterations.push(Iteration {
-            first_impact: cycle.make.first_impact,
-            bounces: cycle.make.bounce_count,
+            first_impact: cycle.chatter().first_impact,
+            bounces: cycle.chatter().bounce_count,
             change,
             ngspice_elapsed,
         });
         let converged = change <= options.tolerance && iteration > 1;
         let thinning = PATH_TOLERANCE * (coil.air_gap + coil.iron_gap);
-        if converged || !options.accelerate {
-            (chatter, back, path) = (cycle.make, cycle.back, thin(&cycle.path, thinning));
+        let strokes = if converged || !options.accelerate {
+            let strokes;
+            (chatter, back, path, strokes) = records(cycle, thinning);
+            strokes
         } else {
             let Some(Vector::Real(time)) = plot.scale() else {
                 return Err(CouplingError::MissingVector {
@@ -445,9 +448,9 @@ pub fn run_coupled(
                 iteration,
                 source,
             })?;
-            (chatter, back, path) = (next.make, next.back, thin(&next.path, thinning));
+            (chatter, back, path, _) = records(next, thinning);
             continue;
-        }
+        };
         if converged {
             let vector = |name: &str| {
                 plot.real(name).ok_or_else(|| CouplingError::MissingVector {
@@ -463,7 +466,7 @@ pub fn run_coupled(
             };
             let switching = Switching::from_coil(time, vector(&volts)?, vector(&current)?);
             return Ok(Coupled {
-                operations: operations(&cycle.strokes, &switching),
+                operations: operations(&strokes, &switching),
                 switching,
                 chatter,
                 back,
@@ -553,6 +556,26 @@ pub fn nc_include(
             source,
         })?;
     Ok(contact_include(&waveform, subckt, ContactElement::Pwl)?.text)
+}
+
+/// The records a pass hands on: the two contacts' chatter, the armature
+/// path thinned to `thinning` (m) for ngspice, and the strokes.
+fn records(
+    trajectory: Trajectory,
+    thinning: f64,
+) -> (Chatter, Chatter, Vec<(f64, f64)>, Vec<Stroke>) {
+    let path = thin(&trajectory.path(), thinning);
+    let strokes = trajectory.strokes().to_vec();
+    let (make, back) = trajectory.into_contacts();
+    let back = back.expect("a driven cycle records its rest stop");
+    (make, back, path, strokes)
+}
+
+/// The rest stop's record of a driven cycle.
+pub(super) fn back_of(trajectory: &Trajectory) -> &Chatter {
+    trajectory
+        .back()
+        .expect("a driven cycle records its rest stop")
 }
 
 /// A contact in `state` from 0 to `t_end`: before the first iteration,

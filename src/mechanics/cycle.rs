@@ -44,6 +44,7 @@ use super::DriveError;
 use super::driven::{self, Drive, State, first_true, monotone_parts, state_on};
 use super::integrate::{Dopri5, Step, Tolerance};
 use super::surface::surface_force;
+use super::trajectory::Segment;
 use super::{Mechanics, Settings, Surface};
 use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome};
 
@@ -103,6 +104,8 @@ pub struct Cycle {
     pub strokes: Vec<Stroke>,
     /// (s, m): the armature's path, at every accepted step and event.
     pub path: Vec<(f64, f64)>,
+    /// The motion itself, step by step, for [`super::Trajectory`].
+    pub(crate) segments: Vec<Segment>,
 }
 
 /// How the armature meets the two stops.
@@ -143,7 +146,7 @@ pub(crate) fn run<D: Drive>(
             make: Track::new(ContactState::Open),
             back: Track::new(back_state),
             log: Vec::new(),
-            path: vec![(0.0, x0)],
+            segments: Vec::new(),
             reach: x0,
         },
     };
@@ -287,7 +290,8 @@ struct Record {
     back: Track,
     /// Every touch, release and lift-off, in order.
     log: Vec<(f64, Event)>,
-    path: Vec<(f64, f64)>,
+    /// Every accepted step, cut at events, and every held stretch.
+    segments: Vec<Segment>,
     /// m, the largest x reached.
     reach: f64,
 }
@@ -372,6 +376,16 @@ impl<D: Drive> Model<'_, D> {
         }
     }
 
+    /// N, the force on a held armature at (t, y) from what holds it: the
+    /// rest stop against the preload's excess over the drive, or the make
+    /// contact against the drive's excess over the preload and spring.
+    fn held_force(&self, phase: Phase, t: f64, y: &State) -> f64 {
+        match phase {
+            Phase::Held => self.m.preload - self.drive.force(t, 0.0, y[2]),
+            _ => self.net(t, self.g(), y[2]),
+        }
+    }
+
     /// Whether a held phase still holds at (t, y): the preload keeps the
     /// armature on the rest stop, or the drive keeps it pressed on the NO
     /// contact.
@@ -443,7 +457,6 @@ impl<D: Drive> Model<'_, D> {
 impl<D: Drive> Sim<'_, D> {
     /// Run the phases from `phase` at (0, y) to `t_end`.
     fn simulate(&mut self, mut phase: Phase, mut y: State) -> Result<(), DriveError> {
-        let g = self.model.g();
         let mut t = 0.0;
         loop {
             let events = self.rec.make.impacts.len() + self.rec.back.impacts.len();
@@ -454,9 +467,6 @@ impl<D: Drive> Sim<'_, D> {
             }
             let (event, te, mut ye) = self.phase(phase, t, y)?;
             let rec = &mut self.rec;
-            if rec.path.last().is_none_or(|&(tp, _)| te > tp) {
-                rec.path.push((te, g + ye[0]));
-            }
             phase = match event {
                 Event::Horizon => return Ok(()),
                 Event::Lift => {
@@ -584,18 +594,37 @@ impl<D: Drive> Sim<'_, D> {
         if held && !model.holds(phase, t0, &y0) {
             return Ok((ends, t0, y0));
         }
+        // A held stretch is one segment, its contact force sampled at the
+        // steps' ends; a moving phase is one segment per step.
+        let side = match phase {
+            Phase::Make => 1,
+            Phase::Back => -1,
+            _ => 0,
+        };
+        let mut forces = Vec::new();
+        if held {
+            forces.push((t0, model.held_force(phase, t0, &y0)));
+        }
+        let held_until = |rec: &mut Record, forces: Vec<(f64, f64)>, te: f64| {
+            let x = g + level;
+            rec.segments
+                .push(Segment::rest(t0, te, x, phase == Phase::Pressed, forces));
+        };
         let mut solver = model.solver(phase, t0, y0);
         loop {
             let step = solver.step(t_end)?;
             let found = if held {
                 if model.holds(phase, step.t1, &step.y1) {
+                    let f = model.held_force(phase, step.t1, &step.y1);
                     if phase == Phase::Pressed {
-                        rec.make.see_force(model.net(step.t1, g, step.y1[2]));
+                        rec.make.see_force(f);
                     }
+                    forces.push((step.t1, f));
                     None
                 } else {
                     let te = first_true(|t| !model.holds(phase, t, &step.at(t)), step.t0, step.t1);
                     let mut ye = state_on(&step, te);
+                    forces.push((te, model.held_force(phase, te, &ye)));
                     (ye[0], ye[1]) = (level, 0.0);
                     Some((ends, te, ye))
                 }
@@ -603,12 +632,22 @@ impl<D: Drive> Sim<'_, D> {
                 moving_event(model, rec, phase, &step)?
             };
             if let Some(found) = found {
+                let (_, te, ye) = found;
+                if held {
+                    held_until(rec, forces, te);
+                } else {
+                    rec.segments.push(Segment::integrated(step, te, ye, side));
+                }
                 return Ok(found);
             }
             if !held {
-                rec.path.push((step.t1, g + step.y1[0]));
+                rec.segments
+                    .push(Segment::integrated(step, step.t1, step.y1, side));
             }
             if step.t1 >= t_end {
+                if held {
+                    held_until(rec, forces, step.t1);
+                }
                 return Ok((Event::Horizon, step.t1, step.y1));
             }
         }
@@ -648,11 +687,21 @@ impl<D: Drive> Sim<'_, D> {
             accumulation_time: None,
             t_end,
         };
+        let x0 = self.model.m.initial_position;
+        let mut path = Vec::with_capacity(rec.segments.len() + 1);
+        path.push((0.0, x0));
+        for seg in &rec.segments {
+            let (t, x) = seg.end_position(g);
+            if path.last().is_none_or(|&(tp, _)| t > tp) {
+                path.push((t, x));
+            }
+        }
         Cycle {
             make,
             back,
             strokes,
-            path: rec.path,
+            path,
+            segments: rec.segments,
         }
     }
 }

@@ -83,7 +83,44 @@ pub struct HcOutcome {
 }
 
 /// The integrated state (u, v, t): u = √δ (√m), v = δ̇ (m/s), t (s).
-type State = Vector3<f64>;
+pub(crate) type State = Vector3<f64>;
+
+/// The most steps [`HcContact::trace`] keeps of one contact.
+pub(crate) const MAX_TRACE_STEPS: usize = 200_000;
+
+/// One step of a traced contact: the dense output of (u = √δ, v = δ̇,
+/// t since the touch) over the fictitious time `[dense.t0, s1]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct HcStep {
+    pub dense: Dense<3>,
+    pub s1: f64,
+}
+
+impl HcStep {
+    /// s since the touch, at the start and end of the step.
+    pub fn span(&self) -> (f64, f64) {
+        (self.dense.at(self.dense.t0)[2], self.dense.at(self.s1)[2])
+    }
+
+    /// (δ, δ̇) at `t` s since the touch, within [`HcStep::span`]: t grows
+    /// with s (dt/ds = u ≥ 0), so s is found by bisection.
+    pub fn at(&self, t: f64) -> (f64, f64) {
+        let (mut lo, mut hi) = (self.dense.t0, self.s1);
+        for _ in 0..100 {
+            let mid = 0.5 * (lo + hi);
+            if mid <= lo || mid >= hi {
+                break;
+            }
+            if self.dense.at(mid)[2] < t {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let y = self.dense.at(0.5 * (lo + hi));
+        (y[0] * y[0], y[1])
+    }
+}
 
 impl HcContact {
     /// The contact of relay `m` (its drive net of preload) on a
@@ -149,13 +186,13 @@ impl HcContact {
         }
     }
 
-    /// [`HcContact::run`] for one spring law.
-    fn integrate<P: Spring>(
+    /// The solver of one contact in the regularized variables, from the
+    /// touch at speed `v_hit`.
+    fn solver<P: Spring>(
         &self,
         equations: Regularized<P>,
         v_hit: f64,
-        budget: f64,
-    ) -> Result<HcOutcome, MechanicsError> {
+    ) -> Dop853<3, impl Fn(f64, &State) -> State, 2> {
         let rhs = move |_s: f64, y: &State| equations.rate(y);
         // Scales: the depth at which the surface alone would stop the
         // impact (energy balance), the time to get there, and the
@@ -175,8 +212,17 @@ impl HcContact {
         let h0 = H0 * s_scale;
         // t is a quadrature of u (dt/ds = u, read by no equation): only u
         // and v set the step size.
-        let mut solver =
-            Dop853::new(rhs, 0.0, State::new(0.0, v_hit, 0.0), h0, tol).controlling_first::<2>();
+        Dop853::new(rhs, 0.0, State::new(0.0, v_hit, 0.0), h0, tol).controlling_first::<2>()
+    }
+
+    /// [`HcContact::run`] for one spring law.
+    fn integrate<P: Spring>(
+        &self,
+        equations: Regularized<P>,
+        v_hit: f64,
+        budget: f64,
+    ) -> Result<HcOutcome, MechanicsError> {
+        let mut solver = self.solver(equations, v_hit);
         let sticks_possible = self.stiffness * self.gap < self.force;
         // Sticking is tested with a small margin so that rounding can never
         // call a contact stuck that will still release.
@@ -252,6 +298,43 @@ impl HcContact {
                 });
             }
         }
+    }
+
+    /// The motion of the contact that [`HcContact::run`] integrates, step
+    /// by step: the same steps (so the same release), each with its dense
+    /// output, cut at the release. A contact that sticks is followed on
+    /// to `budget` (s), at most [`MAX_TRACE_STEPS`] steps; past the last
+    /// step the armature is taken to stay where that step ended.
+    pub(crate) fn trace(&self, v_hit: f64, budget: f64) -> Result<Vec<HcStep>, MechanicsError> {
+        match self.exponent {
+            1.5 => self.trace_with(Regularized::of(self, Hertz), v_hit, budget),
+            1.0 => self.trace_with(Regularized::of(self, Linear), v_hit, budget),
+            n => self.trace_with(Regularized::of(self, Power(n)), v_hit, budget),
+        }
+    }
+
+    fn trace_with<P: Spring>(
+        &self,
+        equations: Regularized<P>,
+        v_hit: f64,
+        budget: f64,
+    ) -> Result<Vec<HcStep>, MechanicsError> {
+        let mut solver = self.solver(equations, v_hit);
+        let mut steps = Vec::new();
+        while steps.len() < MAX_TRACE_STEPS {
+            let step = solver.step(f64::INFINITY)?;
+            let dense = solver.dense();
+            if step.y1[0] < 0.0 {
+                let (s_rel, _) = release(&step, &dense);
+                steps.push(HcStep { dense, s1: s_rel });
+                break;
+            }
+            steps.push(HcStep { dense, s1: step.t1 });
+            if step.y1[2] >= budget {
+                break;
+            }
+        }
+        Ok(steps)
     }
 
     /// The state at release inside the step the solver just took and, if

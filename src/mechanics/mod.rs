@@ -39,12 +39,14 @@ pub mod integrate;
 pub mod linear;
 pub mod root;
 pub mod surface;
+pub mod trajectory;
 
 pub use engine::{
     ImpactResponse, ResponseEnd, critical_impact_speed, impact_response, simulate, validate,
 };
 pub use force::contact_forces;
 pub use surface::Surface;
+pub use trajectory::{Drive, Event, EventKind, Trajectory, simulate_drive};
 
 use thiserror::Error;
 

@@ -1,0 +1,646 @@
+//! The armature's trajectory under any drive: one entry point and one
+//! result for the step force and for a force that varies in time and
+//! position.
+//!
+//! [`simulate_drive`] runs the engine that fits the drive:
+//!
+//! - [`Drive::Step`], the constant force `mechanics.force` from t = 0: the
+//!   exact event engine ([`super::simulate`]). Between its events the
+//!   motion is rebuilt from the exact event states: closed-form flight and
+//!   Kelvin–Voigt contact pieces, and each Hunt–Crossley contact integrated
+//!   again by the very steps that found its release. The step model has no
+//!   rest stop below the contact (a rebound may carry the armature past
+//!   x = 0), as in the engine; `stops.back` is not used.
+//! - [`Drive::Force`], a force `F(t, x)`: the whole operating cycle with
+//!   event location ([`super::cycle`]): held on the rest stop, flight, the
+//!   make contact, pressed on a rigid one, the back contact on the rest
+//!   stop, for every pulse of the force.
+//!
+//! Either way the result is a [`Trajectory`]: position, velocity, contact
+//! gap and contact forces at any time, the event list, and the contact
+//! records (the chatter of the normally-open contact, and of the rest stop
+//! as the normally-closed one).
+
+use super::cycle::{Cycle, Stops, Stroke};
+use super::driven::{State, state_on};
+use super::forced::simulate_cycle;
+use super::hunt_crossley::{HcContact, HcStep};
+use super::integrate::Step;
+use super::linear::{LinearPiece, Mode};
+use super::surface::surface_force;
+use super::{DriveError, Mechanics, MechanicsError, Settings, Surface};
+use crate::chatter::{Chatter, ContactState, Impact};
+
+/// What pushes the armature toward the fixed contact.
+#[derive(Clone, Copy)]
+pub enum Drive<'a> {
+    /// `mechanics.force` (N), a step at t = 0.
+    Step,
+    /// A force (N, toward closing) at time t (s) and position x (m); it
+    /// replaces `mechanics.force`. It must be finite, and smooth between
+    /// the instants the caller knows of (the integrator samples it).
+    Force(&'a dyn Fn(f64, f64) -> f64),
+}
+
+impl std::fmt::Debug for Drive<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Drive::Step => f.write_str("Step"),
+            Drive::Force(_) => f.write_str("Force(..)"),
+        }
+    }
+}
+
+/// Simulate the armature under `drive` from t = 0 to `settings.t_end`.
+/// Parameters are validated first; an invalid one is an error naming its
+/// scenario key.
+pub fn simulate_drive(
+    mechanics: &Mechanics,
+    stops: &Stops,
+    settings: &Settings,
+    drive: Drive<'_>,
+) -> Result<Trajectory, DriveError> {
+    match drive {
+        Drive::Step => {
+            let chatter = super::simulate(mechanics, &stops.make, settings)?;
+            Ok(Trajectory::of_step(
+                mechanics,
+                &stops.make,
+                settings,
+                chatter,
+            )?)
+        }
+        Drive::Force(force) => {
+            let cycle = simulate_cycle(mechanics, stops, settings, force)?;
+            Ok(Trajectory::of_cycle(mechanics, stops, settings, cycle))
+        }
+    }
+}
+
+/// What happened at an event.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EventKind {
+    /// The armature leaves its rest stop on its way to the contact.
+    LiftOff,
+    /// The moving contact touches the fixed one.
+    Touch,
+    /// It separates from it.
+    Release,
+    /// The contact is closed for good from here (to the next release by
+    /// a weakening drive, if any): the last touch of a closing.
+    Settled,
+    /// The armature lands on its rest stop.
+    Landing,
+    /// It rebounds off the rest stop.
+    Rebound,
+}
+
+/// One event of a trajectory.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Event {
+    /// s
+    pub time: f64,
+    pub kind: EventKind,
+    /// m, the position (the gap for contact events, 0 on the rest stop).
+    pub position: f64,
+    /// m/s, the velocity just before the event for a touch or a landing,
+    /// just after it for a release or a rebound, positive toward the
+    /// contact; 0 for lift-off and settling.
+    pub velocity: f64,
+}
+
+/// Which surface pushes on the armature over a segment.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Side {
+    Open,
+    Make,
+    Back,
+}
+
+/// How the armature moves over a segment.
+#[derive(Debug, Clone, PartialEq)]
+enum Motion {
+    /// At rest at `x` (m): held on the rest stop or pressed on a rigid
+    /// contact, the contact force (N) linear between the samples (s, N).
+    Rest { x: f64, forces: Vec<(f64, f64)> },
+    /// A closed-form piece of the step drive, on its own clock from the
+    /// segment's start.
+    Linear(LinearPiece),
+    /// One integrator step in (u = x − g, v, drive state), exact at its
+    /// end `y1`.
+    Integrated { step: Step<3>, y1: State },
+    /// One step of a Hunt–Crossley contact under the step drive, touched
+    /// at `touch` (s).
+    Contact { step: HcStep, touch: f64 },
+}
+
+/// A stretch of the trajectory between two instants.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Segment {
+    t0: f64,
+    t1: f64,
+    side: Side,
+    motion: Motion,
+}
+
+impl Segment {
+    /// The armature at rest at `x` over [t0, t1], pushed by `force` (N,
+    /// samples (s, N)) of the surface it rests on (`on_contact`: the
+    /// make contact, else the rest stop).
+    pub(crate) fn rest(
+        t0: f64,
+        t1: f64,
+        x: f64,
+        on_contact: bool,
+        forces: Vec<(f64, f64)>,
+    ) -> Self {
+        Segment {
+            t0,
+            t1,
+            side: if on_contact { Side::Make } else { Side::Back },
+            motion: Motion::Rest { x, forces },
+        }
+    }
+
+    /// One integrator step of the cycle, cut at `t1` where the state is
+    /// `y1`; `side` is 0 in flight, 1 on the make contact, −1 on the rest
+    /// stop.
+    pub(crate) fn integrated(step: Step<3>, t1: f64, y1: State, side: i8) -> Self {
+        Segment {
+            t0: step.t0,
+            t1,
+            side: match side {
+                1 => Side::Make,
+                -1 => Side::Back,
+                _ => Side::Open,
+            },
+            motion: Motion::Integrated { step, y1 },
+        }
+    }
+
+    /// (s, m): the end of the segment and the position there, for a
+    /// contact at `g`.
+    pub(crate) fn end_position(&self, g: f64) -> (f64, f64) {
+        let x = match &self.motion {
+            Motion::Rest { x, .. } => *x,
+            Motion::Linear(piece) => piece.state(self.t1 - self.t0).0,
+            Motion::Integrated { y1, .. } => g + y1[0],
+            Motion::Contact { step, touch } => g + step.at(self.t1 - touch).0,
+        };
+        (self.t1, x)
+    }
+}
+
+/// The armature's motion from t = 0 to the horizon.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Trajectory {
+    /// m, the travel to the fixed contact.
+    gap: f64,
+    make_surface: Surface,
+    back_surface: Option<Surface>,
+    /// Tiling [0, t_end] in order.
+    segments: Vec<Segment>,
+    events: Vec<Event>,
+    make: Chatter,
+    back: Option<Chatter>,
+    strokes: Vec<Stroke>,
+    t_end: f64,
+}
+
+impl Trajectory {
+    /// s, the horizon.
+    pub fn t_end(&self) -> f64 {
+        self.t_end
+    }
+
+    /// (m, m/s): position and velocity at `t` (s), held at the ends of
+    /// [0, t_end].
+    pub fn state(&self, t: f64) -> (f64, f64) {
+        let Some(seg) = self.segment(t) else {
+            return (0.0, 0.0);
+        };
+        let t = t.clamp(seg.t0, seg.t1);
+        match &seg.motion {
+            Motion::Rest { x, .. } => (*x, 0.0),
+            Motion::Linear(piece) => piece.state(t - seg.t0),
+            Motion::Integrated { step, y1 } => {
+                let y = if t >= seg.t1 { *y1 } else { state_on(step, t) };
+                (self.gap + y[0], y[1])
+            }
+            Motion::Contact { step, touch } => {
+                let (delta, rate) = step.at(t - touch);
+                (self.gap + delta, rate)
+            }
+        }
+    }
+
+    /// m, the position at `t` (0 on the rest stop, the gap at the
+    /// contact).
+    pub fn position(&self, t: f64) -> f64 {
+        self.state(t).0
+    }
+
+    /// m/s, the velocity at `t`, positive toward the contact.
+    pub fn velocity(&self, t: f64) -> f64 {
+        self.state(t).1
+    }
+
+    /// m, how far apart the contacts are at `t`: 0 while the contact is
+    /// closed (a rebound below the resolution counts as closed), else the
+    /// distance left to travel.
+    pub fn gap(&self, t: f64) -> f64 {
+        if self.closed_at(t) {
+            0.0
+        } else {
+            (self.gap - self.position(t)).max(0.0)
+        }
+    }
+
+    /// N, the force of the fixed contact on the moving one at `t`,
+    /// positive pushing it back; 0 while open. A Kelvin–Voigt surface may
+    /// pull just before a release (its force is not clamped).
+    pub fn contact_force(&self, t: f64) -> f64 {
+        self.force_of(t, Side::Make)
+    }
+
+    /// N, the force of the rest stop on the armature at `t`, positive
+    /// pushing it toward the contact; 0 off the stop.
+    pub fn back_force(&self, t: f64) -> f64 {
+        self.force_of(t, Side::Back)
+    }
+
+    /// Every event in time order.
+    pub fn events(&self) -> &[Event] {
+        &self.events
+    }
+
+    /// The normally-open contact's record.
+    pub fn chatter(&self) -> &Chatter {
+        &self.make
+    }
+
+    /// The rest stop as the normally-closed contact (a driven cycle only).
+    pub fn back(&self) -> Option<&Chatter> {
+        self.back.as_ref()
+    }
+
+    /// The strokes of a driven cycle (none for a step).
+    pub fn strokes(&self) -> &[Stroke] {
+        &self.strokes
+    }
+
+    /// The normally-open contact's record, taken out.
+    pub fn into_chatter(self) -> Chatter {
+        self.make
+    }
+
+    /// Both contacts' records, taken out: the normally-open contact and
+    /// (a driven cycle only) the rest stop.
+    pub fn into_contacts(self) -> (Chatter, Option<Chatter>) {
+        (self.make, self.back)
+    }
+
+    /// (s, m): the position at t = 0 and at the end of every segment (every
+    /// integrator step and event of a driven cycle; every event of a step
+    /// drive), strictly increasing in time.
+    pub fn path(&self) -> Vec<(f64, f64)> {
+        let mut out = Vec::with_capacity(self.segments.len() + 1);
+        out.push((0.0, self.position(0.0)));
+        for seg in &self.segments {
+            let (t1, x) = seg.end_position(self.gap);
+            if out.last().is_none_or(|&(t, _)| t1 > t) {
+                out.push((t1, x));
+            }
+        }
+        out
+    }
+
+    /// (s, m): the gap sampled `per_segment` times across every segment
+    /// (at both ends and in between, denser toward the ends), for a
+    /// profile that is linear between its samples.
+    pub fn gap_samples(&self, per_segment: usize) -> Vec<(f64, f64)> {
+        let n = per_segment.max(2);
+        let mut out: Vec<(f64, f64)> = Vec::with_capacity(self.segments.len() * n);
+        for seg in &self.segments {
+            // Openings in full; a contact's gap is 0 throughout.
+            let count = if seg.side == Side::Open && seg.t1 > seg.t0 {
+                n
+            } else {
+                2
+            };
+            for k in 0..count {
+                // Cosine spacing: dense where openings start and end.
+                let theta = std::f64::consts::PI * k as f64 / (count - 1) as f64;
+                let t = seg.t0 + (seg.t1 - seg.t0) * 0.5 * (1.0 - theta.cos());
+                if out.last().is_none_or(|&(tp, _)| t > tp) {
+                    out.push((t, self.gap(t)));
+                }
+            }
+        }
+        if out.is_empty() {
+            out.push((0.0, self.gap(0.0)));
+        }
+        out
+    }
+
+    fn segment(&self, t: f64) -> Option<&Segment> {
+        let k = self.segments.partition_point(|s| s.t1 < t);
+        self.segments.get(k).or(self.segments.last())
+    }
+
+    fn closed_at(&self, t: f64) -> bool {
+        let iv = &self.make.intervals;
+        let k = iv.partition_point(|i| i.end < t);
+        iv.get(k)
+            .is_some_and(|i| i.state == ContactState::Closed && i.start <= t)
+    }
+
+    fn force_of(&self, t: f64, side: Side) -> f64 {
+        let Some(seg) = self.segment(t) else {
+            return 0.0;
+        };
+        if seg.side != side {
+            return 0.0;
+        }
+        if let Motion::Rest { forces, .. } = &seg.motion {
+            return interpolate(forces, t);
+        }
+        let (x, v) = self.state(t);
+        match side {
+            Side::Make => surface_force(&self.make_surface, x - self.gap, v),
+            Side::Back => self.back_surface.map_or(0.0, |s| surface_force(&s, -x, -v)),
+            Side::Open => 0.0,
+        }
+    }
+
+    /// The trajectory of a driven cycle.
+    pub(crate) fn of_cycle(
+        m: &Mechanics,
+        stops: &Stops,
+        settings: &Settings,
+        cycle: Cycle,
+    ) -> Self {
+        let mut events = contact_events(&cycle.make, m.gap);
+        for b in &cycle.back.impacts {
+            events.push(Event {
+                time: b.impact_time,
+                kind: EventKind::Landing,
+                position: 0.0,
+                velocity: -b.impact_velocity,
+            });
+            if let (Some(t), Some(v)) = (b.release_time, b.release_velocity) {
+                events.push(Event {
+                    time: t,
+                    kind: EventKind::Rebound,
+                    position: 0.0,
+                    velocity: -v,
+                });
+            }
+        }
+        for s in &cycle.strokes {
+            let rebound = events
+                .iter()
+                .any(|e| e.kind == EventKind::Rebound && e.time == s.lift_off);
+            if !rebound {
+                events.push(Event {
+                    time: s.lift_off,
+                    kind: EventKind::LiftOff,
+                    position: 0.0,
+                    velocity: 0.0,
+                });
+            }
+            if let Some(t) = s.last_make {
+                events.push(settled(t, m.gap));
+            }
+        }
+        sort(&mut events);
+        Trajectory {
+            gap: m.gap,
+            make_surface: stops.make,
+            back_surface: stops.back,
+            segments: cycle.segments,
+            events,
+            make: cycle.make,
+            back: Some(cycle.back),
+            strokes: cycle.strokes,
+            t_end: settings.t_end,
+        }
+    }
+}
+
+impl Trajectory {
+    /// The trajectory of a step-force closing whose record the engine has
+    /// made ([`super::simulate`] of the same relay, surface and settings),
+    /// rebuilt from its exact event states.
+    pub fn of_step(
+        m: &Mechanics,
+        surface: &Surface,
+        settings: &Settings,
+        chatter: Chatter,
+    ) -> Result<Trajectory, MechanicsError> {
+        step_trajectory(m, surface, settings, chatter)
+    }
+}
+
+fn step_trajectory(
+    m: &Mechanics,
+    surface: &Surface,
+    settings: &Settings,
+    chatter: Chatter,
+) -> Result<Trajectory, MechanicsError> {
+    let g = m.gap;
+    let t_end = settings.t_end;
+    let f_net = m.force - m.preload;
+    let flight = Mode::new(m.mass, m.damping, m.stiffness, f_net);
+    let at_rest = m.initial_position == 0.0 && m.initial_velocity == 0.0 && f_net <= 0.0;
+    let mut segments = Vec::with_capacity(chatter.intervals.len());
+    let mut events = contact_events(&chatter, g);
+    if at_rest {
+        let held = m.preload - m.force;
+        segments.push(Segment::rest(0.0, t_end, 0.0, false, vec![(0.0, held)]));
+    } else if m.initial_position == 0.0 && m.initial_velocity == 0.0 {
+        events.push(Event {
+            time: 0.0,
+            kind: EventKind::LiftOff,
+            position: 0.0,
+            velocity: 0.0,
+        });
+    }
+    if let (Some(t), true) = (chatter.settle_time, chatter.outcome.is_closed()) {
+        events.push(settled(t, g));
+    }
+    sort(&mut events);
+    let impact_at = |t: f64| chatter.impacts.iter().find(|i| i.impact_time == t);
+    let released_at = |t: f64| {
+        chatter
+            .impacts
+            .iter()
+            .find(|i| i.release_time == Some(t))
+            .and_then(|i| i.release_velocity)
+    };
+    let last = chatter.intervals.len().saturating_sub(1);
+    for (k, iv) in chatter.intervals.iter().enumerate() {
+        if at_rest {
+            break;
+        }
+        let end = if k == last { t_end } else { iv.end };
+        match iv.state {
+            ContactState::Open => {
+                let (x0, v0) = if k == 0 {
+                    (m.initial_position, m.initial_velocity)
+                } else {
+                    (g, released_at(iv.start).unwrap_or(0.0))
+                };
+                segments.push(Segment {
+                    t0: iv.start,
+                    t1: end,
+                    side: Side::Open,
+                    motion: Motion::Linear(LinearPiece::start(&flight, x0, v0)),
+                });
+            }
+            ContactState::Closed if end > iv.start => {
+                let v_hit = impact_at(iv.start).map_or(0.0, |i: &Impact| i.impact_velocity);
+                contact_segments(&mut segments, m, surface, (iv.start, end), v_hit)?;
+            }
+            ContactState::Closed => {}
+        }
+    }
+    Ok(Trajectory {
+        gap: g,
+        make_surface: *surface,
+        back_surface: None,
+        segments,
+        events,
+        make: chatter,
+        back: None,
+        strokes: Vec::new(),
+        t_end,
+    })
+}
+
+/// The segments of one contact of the step drive over `(t_hit, end)`,
+/// touched at `v_hit`.
+fn contact_segments(
+    segments: &mut Vec<Segment>,
+    m: &Mechanics,
+    surface: &Surface,
+    (t_hit, end): (f64, f64),
+    v_hit: f64,
+) -> Result<(), MechanicsError> {
+    let g = m.gap;
+    let f_net = m.force - m.preload;
+    match *surface {
+        Surface::Rigid { .. } => {
+            // Held at the surface by the static overtravel force.
+            let held = f_net - m.stiffness * g;
+            segments.push(Segment::rest(t_hit, end, g, true, vec![(t_hit, held)]));
+        }
+        Surface::KelvinVoigt { stiffness, damping } => {
+            let contact = Mode::new(
+                m.mass,
+                m.damping + damping,
+                m.stiffness + stiffness,
+                f_net + stiffness * g,
+            );
+            segments.push(Segment {
+                t0: t_hit,
+                t1: end,
+                side: Side::Make,
+                motion: Motion::Linear(LinearPiece::start(&contact, g, v_hit)),
+            });
+        }
+        Surface::HuntCrossley {
+            stiffness,
+            exponent,
+            chi,
+        } => {
+            let hc = HcContact::new(m, stiffness, exponent, chi);
+            let mut reached = t_hit;
+            for step in hc.trace(v_hit, end - t_hit)? {
+                let (a, b) = step.span();
+                let (t0, t1) = (t_hit + a, (t_hit + b).min(end));
+                if t1 <= t0 {
+                    continue;
+                }
+                segments.push(Segment {
+                    t0,
+                    t1,
+                    side: Side::Make,
+                    motion: Motion::Contact { step, touch: t_hit },
+                });
+                reached = t1;
+            }
+            if reached < end {
+                // Past the traced steps (a rebound below the resolution,
+                // or the step cap): at rest where the contact was left.
+                let x = segments.last().map_or(g, |s| match &s.motion {
+                    Motion::Contact { step, touch } => g + step.at(reached - touch).0,
+                    _ => g,
+                });
+                let held = (f_net - m.stiffness * x).max(0.0);
+                segments.push(Segment::rest(reached, end, x, true, vec![(reached, held)]));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Touch and release events of a contact record at the gap `g`.
+fn contact_events(chatter: &Chatter, g: f64) -> Vec<Event> {
+    let mut events = Vec::with_capacity(2 * chatter.impacts.len() + 2);
+    for i in &chatter.impacts {
+        events.push(Event {
+            time: i.impact_time,
+            kind: EventKind::Touch,
+            position: g,
+            velocity: i.impact_velocity,
+        });
+        if let (Some(t), Some(v)) = (i.release_time, i.release_velocity) {
+            events.push(Event {
+                time: t,
+                kind: EventKind::Release,
+                position: g,
+                velocity: v,
+            });
+        }
+    }
+    events
+}
+
+fn settled(time: f64, g: f64) -> Event {
+    Event {
+        time,
+        kind: EventKind::Settled,
+        position: g,
+        velocity: 0.0,
+    }
+}
+
+/// In time order; at one instant, in the order things happen (a lift-off
+/// before a touch, a touch before its release or its settling).
+fn sort(events: &mut [Event]) {
+    let rank = |k: EventKind| match k {
+        EventKind::Landing => 0,
+        EventKind::Rebound | EventKind::LiftOff => 1,
+        EventKind::Touch => 2,
+        EventKind::Settled => 3,
+        EventKind::Release => 4,
+    };
+    events.sort_by(|a, b| {
+        a.time
+            .total_cmp(&b.time)
+            .then(rank(a.kind).cmp(&rank(b.kind)))
+    });
+}
+
+/// Linear interpolation in (s, N) samples, held beyond both ends.
+fn interpolate(samples: &[(f64, f64)], t: f64) -> f64 {
+    let k = samples.partition_point(|&(ts, _)| ts <= t);
+    match (k.checked_sub(1).map(|j| samples[j]), samples.get(k)) {
+        (Some((t0, f0)), Some(&(t1, f1))) if t1 > t0 => f0 + (f1 - f0) * (t - t0) / (t1 - t0),
+        (Some((_, f)), _) => f,
+        (None, Some(&(_, f))) => f,
+        (None, None) => 0.0,
+    }
+}
