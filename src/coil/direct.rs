@@ -14,8 +14,9 @@
 //! which is `V = R i + L(x) di/dt + i L'(x) ẋ` written in the flux. The
 //! armature sits on its rest stop until `F_m > p`, flies, and chatters on
 //! the fixed contact by the surface law, as in the step-force engine; the
-//! events and endings are those of `mechanics::driven`, whose sticking test freezes
-//! the coil current at the smaller of its present value and `V/R`.
+//! events and endings are those of one closing of the mechanics' cycle
+//! engine, whose sticking test freezes the coil current at the smaller of
+//! its present value and `V/R`.
 //!
 //! The result adds to the [`Chatter`] the coil current over time, the
 //! named events of a closing (lift-off, first make, the pull-in dip of the
@@ -25,7 +26,9 @@
 
 use super::{Coil, CoilError};
 use crate::chatter::Chatter;
+use crate::mechanics::cycle;
 use crate::mechanics::driven::{self, Drive, Phase, Piece, State};
+use crate::mechanics::trajectory::Segment;
 use crate::mechanics::{self, Mechanics, Settings, Surface};
 
 /// The ideal voltage source the coil is switched onto at t = 0.
@@ -129,26 +132,32 @@ pub struct CoilRun {
     pub energy: EnergyBalance,
     coil: Coil,
     gap: f64,
-    steps: Vec<Piece>,
+    /// The integrator's steps, each a [`Piece`].
+    steps: Vec<Segment>,
+}
+
+/// The integrator's steps of a closing, in time order.
+fn pieces(steps: &[Segment]) -> impl DoubleEndedIterator<Item = Piece<'_>> {
+    steps.iter().filter_map(Segment::piece)
 }
 
 impl CoilRun {
     /// The state at `t` (s), from the integrator's dense output; `None`
     /// outside the run.
     pub fn state_at(&self, t: f64) -> Option<CoilState> {
-        let first = self.steps.first()?;
-        let last = self.steps.last()?;
-        if !(t >= first.t0() && t <= last.t1) {
+        let (t0, _) = self.steps.first()?.span();
+        let (_, t1) = self.steps.last()?.span();
+        if !(t >= t0 && t <= t1) {
             return None;
         }
-        let j = self.steps.partition_point(|p| p.t1 < t);
-        let piece = self.steps.get(j)?;
+        let j = self.steps.partition_point(|s| s.span().1 < t);
+        let piece = self.steps.get(j)?.piece()?;
         Some(self.state(t, &piece.at(t)))
     }
 
     /// The end of the run: s.
     pub fn end_time(&self) -> f64 {
-        self.steps.last().map_or(0.0, |p| p.t1)
+        self.steps.last().map_or(0.0, |s| s.span().1)
     }
 
     fn state(&self, t: f64, y: &State) -> CoilState {
@@ -196,7 +205,7 @@ pub fn simulate_direct(
         });
     }
     let drive = CoilDrive::new(coil, source, m.gap);
-    let run = driven::run(&m, surface, settings, &drive, 0.0)?;
+    let run = cycle::run_closing(&m, surface, settings, &drive, 0.0)?;
     let events = drive.events(&run, &m);
     let energy = drive.energy(&run, &m, surface);
     let current = current_trace(&drive, &run.steps, m.gap);
@@ -259,9 +268,7 @@ impl CoilDrive {
             make_velocity: first.map(|i| i.impact_velocity),
             current_at_make: first_make.map(|t| {
                 // The last piece of the first flight ends at the touch.
-                let piece = run
-                    .steps
-                    .iter()
+                let piece = pieces(&run.steps)
                     .rev()
                     .find(|p| p.phase == Phase::Flight && p.t1 <= t)
                     .expect("a flight reached the first touch");
@@ -278,16 +285,13 @@ impl CoilDrive {
     /// change of di/dt from − to +, inside a step (located by bisection on
     /// its interpolant) or across an event (a rigid impact reverses the
     /// back-EMF at once).
-    fn pull_in_dip(&self, steps: &[Piece], lift_off: f64) -> Option<PullInDip> {
+    fn pull_in_dip(&self, steps: &[Segment], lift_off: f64) -> Option<PullInDip> {
         let at = |t: f64, y: &State| PullInDip {
             time: t,
             current: self.current(y[2], self.gap + y[0]),
         };
         let mut falling = false;
-        for piece in steps
-            .iter()
-            .filter(|p| p.phase != Phase::Held && p.t1 > lift_off)
-        {
+        for piece in pieces(steps).filter(|p| p.phase != Phase::Held && p.t1 > lift_off) {
             let (y0, y1) = (piece.y0(), piece.y1);
             let (d0, d1) = (self.current_rate(&y0), self.current_rate(&y1));
             if falling && d0 >= 0.0 {
@@ -318,7 +322,7 @@ impl CoilDrive {
             (0.906_179_845_938_664, 0.236_926_885_056_189_1),
         ];
         let (mut source, mut resistive, mut work, mut lost) = (0.0, 0.0, 0.0, 0.0);
-        for piece in &run.steps {
+        for piece in pieces(&run.steps) {
             let phase = &piece.phase;
             let (mid, half) = (0.5 * (piece.t0() + piece.t1), 0.5 * (piece.t1 - piece.t0()));
             for &(z, w) in &GL5 {
@@ -372,7 +376,7 @@ impl Drive for CoilDrive {
     fn frozen_work(&self, _t: f64, psi: f64, from: f64, to: f64) -> f64 {
         // At constant current c the pull ½c²L'(x) integrates to
         // ½c²(L(to) − L(from)); the current is frozen at the smaller of
-        // its present and final values (see `mechanics::driven`).
+        // its present and final values (the closing's sticking test).
         let c = self
             .current(psi, to)
             .abs()
@@ -397,16 +401,12 @@ impl Drive for CoilDrive {
 }
 
 /// (s, A) at t = 0 and at the end of every step.
-fn current_trace(drive: &CoilDrive, steps: &[Piece], gap: f64) -> Vec<(f64, f64)> {
+fn current_trace(drive: &CoilDrive, steps: &[Segment], gap: f64) -> Vec<(f64, f64)> {
     let mut out = Vec::with_capacity(steps.len() + 1);
-    if let Some(p) = steps.first() {
+    if let Some(p) = pieces(steps).next() {
         let y = p.y0();
         out.push((p.t0(), drive.current(y[2], gap + y[0])));
     }
-    out.extend(
-        steps
-            .iter()
-            .map(|p| (p.t1, drive.current(p.y1[2], gap + p.y1[0]))),
-    );
+    out.extend(pieces(steps).map(|p| (p.t1, drive.current(p.y1[2], gap + p.y1[0]))));
     out
 }

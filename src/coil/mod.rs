@@ -26,8 +26,8 @@
 //! and the coupling with the circuit; the armature's event rules under a
 //! drive that varies (the closing, the whole cycle, a force `F(t, x)`)
 //! live with the rest of the mechanics in [`crate::mechanics`]
-//! ([`crate::mechanics::driven`], [`crate::mechanics::cycle`],
-//! [`crate::mechanics::forced`]).
+//! (one engine, [`crate::mechanics::cycle`], with its entry points in
+//! [`crate::mechanics::forced`] and [`crate::mechanics::simulate_drive`]).
 //!
 //! - [`direct`]: a coil switched onto an ideal voltage source, solved as
 //!   one ODE in (ψ, x, ẋ) with no circuit simulator: the independent

@@ -4,14 +4,17 @@
 //! the armature on its rest stop (the normally-closed contact), and so on
 //! for as many pulses as the drive gives (docs/model.md §7).
 //!
-//! The closing engine ([`super::driven`]) simulates one closing and ends when the contact has
-//! stuck, on the understanding that the drive does not weaken afterwards.
-//! Here nothing ends before `t_end`: a stuck contact stays in its contact
-//! phase and releases by the same rule that ends every contact (the
-//! moving contact back at the surface, moving out), so the break of the
-//! normally-open (NO) contact is found where the pull no longer holds it.
+//! This is the one engine for every drive that varies in time or
+//! position. Run as a cycle (`run`) nothing ends before `t_end`: a
+//! stuck contact stays in its contact phase and releases by the same rule
+//! that ends every contact (the moving contact back at the surface, moving
+//! out), so the break of the normally-open (NO) contact is found where the
+//! pull no longer holds it. Run as one closing (`run_closing`) it stops
+//! where the closing's ending is decided, on the understanding that the
+//! drive does not weaken afterwards (`closing`: the sticking test and the
+//! endings at the horizon).
 //!
-//! The state is the one of [`super::driven`], `(u = x − g, v, e)`, and so are the
+//! The state is `(u = x − g, v, e)` of [`super::driven`], and so are the
 //! numerics: Dormand–Prince 5(4) with dense output, each step split at its
 //! velocity zero, every crossing bracketed on a monotonic part and
 //! polished by bisection on the interpolant. The phases:
@@ -38,14 +41,20 @@
 //!
 //! Contact forces (peak and minimum per contact) are taken at the events,
 //! at the ends of the steps and at the zeros of the force's rate inside
-//! them, bisected on the interpolant, as the closing engine does.
+//! them, bisected on the interpolant.
+//!
+//! Every accepted step is kept, cut at its event, as a segment of the
+//! armature's [`super::Trajectory`]; a closing hands the same steps on as
+//! its record (`Run`).
 
 use super::DriveError;
-use super::driven::{self, Drive, State, first_true, monotone_parts, state_on};
+use super::driven::{self, Drive, Run, State, first_true, monotone_parts, state_on};
 use super::integrate::{Dopri5, Step, Tolerance};
 use super::surface::surface_force;
 use super::trajectory::Segment;
 use super::{Mechanics, Settings, Surface};
+
+mod closing;
 use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome};
 
 /// One stroke of the armature: from leaving the rest stop (lift-off) to
@@ -126,6 +135,36 @@ pub(crate) fn run<D: Drive>(
     drive: &D,
     e0: f64,
 ) -> Result<Cycle, DriveError> {
+    Ok(simulated(m, stops, settings, drive, e0, false)?.finish())
+}
+
+/// One closing under `drive` onto `surface`, from the drive's state
+/// `e0`: the same engine, stopped where the closing's ending is decided
+/// ([`closing`]). Parameters must have been validated.
+pub(crate) fn run_closing<D: Drive>(
+    m: &Mechanics,
+    surface: &Surface,
+    settings: &Settings,
+    drive: &D,
+    e0: f64,
+) -> Result<Run, DriveError> {
+    let stops = Stops {
+        make: *surface,
+        back: None,
+    };
+    Ok(closing::finish(simulated(
+        m, &stops, settings, drive, e0, true,
+    )?))
+}
+
+fn simulated<'a, D: Drive>(
+    m: &Mechanics,
+    stops: &Stops,
+    settings: &Settings,
+    drive: &'a D,
+    e0: f64,
+    closing: bool,
+) -> Result<Sim<'a, D>, DriveError> {
     let tol = driven::start(m, drive, e0)?;
     let x0 = m.initial_position;
     let held = x0 == 0.0 && m.initial_velocity <= 0.0;
@@ -141,6 +180,7 @@ pub(crate) fn run<D: Drive>(
             settings: *settings,
             drive,
             tol,
+            closing,
         },
         rec: Record {
             make: Track::new(ContactState::Open),
@@ -148,11 +188,13 @@ pub(crate) fn run<D: Drive>(
             log: Vec::new(),
             segments: Vec::new(),
             reach: x0,
+            jump_loss: 0.0,
+            ending: None,
         },
     };
     let y0 = State::new(x0 - m.gap, if held { 0.0 } else { m.initial_velocity }, e0);
     sim.simulate(if held { Phase::Held } else { Phase::Flight }, y0)?;
-    Ok(sim.finish())
+    Ok(sim)
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -174,6 +216,8 @@ enum Event {
     ReleaseBack,
     Break,
     Horizon,
+    /// A closing's contact has stuck for good ([`closing`] only).
+    Stuck,
 }
 
 /// One contact's record: its intervals and impacts.
@@ -282,6 +326,8 @@ struct Model<'a, D> {
     settings: Settings,
     drive: &'a D,
     tol: Tolerance<3>,
+    /// Stop where one closing's ending is decided ([`closing`]).
+    closing: bool,
 }
 
 /// What the run has produced so far.
@@ -294,6 +340,10 @@ struct Record {
     segments: Vec<Segment>,
     /// m, the largest x reached.
     reach: f64,
+    /// J, kinetic energy taken by rigid impacts and inelastic landings.
+    jump_loss: f64,
+    /// How a closing ended, once it has ([`closing`] only).
+    ending: Option<closing::Ending>,
 }
 
 impl Record {
@@ -443,12 +493,15 @@ impl<D: Drive> Model<'_, D> {
 
     /// Whether the opening since `track`'s last release, touched again at
     /// `t`, is below resolution.
-    fn unresolved(&self, track: &Track, t: f64) -> bool {
+    /// `t` and the state `y` there give the scale of the motion: the gap,
+    /// or the drive's equilibrium if that lies farther.
+    fn unresolved(&self, track: &Track, t: f64, y: &State) -> bool {
         let Some((released, farthest)) = track.released else {
             return false;
         };
         let s = &self.settings;
-        let min_gap = s.min_gap.max(1e3 * f64::EPSILON * self.g());
+        let x_eq = (self.drive.force(t, self.g() + y[0], y[2]) - self.m.preload) / self.m.stiffness;
+        let min_gap = s.min_gap.max(1e3 * f64::EPSILON * x_eq.abs().max(self.g()));
         let min_open = s.min_open_time.max(1e3 * f64::EPSILON * t);
         t - released < min_open || farthest < min_gap
     }
@@ -466,9 +519,13 @@ impl<D: Drive> Sim<'_, D> {
                 );
             }
             let (event, te, mut ye) = self.phase(phase, t, y)?;
+            if self.model.closing && event == Event::Horizon {
+                let ending = closing::at_horizon(&self.model, &mut self.rec, phase, te, ye);
+                self.rec.ending = Some(ending);
+            }
             let rec = &mut self.rec;
             phase = match event {
-                Event::Horizon => return Ok(()),
+                Event::Horizon | Event::Stuck => return Ok(()),
                 Event::Lift => {
                     rec.log.push((te, Event::Lift));
                     rec.back.change(te, ContactState::Open);
@@ -488,6 +545,9 @@ impl<D: Drive> Sim<'_, D> {
                 Event::TouchMake => self.touch_make(te, &mut ye),
                 Event::TouchBack => self.touch_back(te, &mut ye),
             };
+            if self.rec.ending.is_some() {
+                return Ok(());
+            }
             (t, y) = (te, ye);
         }
     }
@@ -497,10 +557,18 @@ impl<D: Drive> Sim<'_, D> {
     fn touch_make(&mut self, t: f64, y: &mut State) -> Phase {
         let (model, rec) = (&self.model, &mut self.rec);
         let speed = y[1];
-        if model.unresolved(&rec.make, t) {
+        let mass = model.m.mass;
+        if model.unresolved(&rec.make, t, y) {
+            if model.closing {
+                rec.ending = Some(closing::resolved(model, rec, t, *y));
+                return Phase::Flight;
+            }
             rec.make.unresolve();
             return match model.stops.make {
-                Surface::Rigid { .. } => self.press(t, y),
+                Surface::Rigid { .. } => {
+                    rec.jump_loss += 0.5 * mass * speed * speed;
+                    self.press(t, y)
+                }
                 _ => Phase::Make,
             };
         }
@@ -509,8 +577,15 @@ impl<D: Drive> Sim<'_, D> {
         match model.stops.make {
             Surface::Rigid { restitution } => {
                 let out = restitution * speed;
+                rec.jump_loss += 0.5 * mass * (speed * speed - out * out);
                 if out == 0.0 {
-                    return self.press(t, y);
+                    let phase = self.press(t, y);
+                    if self.model.closing && phase == Phase::Pressed {
+                        // Held against the surface by the static
+                        // overtravel force: stuck for good.
+                        self.rec.ending = Some(closing::Ending::Stuck { end: (t, *y) });
+                    }
+                    return phase;
                 }
                 y[1] = -out;
                 rec.log.push((t, Event::ReleaseMake));
@@ -542,33 +617,44 @@ impl<D: Drive> Sim<'_, D> {
     fn touch_back(&mut self, t: f64, y: &mut State) -> Phase {
         let (model, rec) = (&self.model, &mut self.rec);
         let speed = -y[1];
+        let mass = model.m.mass;
+        if model.closing {
+            // A closing's landing: the opening after the last contact
+            // reached the whole gap.
+            if let Some(last) = rec.make.impacts.last_mut() {
+                last.max_gap_after.get_or_insert(model.g());
+            }
+        }
         let deformable = matches!(
             model.stops.back,
             Some(Surface::KelvinVoigt { .. } | Surface::HuntCrossley { .. })
         );
-        if model.unresolved(&rec.back, t) {
+        if model.unresolved(&rec.back, t, y) {
             rec.back.unresolve();
-            return if deformable { Phase::Back } else { rest(y) };
+            if deformable {
+                return Phase::Back;
+            }
+            rec.jump_loss += 0.5 * mass * speed * speed;
+            return rest(y);
         }
         rec.log.push((t, Event::TouchBack));
         rec.back.touch(t, speed);
-        match model.stops.back {
-            None => rest(y),
-            Some(Surface::Rigid { restitution }) => {
-                let out = restitution * speed;
-                if out == 0.0 {
-                    return rest(y);
-                }
-                y[1] = out;
-                rec.log.push((t, Event::ReleaseBack));
-                rec.back.release(t, out);
-                Phase::Flight
-            }
+        let out = match model.stops.back {
+            None => 0.0,
+            Some(Surface::Rigid { restitution }) => restitution * speed,
             Some(_) => {
                 rec.back.see_force(model.back_force(y));
-                Phase::Back
+                return Phase::Back;
             }
+        };
+        rec.jump_loss += 0.5 * mass * (speed * speed - out * out);
+        if out == 0.0 {
+            return rest(y);
         }
+        y[1] = out;
+        rec.log.push((t, Event::ReleaseBack));
+        rec.back.release(t, out);
+        Phase::Flight
     }
 
     /// Integrate `phase` from (t0, y0) to its event: (event, time, state
@@ -594,60 +680,55 @@ impl<D: Drive> Sim<'_, D> {
         if held && !model.holds(phase, t0, &y0) {
             return Ok((ends, t0, y0));
         }
-        // A held stretch is one segment, its contact force sampled at the
-        // steps' ends; a moving phase is one segment per step.
+        // One segment per accepted step, cut at the event; a held one
+        // carries the force of what holds it at both ends.
         let side = match phase {
             Phase::Make => 1,
             Phase::Back => -1,
             _ => 0,
         };
-        let mut forces = Vec::new();
-        if held {
-            forces.push((t0, model.held_force(phase, t0, &y0)));
-        }
-        let held_until = |rec: &mut Record, forces: Vec<(f64, f64)>, te: f64| {
-            let x = g + level;
-            rec.segments
-                .push(Segment::rest(t0, te, x, phase == Phase::Pressed, forces));
+        let mut held_by = if held {
+            model.held_force(phase, t0, &y0)
+        } else {
+            0.0
         };
         let mut solver = model.solver(phase, t0, y0);
         loop {
             let step = solver.step(t_end)?;
             let found = if held {
                 if model.holds(phase, step.t1, &step.y1) {
-                    let f = model.held_force(phase, step.t1, &step.y1);
-                    if phase == Phase::Pressed {
-                        rec.make.see_force(f);
-                    }
-                    forces.push((step.t1, f));
                     None
                 } else {
                     let te = first_true(|t| !model.holds(phase, t, &step.at(t)), step.t0, step.t1);
                     let mut ye = state_on(&step, te);
-                    forces.push((te, model.held_force(phase, te, &ye)));
                     (ye[0], ye[1]) = (level, 0.0);
                     Some((ends, te, ye))
                 }
             } else {
-                moving_event(model, rec, phase, &step)?
-            };
-            if let Some(found) = found {
-                let (_, te, ye) = found;
-                if held {
-                    held_until(rec, forces, te);
-                } else {
-                    rec.segments.push(Segment::integrated(step, te, ye, side));
+                match moving_event(model, rec, phase, &step)? {
+                    None if phase == Phase::Make && model.closing => {
+                        closing::stuck_after(model, rec, &step)
+                    }
+                    found => found,
                 }
+            };
+            let (te, ye) = found.map_or((step.t1, step.y1), |(_, te, ye)| (te, ye));
+            if held {
+                let f = model.held_force(phase, te, &ye);
+                if phase == Phase::Pressed && found.is_none() {
+                    rec.make.see_force(f);
+                }
+                let pressed = phase == Phase::Pressed;
+                let segment = Segment::held(step, te, ye, g + level, pressed, (held_by, f));
+                rec.segments.push(segment);
+                held_by = f;
+            } else {
+                rec.segments.push(Segment::integrated(step, te, ye, side));
+            }
+            if let Some(found) = found {
                 return Ok(found);
             }
-            if !held {
-                rec.segments
-                    .push(Segment::integrated(step, step.t1, step.y1, side));
-            }
             if step.t1 >= t_end {
-                if held {
-                    held_until(rec, forces, step.t1);
-                }
                 return Ok((Event::Horizon, step.t1, step.y1));
             }
         }

@@ -4,13 +4,14 @@
 //! ngspice: the circuit gives the coil current `i(t)`, the coil turns it
 //! into `F_m(i(t), x)` ([`crate::coil::Coil::force`]), and this integrates the
 //! armature under it, with the same events, surface laws and endings as
-//! the step-force engine (see [`super::driven`] for the numerics and the sticking
-//! argument). With a constant force it reproduces
-//! [`crate::mechanics::simulate`].
+//! the step-force engine, by the one integrated engine ([`super::cycle`]:
+//! the whole cycle, or one closing stopped at its ending). With a
+//! constant force it reproduces [`crate::mechanics::simulate`].
 
 use super::DriveError;
 use super::cycle::{self, Cycle, Stops};
-use super::driven::{self, Drive};
+use super::driven::Drive;
+use super::trajectory::Segment;
 use super::{self as mechanics, Mechanics, Settings, Surface};
 use crate::chatter::Chatter;
 
@@ -46,15 +47,16 @@ pub fn simulate_forced_path(
 ) -> Result<(Chatter, Vec<(f64, f64)>), DriveError> {
     validate(mechanics, &[surface], settings)?;
     let drive = Forced::new(mechanics, force);
-    let run = driven::run(mechanics, surface, settings, &drive, 0.0)?;
+    let run = cycle::run_closing(mechanics, surface, settings, &drive, 0.0)?;
     let gap = mechanics.gap;
     let mut path: Vec<(f64, f64)> = Vec::with_capacity(run.steps.len() + 1);
-    if let Some(first) = run.steps.first() {
+    if let Some(first) = run.steps.first().and_then(Segment::piece) {
         path.push((first.t0(), gap + first.y0()[0]));
     }
-    for piece in &run.steps {
-        if path.last().is_none_or(|&(t, _)| piece.t1 > t) {
-            path.push((piece.t1, gap + piece.y1[0]));
+    for segment in &run.steps {
+        let (t, x) = segment.end_position(gap);
+        if path.last().is_none_or(|&(tp, _)| t > tp) {
+            path.push((t, x));
         }
     }
     Ok((run.chatter, path))

@@ -19,10 +19,17 @@
 //!   and release ([`hunt_crossley`]).
 //!
 //! Under a drive that varies in time and position (a coil), the same
-//! events, surface laws and endings are integrated with event location:
-//! [`driven`] (one closing), [`cycle`] (the whole operating cycle: make,
-//! hold, release, the rest stop), [`forced`] (their entry points for a
-//! force `F(t, x)`).
+//! events, surface laws and endings are integrated with event location
+//! by one engine, [`cycle`]: the whole operating cycle (make, hold,
+//! release, the rest stop), or one closing stopped where its ending is
+//! decided. [`driven`] holds what it shares with its users (the drive, the
+//! state, the event-location numerics) and [`forced`] its entry points for
+//! a force `F(t, x)`.
+//!
+//! [`simulate_drive`] is the one entry point for any drive: the step
+//! force through the exact engine, a force `F(t, x)` through the cycle;
+//! either way the result is one [`Trajectory`], with position, velocity,
+//! gap and contact forces at any time and the event list.
 //!
 //! Sign conventions: `x` is the displacement toward the fixed contact
 //! (m), velocities are positive toward it, and contact forces are the

@@ -22,7 +22,7 @@
 //! as the normally-closed one).
 
 use super::cycle::{Cycle, Stops, Stroke};
-use super::driven::{State, state_on};
+use super::driven::{Phase, Piece, State, state_on};
 use super::forced::simulate_cycle;
 use super::hunt_crossley::{HcContact, HcStep};
 use super::integrate::Step;
@@ -121,9 +121,20 @@ enum Side {
 /// How the armature moves over a segment.
 #[derive(Debug, Clone, PartialEq)]
 enum Motion {
-    /// At rest at `x` (m): held on the rest stop or pressed on a rigid
-    /// contact, the contact force (N) linear between the samples (s, N).
-    Rest { x: f64, forces: Vec<(f64, f64)> },
+    /// At rest at `x` (m) under a constant contact force (N): the step
+    /// drive's armature held on the rest stop or pressed on a rigid
+    /// contact.
+    Rest { x: f64, force: f64 },
+    /// Held at `x` (m) by the rest stop or a rigid contact over one
+    /// integrator step of the drive's own state, exact at its end `y1`;
+    /// the contact force (N) linear from `forces.0` at the start to
+    /// `forces.1` at the end.
+    Held {
+        x: f64,
+        step: Step<3>,
+        y1: State,
+        forces: (f64, f64),
+    },
     /// A closed-form piece of the step drive, on its own clock from the
     /// segment's start.
     Linear(LinearPiece),
@@ -145,21 +156,40 @@ pub(crate) struct Segment {
 }
 
 impl Segment {
-    /// The armature at rest at `x` over [t0, t1], pushed by `force` (N,
-    /// samples (s, N)) of the surface it rests on (`on_contact`: the
-    /// make contact, else the rest stop).
-    pub(crate) fn rest(
-        t0: f64,
-        t1: f64,
-        x: f64,
-        on_contact: bool,
-        forces: Vec<(f64, f64)>,
-    ) -> Self {
+    /// The armature at rest at `x` over [t0, t1], pushed by `force` (N)
+    /// of the surface it rests on (`on_contact`: the make contact, else
+    /// the rest stop).
+    fn rest(t0: f64, t1: f64, x: f64, on_contact: bool, force: f64) -> Self {
         Segment {
             t0,
             t1,
             side: if on_contact { Side::Make } else { Side::Back },
-            motion: Motion::Rest { x, forces },
+            motion: Motion::Rest { x, force },
+        }
+    }
+
+    /// One integrator step of a held armature at `x`, cut at `t1` where
+    /// the drive's state is `y1`, pushed by the surface it rests on
+    /// (`on_contact`: the make contact, else the rest stop) with `forces`
+    /// (N) at the step's start and at `t1`.
+    pub(crate) fn held(
+        step: Step<3>,
+        t1: f64,
+        y1: State,
+        x: f64,
+        on_contact: bool,
+        forces: (f64, f64),
+    ) -> Self {
+        Segment {
+            t0: step.t0,
+            t1,
+            side: if on_contact { Side::Make } else { Side::Back },
+            motion: Motion::Held {
+                x,
+                step,
+                y1,
+                forces,
+            },
         }
     }
 
@@ -179,11 +209,33 @@ impl Segment {
         }
     }
 
+    /// The integrator step under this segment as a closing records it;
+    /// `None` for a closed-form piece.
+    pub(crate) fn piece(&self) -> Option<Piece<'_>> {
+        let (phase, step, y1) = match &self.motion {
+            Motion::Held { step, y1, .. } => (Phase::Held, step, y1),
+            Motion::Integrated { step, y1 } if self.side == Side::Open => (Phase::Flight, step, y1),
+            Motion::Integrated { step, y1 } => (Phase::Contact, step, y1),
+            _ => return None,
+        };
+        Some(Piece {
+            phase,
+            step,
+            t1: self.t1,
+            y1: *y1,
+        })
+    }
+
+    /// s, where the segment starts and ends.
+    pub(crate) fn span(&self) -> (f64, f64) {
+        (self.t0, self.t1)
+    }
+
     /// (s, m): the end of the segment and the position there, for a
     /// contact at `g`.
     pub(crate) fn end_position(&self, g: f64) -> (f64, f64) {
         let x = match &self.motion {
-            Motion::Rest { x, .. } => *x,
+            Motion::Rest { x, .. } | Motion::Held { x, .. } => *x,
             Motion::Linear(piece) => piece.state(self.t1 - self.t0).0,
             Motion::Integrated { y1, .. } => g + y1[0],
             Motion::Contact { step, touch } => g + step.at(self.t1 - touch).0,
@@ -222,7 +274,7 @@ impl Trajectory {
         };
         let t = t.clamp(seg.t0, seg.t1);
         match &seg.motion {
-            Motion::Rest { x, .. } => (*x, 0.0),
+            Motion::Rest { x, .. } | Motion::Held { x, .. } => (*x, 0.0),
             Motion::Linear(piece) => piece.state(t - seg.t0),
             Motion::Integrated { step, y1 } => {
                 let y = if t >= seg.t1 { *y1 } else { state_on(step, t) };
@@ -363,8 +415,14 @@ impl Trajectory {
         if seg.side != side {
             return 0.0;
         }
-        if let Motion::Rest { forces, .. } = &seg.motion {
-            return interpolate(forces, t);
+        match &seg.motion {
+            Motion::Rest { force, .. } => return *force,
+            Motion::Held { forces, .. } if seg.t1 > seg.t0 => {
+                let w = ((t - seg.t0) / (seg.t1 - seg.t0)).clamp(0.0, 1.0);
+                return forces.0 + (forces.1 - forces.0) * w;
+            }
+            Motion::Held { forces, .. } => return forces.1,
+            _ => {}
         }
         let (x, v) = self.state(t);
         match side {
@@ -458,7 +516,7 @@ fn step_trajectory(
     let mut events = contact_events(&chatter, g);
     if at_rest {
         let held = m.preload - m.force;
-        segments.push(Segment::rest(0.0, t_end, 0.0, false, vec![(0.0, held)]));
+        segments.push(Segment::rest(0.0, t_end, 0.0, false, held));
     } else if m.initial_position == 0.0 && m.initial_velocity == 0.0 {
         events.push(Event {
             time: 0.0,
@@ -534,7 +592,7 @@ fn contact_segments(
         Surface::Rigid { .. } => {
             // Held at the surface by the static overtravel force.
             let held = f_net - m.stiffness * g;
-            segments.push(Segment::rest(t_hit, end, g, true, vec![(t_hit, held)]));
+            segments.push(Segment::rest(t_hit, end, g, true, held));
         }
         Surface::KelvinVoigt { stiffness, damping } => {
             let contact = Mode::new(
@@ -579,7 +637,7 @@ fn contact_segments(
                     _ => g,
                 });
                 let held = (f_net - m.stiffness * x).max(0.0);
-                segments.push(Segment::rest(reached, end, x, true, vec![(reached, held)]));
+                segments.push(Segment::rest(reached, end, x, true, held));
             }
         }
     }
@@ -632,15 +690,4 @@ fn sort(events: &mut [Event]) {
             .total_cmp(&b.time)
             .then(rank(a.kind).cmp(&rank(b.kind)))
     });
-}
-
-/// Linear interpolation in (s, N) samples, held beyond both ends.
-fn interpolate(samples: &[(f64, f64)], t: f64) -> f64 {
-    let k = samples.partition_point(|&(ts, _)| ts <= t);
-    match (k.checked_sub(1).map(|j| samples[j]), samples.get(k)) {
-        (Some((t0, f0)), Some(&(t1, f1))) if t1 > t0 => f0 + (f1 - f0) * (t - t0) / (t1 - t0),
-        (Some((_, f)), _) => f,
-        (None, Some(&(_, f))) => f,
-        (None, None) => 0.0,
-    }
 }
