@@ -2,11 +2,17 @@
 //!
 //! `cargo bench --bench mechanics`. Targets: the docs/model.md
 //! reference sequence (Kelvin–Voigt, 18 contacts) ≤ 5 µs median; a
-//! Hunt–Crossley sequence ≤ 50 µs.
+//! Hunt–Crossley sequence ≤ 50 µs. Also measured: the same reference as a
+//! whole trajectory (`simulate_drive` with the step drive: the sequence
+//! and the motion rebuilt between its events), and one closing and the
+//! whole cycle of the integrated engine under a drive that varies.
 
 use std::hint::black_box;
 
+use chatterspice::coil::simulate_forced;
+use chatterspice::mechanics::cycle::Stops;
 use chatterspice::mechanics::surface::hunt_crossley_chi;
+use chatterspice::mechanics::{Drive, simulate_drive};
 use chatterspice::{Mechanics, Settings, Surface, simulate};
 use criterion::{Criterion, criterion_group, criterion_main};
 
@@ -68,6 +74,39 @@ fn bench(c: &mut Criterion) {
     assert_eq!((r.impacts.len(), r.outcome.as_str()), (11, "stuck"));
     c.bench_function("hunt_crossley_sequence", |b| {
         b.iter(|| simulate(black_box(&m), black_box(&s), black_box(&st)).unwrap())
+    });
+
+    let (m, s, st) = reference();
+    let stops = Stops {
+        make: s,
+        back: None,
+    };
+    c.bench_function("kelvin_voigt_reference_trajectory", |b| {
+        b.iter(|| simulate_drive(black_box(&m), &stops, &st, Drive::Step).unwrap())
+    });
+
+    // The signal relay of `hunt_crossley` on a Kelvin–Voigt contact,
+    // under a 1 N force that switches on at 0.1 ms and off at 5 ms,
+    // against a 0.1 N preload.
+    let (m, _, _) = hunt_crossley();
+    let m = Mechanics { preload: 0.1, ..m };
+    let stops = Stops {
+        make: Surface::KelvinVoigt {
+            stiffness: 8e4,
+            damping: 0.37536,
+        },
+        back: None,
+    };
+    let st = Settings {
+        t_end: 0.012,
+        ..Settings::default()
+    };
+    let pulse = |t: f64, _x: f64| if (1e-4..5e-3).contains(&t) { 1.0 } else { 0.0 };
+    c.bench_function("driven_closing", |b| {
+        b.iter(|| simulate_forced(black_box(&m), &stops.make, &st, pulse).unwrap())
+    });
+    c.bench_function("driven_cycle", |b| {
+        b.iter(|| simulate_drive(black_box(&m), &stops, &st, Drive::Force(&pulse)).unwrap())
     });
 }
 

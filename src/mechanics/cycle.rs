@@ -51,7 +51,7 @@ use super::DriveError;
 use super::driven::{self, Drive, Run, State, first_true, monotone_parts, state_on};
 use super::integrate::{Dopri5, Step, Tolerance};
 use super::surface::surface_force;
-use super::trajectory::Segment;
+use super::trajectory::{Segment, path_of};
 use super::{Mechanics, Settings, Surface};
 
 mod closing;
@@ -276,8 +276,12 @@ impl Track {
     }
 
     /// The opening since the last release is below resolution: the
-    /// contact is taken as closed since the last touch.
-    fn unresolve(&mut self) {
+    /// contact is taken as closed since the last touch. The cycle goes on
+    /// from there as one contact, and forgets the release; a closing stops
+    /// there and keeps it on the last impact's record (its release, and
+    /// the opening it made, as the step-force engine reports a resolved
+    /// sequence).
+    fn unresolve(&mut self, keep_release: bool) {
         self.released = None;
         let Some(closed) = self.intervals.pop() else {
             return;
@@ -285,6 +289,9 @@ impl Track {
         debug_assert_eq!(closed.state, ContactState::Closed);
         self.state = ContactState::Closed;
         self.since = closed.start;
+        if keep_release {
+            return;
+        }
         if let Some(last) = self.impacts.last_mut() {
             last.release_time = None;
             last.release_velocity = None;
@@ -336,7 +343,7 @@ struct Record {
     back: Track,
     /// Every touch, release and lift-off, in order.
     log: Vec<(f64, Event)>,
-    /// Every accepted step, cut at events, and every held stretch.
+    /// Every accepted step, cut at its event (held ones too).
     segments: Vec<Segment>,
     /// m, the largest x reached.
     reach: f64,
@@ -371,6 +378,11 @@ impl<D: Drive> Model<'_, D> {
         self.drive.force(t, x, e) - self.m.preload - self.m.stiffness * x
     }
 
+    /// N, the drive at (t, y) less the preload.
+    fn drive_net(&self, t: f64, y: &State) -> f64 {
+        self.drive.force(t, self.g() + y[0], y[2]) - self.m.preload
+    }
+
     /// N, the NO contact's force at u (> 0 in it) and rate v.
     fn make_force(&self, y: &State) -> f64 {
         surface_force(&self.stops.make, y[0], y[1])
@@ -384,6 +396,7 @@ impl<D: Drive> Model<'_, D> {
         }
     }
 
+    #[inline]
     fn rhs(&self, phase: Phase, t: f64, y: &State) -> State {
         let g = self.g();
         match phase {
@@ -500,7 +513,7 @@ impl<D: Drive> Model<'_, D> {
             return false;
         };
         let s = &self.settings;
-        let x_eq = (self.drive.force(t, self.g() + y[0], y[2]) - self.m.preload) / self.m.stiffness;
+        let x_eq = self.drive_net(t, y) / self.m.stiffness;
         let min_gap = s.min_gap.max(1e3 * f64::EPSILON * x_eq.abs().max(self.g()));
         let min_open = s.min_open_time.max(1e3 * f64::EPSILON * t);
         t - released < min_open || farthest < min_gap
@@ -563,7 +576,7 @@ impl<D: Drive> Sim<'_, D> {
                 rec.ending = Some(closing::resolved(model, rec, t, *y));
                 return Phase::Flight;
             }
-            rec.make.unresolve();
+            rec.make.unresolve(false);
             return match model.stops.make {
                 Surface::Rigid { .. } => {
                     rec.jump_loss += 0.5 * mass * speed * speed;
@@ -620,17 +633,19 @@ impl<D: Drive> Sim<'_, D> {
         let mass = model.m.mass;
         if model.closing {
             // A closing's landing: the opening after the last contact
-            // reached the whole gap.
+            // reached the whole gap, and the next touch starts afresh
+            // from the rest stop (no resolution test against the release).
             if let Some(last) = rec.make.impacts.last_mut() {
                 last.max_gap_after.get_or_insert(model.g());
             }
+            rec.make.released = None;
         }
         let deformable = matches!(
             model.stops.back,
             Some(Surface::KelvinVoigt { .. } | Surface::HuntCrossley { .. })
         );
         if model.unresolved(&rec.back, t, y) {
-            rec.back.unresolve();
+            rec.back.unresolve(false);
             if deformable {
                 return Phase::Back;
             }
@@ -768,15 +783,7 @@ impl<D: Drive> Sim<'_, D> {
             accumulation_time: None,
             t_end,
         };
-        let x0 = self.model.m.initial_position;
-        let mut path = Vec::with_capacity(rec.segments.len() + 1);
-        path.push((0.0, x0));
-        for seg in &rec.segments {
-            let (t, x) = seg.end_position(g);
-            if path.last().is_none_or(|&(tp, _)| t > tp) {
-                path.push((t, x));
-            }
-        }
+        let path = path_of((0.0, self.model.m.initial_position), &rec.segments, g);
         Cycle {
             make,
             back,

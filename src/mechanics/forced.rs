@@ -11,7 +11,7 @@
 use super::DriveError;
 use super::cycle::{self, Cycle, Stops};
 use super::driven::Drive;
-use super::trajectory::Segment;
+use super::trajectory::{Segment, path_of};
 use super::{self as mechanics, Mechanics, Settings, Surface};
 use crate::chatter::Chatter;
 
@@ -49,16 +49,10 @@ pub fn simulate_forced_path(
     let drive = Forced::new(mechanics, force);
     let run = cycle::run_closing(mechanics, surface, settings, &drive, 0.0)?;
     let gap = mechanics.gap;
-    let mut path: Vec<(f64, f64)> = Vec::with_capacity(run.steps.len() + 1);
-    if let Some(first) = run.steps.first().and_then(Segment::piece) {
-        path.push((first.t0(), gap + first.y0()[0]));
-    }
-    for segment in &run.steps {
-        let (t, x) = segment.end_position(gap);
-        if path.last().is_none_or(|&(tp, _)| t > tp) {
-            path.push((t, x));
-        }
-    }
+    let path = match run.steps.first().and_then(Segment::piece) {
+        Some(first) => path_of((first.t0(), gap + first.y0()[0]), &run.steps, gap),
+        None => Vec::new(),
+    };
     Ok((run.chatter, path))
 }
 
@@ -228,6 +222,41 @@ mod tests {
         let now = simulate_forced(&m, &s, &settings, |_, _| 1.5).unwrap();
         let shift = late.impacts[0].impact_time - now.impacts[0].impact_time;
         assert!(shift > 3.0 + 1e-3 / 3.0 && shift < 3.001, "{shift}");
+    }
+
+    #[test]
+    fn a_closing_that_lands_and_lifts_again_starts_afresh() {
+        // A rigid contact (e = 0.5) touched once under a short pulse: it
+        // rebounds, the pulse ends, the armature lands on its rest stop.
+        // A second pulse at 20 s lifts it again. With `min_open_time`
+        // longer than the whole run, the touch after the landing must not
+        // be judged against the first release (that would end the closing
+        // as resolved at the first touch); the closing resolves after the
+        // second touch, its first rebound being too short.
+        let m = Mechanics {
+            preload: 0.5,
+            ..relay()
+        };
+        let s = Surface::Rigid { restitution: 0.5 };
+        let settings = Settings {
+            t_end: 60.0,
+            min_open_time: 100.0,
+            ..Settings::default()
+        };
+        let steady = simulate_forced(&m, &s, &settings, |_, _| 1.5).unwrap();
+        let t1 = steady.impacts[0].impact_time;
+        let (off, on) = (t1 + 0.05, 20.0);
+        let pulses = move |t: f64, _x: f64| if t < off || t >= on { 1.5 } else { 0.0 };
+        let c = simulate_forced(&m, &s, &settings, pulses).unwrap();
+        assert_eq!(c.outcome, Outcome::Resolved);
+        assert_eq!(c.impacts.len(), 2, "{:?}", c.impacts);
+        assert!((c.impacts[0].impact_time - t1).abs() < 1e-9);
+        // The second closing repeats the first, shifted by the pulse.
+        let second = c.impacts[1].impact_time;
+        assert!((second - (on + t1)).abs() < 1e-6, "{second}");
+        assert_eq!(c.settle_time, Some(second));
+        // The opening between the two reached the rest stop.
+        assert_eq!(c.impacts[0].max_gap_after, Some(m.gap));
     }
 
     #[test]

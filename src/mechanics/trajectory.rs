@@ -209,13 +209,16 @@ impl Segment {
         }
     }
 
-    /// The integrator step under this segment as a closing records it;
-    /// `None` for a closed-form piece.
+    /// The integrator step under this segment as a closing records it:
+    /// held, in flight or in the make contact; `None` for a closed-form
+    /// piece and for the back stop's contact, which a closing never has.
     pub(crate) fn piece(&self) -> Option<Piece<'_>> {
         let (phase, step, y1) = match &self.motion {
             Motion::Held { step, y1, .. } => (Phase::Held, step, y1),
             Motion::Integrated { step, y1 } if self.side == Side::Open => (Phase::Flight, step, y1),
-            Motion::Integrated { step, y1 } => (Phase::Contact, step, y1),
+            Motion::Integrated { step, y1 } if self.side == Side::Make => {
+                (Phase::Contact, step, y1)
+            }
             _ => return None,
         };
         Some(Piece {
@@ -357,15 +360,7 @@ impl Trajectory {
     /// integrator step and event of a driven cycle; every event of a step
     /// drive), strictly increasing in time.
     pub fn path(&self) -> Vec<(f64, f64)> {
-        let mut out = Vec::with_capacity(self.segments.len() + 1);
-        out.push((0.0, self.position(0.0)));
-        for seg in &self.segments {
-            let (t1, x) = seg.end_position(self.gap);
-            if out.last().is_none_or(|&(t, _)| t1 > t) {
-                out.push((t1, x));
-            }
-        }
-        out
+        path_of((0.0, self.position(0.0)), &self.segments, self.gap)
     }
 
     /// (s, m): the gap sampled `per_segment` times across every segment
@@ -690,4 +685,18 @@ fn sort(events: &mut [Event]) {
             .total_cmp(&b.time)
             .then(rank(a.kind).cmp(&rank(b.kind)))
     });
+}
+
+/// (s, m): `start`, then the position at the end of every segment (the
+/// contact at `g`), strictly increasing in time.
+pub(crate) fn path_of(start: (f64, f64), segments: &[Segment], g: f64) -> Vec<(f64, f64)> {
+    let mut out = Vec::with_capacity(segments.len() + 1);
+    out.push(start);
+    for segment in segments {
+        let (t, x) = segment.end_position(g);
+        if out.last().is_none_or(|&(tp, _)| t > tp) {
+            out.push((t, x));
+        }
+    }
+    out
 }

@@ -38,7 +38,7 @@
 //! results equal the step-force engine's.
 
 use super::{Event, Model, Phase, Record, Sim, Track};
-use crate::chatter::{Chatter, ContactState, Outcome, bounces};
+use crate::chatter::{Chatter, Outcome, bounces};
 use crate::mechanics::Surface;
 use crate::mechanics::driven::{Drive, Run, State};
 use crate::mechanics::integrate::Step;
@@ -80,11 +80,6 @@ fn margin<D: Drive>(model: &Model<'_, D>, t: f64, y: &State) -> f64 {
         - model.drive.frozen_work(t, y[2], g, g + u)
 }
 
-/// N, the drive net of preload with everything frozen at (t, y).
-fn frozen_net_force<D: Drive>(model: &Model<'_, D>, t: f64, y: &State) -> f64 {
-    model.drive.force(t, model.g() + y[0], y[2]) - model.m.preload
-}
-
 /// The closed-form Kelvin–Voigt contact from (t, y) with the drive
 /// frozen there, with the surface's stiffness and damping; `None` for
 /// another surface.
@@ -102,7 +97,7 @@ fn frozen_kv_piece<D: Drive>(
         m.mass,
         m.damping + damping,
         m.stiffness + stiffness,
-        frozen_net_force(model, t, y) + stiffness * g,
+        model.drive_net(t, y) + stiffness * g,
         g + y[0],
         y[1],
     );
@@ -154,14 +149,11 @@ pub(super) fn resolved<D: Drive>(
     y: State,
 ) -> Ending {
     let track = &mut rec.make;
-    let (released, farthest) = track.released.take().expect("a release came before");
+    let (released, farthest) = track.released.expect("a release came before");
     if let Some(last) = track.impacts.last_mut() {
         last.max_gap_after = Some(farthest);
     }
-    if let Some(closed) = track.intervals.pop() {
-        debug_assert_eq!(closed.state, ContactState::Closed);
-        (track.state, track.since) = (ContactState::Closed, closed.start);
-    }
+    track.unresolve(true);
     let accumulation = match model.stops.make {
         Surface::Rigid { restitution } if restitution < 1.0 => {
             Some(released + (t - released) / (1.0 - restitution))
@@ -199,7 +191,7 @@ pub(super) fn at_horizon<D: Drive>(
                 m.mass,
                 m.damping,
                 m.stiffness,
-                frozen_net_force(model, t, &y),
+                model.drive_net(t, &y),
                 x,
                 y[1],
             );
@@ -235,7 +227,8 @@ pub(super) fn at_horizon<D: Drive>(
             }
             Ending::InContact { end }
         }
-        // A closing stops at the first press.
+        // Not reached: a closing stops at its first press, and has no
+        // back-stop law.
         Phase::Pressed | Phase::Back => Ending::Stuck { end },
     }
 }
