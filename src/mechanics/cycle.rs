@@ -396,7 +396,6 @@ impl<D: Drive> Model<'_, D> {
         }
     }
 
-    #[inline]
     fn rhs(&self, phase: Phase, t: f64, y: &State) -> State {
         let g = self.g();
         match phase {

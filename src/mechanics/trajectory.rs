@@ -54,6 +54,37 @@ impl std::fmt::Debug for Drive<'_> {
 /// Simulate the armature under `drive` from t = 0 to `settings.t_end`.
 /// Parameters are validated first; an invalid one is an error naming its
 /// scenario key.
+///
+/// ```
+/// use chatterspice::mechanics::cycle::Stops;
+/// use chatterspice::mechanics::{Drive, EventKind, simulate_drive};
+/// use chatterspice::{Mechanics, Settings, Surface};
+///
+/// let relay = Mechanics { mass: 1e-4, stiffness: 5000.0, damping: 0.07, force: 1.0,
+///                         gap: 1.4e-4, initial_position: 0.0, initial_velocity: 0.0,
+///                         preload: 0.0 };
+/// let surface = Surface::KelvinVoigt { stiffness: 5e5, damping: 1.92 };
+/// let stops = Stops { make: surface, back: None };
+///
+/// // A step force: the exact engine's closing, as a trajectory.
+/// let closing = simulate_drive(&relay, &stops, &Settings::default(), Drive::Step)?;
+/// assert_eq!(closing.chatter().bounce_count, 5);
+/// let release = closing.chatter().impacts[1].release_time.unwrap();
+/// assert_eq!(closing.gap(release - 1e-7), 0.0);
+/// assert!(closing.gap(release + 1e-5) > 0.0 && closing.velocity(release + 1e-5) < 0.0);
+///
+/// // A 10 ms pulse against a 0.1 N preload: the whole cycle.
+/// let pulse = |t: f64, _x: f64| if t < 0.01 { 1.0 } else { 0.0 };
+/// let held = Mechanics { preload: 0.1, ..relay };
+/// let settings = Settings { t_end: 0.03, ..Settings::default() };
+/// let cycle = simulate_drive(&held, &stops, &settings, Drive::Force(&pulse))?;
+/// let kinds: Vec<EventKind> = cycle.events().iter().map(|e| e.kind).collect();
+/// assert_eq!(kinds.first(), Some(&EventKind::LiftOff));
+/// assert!(kinds.contains(&EventKind::Settled) && kinds.contains(&EventKind::Release));
+/// assert_eq!(kinds.last(), Some(&EventKind::Landing));
+/// assert_eq!(cycle.gap(0.029), relay.gap);
+/// # Ok::<(), chatterspice::mechanics::DriveError>(())
+/// ```
 pub fn simulate_drive(
     mechanics: &Mechanics,
     stops: &Stops,
