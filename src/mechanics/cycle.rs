@@ -863,11 +863,8 @@ fn moving_event<D: Drive>(
             let y = state_on(step, t);
             model.force_rate(side, t, &y)
         };
-        let mut seen = vec![y_last];
-        if let Some(tz) = driven::sign_change(rate, step.t0, t_last) {
-            seen.push(state_on(step, tz));
-        }
-        for y in seen {
+        let extremum = driven::sign_change(rate, step.t0, t_last).map(|tz| state_on(step, tz));
+        for y in std::iter::once(y_last).chain(extremum) {
             match side {
                 Phase::Make => rec.make.see_force(model.make_force(&y)),
                 _ => rec.back.see_force(model.back_force(&y)),
