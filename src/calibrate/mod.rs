@@ -5,4 +5,10 @@
 pub mod fit;
 pub mod parts;
 pub mod render;
-pub mod sections;
+
+/// The scenario sections calibration reads and writes (`[datasheet]`,
+/// `[fit]`, `[provenance]`), defined with the other sections in
+/// [`crate::scenario`].
+pub mod sections {
+    pub use crate::scenario::{DatasheetSection, FitSection, FittedParameter, ProvenanceSection};
+}

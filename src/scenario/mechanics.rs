@@ -1,5 +1,5 @@
-//! `[mechanics]`, `[coil]` and `[simulation]`: the moving contact, its
-//! magnetic drive and when to stop.
+//! `[mechanics]`: the moving contact, and its drive (a step force, or
+//! the `[coil]` of `coil.rs`).
 
 use super::*;
 
@@ -26,45 +26,6 @@ pub struct MechanicsSection {
     /// N, return-spring force holding the armature on its rest stop.
     #[serde(default)]
     pub preload: f64,
-}
-
-/// `[coil]`: the magnetic drive of docs/model.md §7, instead of a step force.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct CoilSection {
-    /// Ω
-    pub resistance: f64,
-    pub turns: u32,
-    /// m²
-    pub pole_area: f64,
-    /// m, armature air gap at rest.
-    pub air_gap: f64,
-    /// m, the iron path as an equivalent air gap.
-    pub iron_gap: f64,
-}
-
-/// `[simulation]`: the engine's [`Settings`].
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct SimulationSection {
-    /// s
-    pub t_end: f64,
-    /// s
-    pub min_open_time: f64,
-    /// m
-    pub min_gap: f64,
-}
-
-impl Default for SimulationSection {
-    /// The engine's own defaults, so that the file and the library agree.
-    fn default() -> Self {
-        let s = Settings::default();
-        SimulationSection {
-            t_end: s.t_end,
-            min_open_time: s.min_open_time,
-            min_gap: s.min_gap,
-        }
-    }
 }
 
 impl Check<'_> {
@@ -168,71 +129,5 @@ impl Check<'_> {
             }
             (None, Some(c)) => self.coil(c, m.gap),
         }
-    }
-
-    pub(super) fn coil(&self, c: &CoilSection, gap: f64) -> Result<(), ScenarioError> {
-        self.number(
-            "coil.resistance",
-            c.resistance,
-            c.resistance > 0.0,
-            "must be > 0: the coil's DC resistance, in Ω",
-        )?;
-        if c.turns == 0 {
-            return Err(self.invalid(
-                "coil.turns",
-                0.0,
-                "must be at least 1: the number of turns of the coil",
-            ));
-        }
-        self.number(
-            "coil.pole_area",
-            c.pole_area,
-            c.pole_area > 0.0,
-            "must be > 0: the pole face area, in m²",
-        )?;
-        self.number(
-            "coil.air_gap",
-            c.air_gap,
-            c.air_gap > gap,
-            format!(
-                "must exceed `mechanics.gap` = {gap:?} m: a residual air gap must remain \
-                 when the contacts close"
-            ),
-        )?;
-        self.number(
-            "coil.iron_gap",
-            c.iron_gap,
-            c.iron_gap >= 0.0,
-            "must be ≥ 0: the iron path as an equivalent air gap, in m",
-        )
-    }
-
-    pub(super) fn simulation(&self, s: &SimulationSection) -> Result<(), ScenarioError> {
-        self.number(
-            "simulation.t_end",
-            s.t_end,
-            s.t_end > 0.0,
-            "must be > 0: the simulated horizon, in s",
-        )?;
-        self.number(
-            "simulation.min_open_time",
-            s.min_open_time,
-            s.min_open_time >= 0.0,
-            "must be ≥ 0: the shortest opening worth resolving, in s",
-        )?;
-        self.number(
-            "simulation.min_gap",
-            s.min_gap,
-            s.min_gap >= 0.0,
-            "must be ≥ 0: the smallest opening worth resolving, in m",
-        )?;
-        for (key, value) in [
-            ("simulation.t_end", s.t_end),
-            ("simulation.min_open_time", s.min_open_time),
-            ("simulation.min_gap", s.min_gap),
-        ] {
-            self.envelope(key, Some(value))?;
-        }
-        Ok(())
     }
 }

@@ -14,8 +14,10 @@
 //! [`Scenario::mechanics`], [`Scenario::surface`], [`Scenario::settings`].
 
 mod arc;
+mod calibration;
 mod check;
 mod circuit;
+mod coil;
 mod contact;
 mod error;
 mod keys;
@@ -23,18 +25,22 @@ mod limits;
 mod mechanics;
 mod numbers;
 mod probes;
+mod simulation;
 mod surface;
 mod sweep;
 #[cfg(test)]
 mod tests;
 
+pub use calibration::{DatasheetSection, FitSection, FittedParameter, ProvenanceSection};
 pub use circuit::CircuitSection;
+pub use coil::CoilSection;
 pub use contact::{ContactSection, HolmSection};
 pub use error::{Location, ScenarioError};
 pub use limits::LimitsSection;
-pub use mechanics::{CoilSection, MechanicsSection, SimulationSection};
+pub use mechanics::MechanicsSection;
 pub use numbers::{ENVELOPE, NUMBER_KEYS};
 pub use probes::Probe;
+pub use simulation::SimulationSection;
 pub use surface::{SurfaceLaw, SurfaceSection};
 pub use sweep::{GridAxis, SweepSection, Tolerance};
 
@@ -43,7 +49,6 @@ use keys::*;
 use numbers::*;
 
 pub use crate::arc::ArcSection;
-pub use crate::calibrate::sections::{DatasheetSection, FitSection, ProvenanceSection};
 use std::collections::BTreeMap;
 use std::fmt;
 use std::ops::Range;

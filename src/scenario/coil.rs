@@ -1,0 +1,58 @@
+//! `[coil]`: the magnetic drive of a coil-driven relay, instead of a step
+//! force.
+
+use super::*;
+
+/// `[coil]`: the magnetic drive of docs/model.md §7, instead of a step force.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CoilSection {
+    /// Ω
+    pub resistance: f64,
+    pub turns: u32,
+    /// m²
+    pub pole_area: f64,
+    /// m, armature air gap at rest.
+    pub air_gap: f64,
+    /// m, the iron path as an equivalent air gap.
+    pub iron_gap: f64,
+}
+
+impl Check<'_> {
+    pub(super) fn coil(&self, c: &CoilSection, gap: f64) -> Result<(), ScenarioError> {
+        self.number(
+            "coil.resistance",
+            c.resistance,
+            c.resistance > 0.0,
+            "must be > 0: the coil's DC resistance, in Ω",
+        )?;
+        if c.turns == 0 {
+            return Err(self.invalid(
+                "coil.turns",
+                0.0,
+                "must be at least 1: the number of turns of the coil",
+            ));
+        }
+        self.number(
+            "coil.pole_area",
+            c.pole_area,
+            c.pole_area > 0.0,
+            "must be > 0: the pole face area, in m²",
+        )?;
+        self.number(
+            "coil.air_gap",
+            c.air_gap,
+            c.air_gap > gap,
+            format!(
+                "must exceed `mechanics.gap` = {gap:?} m: a residual air gap must remain \
+                 when the contacts close"
+            ),
+        )?;
+        self.number(
+            "coil.iron_gap",
+            c.iron_gap,
+            c.iron_gap >= 0.0,
+            "must be ≥ 0: the iron path as an equivalent air gap, in m",
+        )
+    }
+}
