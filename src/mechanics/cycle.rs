@@ -389,6 +389,11 @@ impl<D: Drive> Model<'_, D> {
     }
 
     /// N, the back stop's force at x = g + u (< 0 in it), pushing +x.
+    ///
+    /// Out of line, so that `rhs` is small enough to be inlined into the
+    /// integrator's stepper (measured on a closing of 1139 steps: 215 µs
+    /// so, 280 µs with `rhs` called).
+    #[inline(never)]
     fn back_force(&self, y: &State) -> f64 {
         match self.stops.back {
             Some(s) => surface_force(&s, -(self.g() + y[0]), -y[1]),
@@ -396,6 +401,7 @@ impl<D: Drive> Model<'_, D> {
         }
     }
 
+    #[inline(always)]
     fn rhs(&self, phase: Phase, t: f64, y: &State) -> State {
         let g = self.g();
         match phase {
