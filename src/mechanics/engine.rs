@@ -184,7 +184,7 @@ impl<'a> Engine<'a> {
             surface,
             settings,
             f_net,
-            flight: Mode::new(m.mass, m.damping, m.stiffness, f_net),
+            flight: free_flight(m),
             law: Law::new(m, surface),
             impacts: Vec::with_capacity(TYPICAL_CONTACTS),
             intervals: Vec::with_capacity(2 * TYPICAL_CONTACTS + 1),
@@ -445,17 +445,10 @@ enum Law {
 
 impl Law {
     fn new(m: &Mechanics, surface: &Surface) -> Law {
-        let g = m.gap;
-        let f_net = m.force - m.preload;
         match *surface {
             Surface::Rigid { restitution } => Law::Rigid { restitution },
             Surface::KelvinVoigt { stiffness, damping } => {
-                let contact = Mode::new(
-                    m.mass,
-                    m.damping + damping,
-                    m.stiffness + stiffness,
-                    f_net + stiffness * g,
-                );
+                let contact = kelvin_voigt_contact(m, stiffness, damping);
                 Law::KelvinVoigt {
                     contact,
                     stiffness,
@@ -655,4 +648,21 @@ fn kv_force_extremes(
         consider(at_rest + varying);
     }
     (peak, min)
+}
+
+/// The free flight of the step-force relay `m`: `m ẍ + r ẋ + s x = f − p`.
+pub(crate) fn free_flight(m: &Mechanics) -> Mode {
+    Mode::new(m.mass, m.damping, m.stiffness, m.force - m.preload)
+}
+
+/// The step-force relay `m` in contact with a Kelvin–Voigt surface of
+/// `stiffness` and `damping`: the surface's spring and damper add to the
+/// suspension's, and its spring pushes back from the contact at `g`.
+pub(crate) fn kelvin_voigt_contact(m: &Mechanics, stiffness: f64, damping: f64) -> Mode {
+    Mode::new(
+        m.mass,
+        m.damping + damping,
+        m.stiffness + stiffness,
+        m.force - m.preload + stiffness * m.gap,
+    )
 }

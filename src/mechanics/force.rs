@@ -10,6 +10,7 @@
 use nalgebra::Vector2;
 
 use super::MechanicsError;
+use super::engine::kelvin_voigt_contact;
 use super::hunt_crossley::HcContact;
 use super::integrate::{Dopri5, Tolerance};
 use super::linear::LinearPiece;
@@ -78,14 +79,7 @@ fn replay(
             Ok(vec![force; local.len()])
         }
         Surface::KelvinVoigt { stiffness, damping } => {
-            let piece = LinearPiece::new(
-                m.mass,
-                m.damping + damping,
-                m.stiffness + stiffness,
-                f_net + stiffness * g,
-                g,
-                v_hit,
-            );
+            let piece = LinearPiece::start(&kelvin_voigt_contact(m, stiffness, damping), g, v_hit);
             Ok(local
                 .iter()
                 .map(|&t| {

@@ -23,10 +23,11 @@
 
 use super::cycle::{Cycle, Stops, Stroke};
 use super::driven::{Phase, Piece, State, state_on};
+use super::engine::{free_flight, kelvin_voigt_contact};
 use super::forced::simulate_cycle;
 use super::hunt_crossley::{HcContact, HcStep};
 use super::integrate::Step;
-use super::linear::{LinearPiece, Mode};
+use super::linear::LinearPiece;
 use super::surface::surface_force;
 use super::{DriveError, Mechanics, MechanicsError, Settings, Surface};
 use crate::chatter::{Chatter, ContactState, Impact};
@@ -536,7 +537,7 @@ fn step_trajectory(
     let g = m.gap;
     let t_end = settings.t_end;
     let f_net = m.force - m.preload;
-    let flight = Mode::new(m.mass, m.damping, m.stiffness, f_net);
+    let flight = free_flight(m);
     let at_rest = m.initial_position == 0.0 && m.initial_velocity == 0.0 && f_net <= 0.0;
     let mut segments = Vec::with_capacity(chatter.intervals.len());
     let mut events = contact_events(&chatter, g);
@@ -621,12 +622,7 @@ fn contact_segments(
             segments.push(Segment::rest(t_hit, end, g, true, held));
         }
         Surface::KelvinVoigt { stiffness, damping } => {
-            let contact = Mode::new(
-                m.mass,
-                m.damping + damping,
-                m.stiffness + stiffness,
-                f_net + stiffness * g,
-            );
+            let contact = kelvin_voigt_contact(m, stiffness, damping);
             segments.push(Segment {
                 t0: t_hit,
                 t1: end,
