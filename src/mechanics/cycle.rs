@@ -53,9 +53,9 @@ use super::integrate::{Dopri5, Step, Tolerance};
 use super::surface::surface_force;
 use super::trajectory::{Segment, path_of};
 use super::{Mechanics, Settings, Surface};
+use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome};
 
 mod closing;
-use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome};
 
 /// One stroke of the armature: from leaving the rest stop (lift-off) to
 /// leaving it again, or to the end of the run. All times in s from t = 0.
