@@ -503,9 +503,8 @@ fn pwl(args: &PwlArgs) -> Result<()> {
                 scenario.surface(),
                 scenario.settings(),
             );
-            let trajectory = simulate(&mechanics, &surface, &settings)
-                .and_then(|chatter| Trajectory::of_step(&mechanics, &surface, &settings, chatter))
-                .with_context(|| {
+            let trajectory =
+                Trajectory::of_step(&mechanics, &surface, &settings).with_context(|| {
                     format!(
                         "{}: the mechanics simulation failed",
                         scenario.origin.display()

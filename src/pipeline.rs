@@ -1,6 +1,6 @@
 //! The main job, `chatterspice run`: every stage of the pipeline in order.
 //!
-//! scenario → [`simulate`] (the chatter) →
+//! scenario → [`Trajectory::of_step`] (the chatter and the armature's motion) →
 //! [`Waveform`] (the contact conductance) → [`netlist`]
 //! (the contact include and the user's netlist with the `.include` added)
 //! → a [`Runner`] (ngspice in batch mode) → the raw file →
@@ -29,7 +29,7 @@ use crate::chatter::{Chatter, ContactState, Interval};
 use crate::coil::coupled::Iteration;
 use crate::coil::coupled::nc_include;
 use crate::coil::{CouplingError, CouplingOptions, Operation, run_coupled};
-use crate::mechanics::{MechanicsError, Trajectory, contact_forces, simulate};
+use crate::mechanics::{MechanicsError, Trajectory, contact_forces};
 use crate::netlist::{self, ContactElement, ContactInclude, Deck, DeckRequest, NetlistError};
 use crate::rawfile::Plot;
 use crate::scenario::{Probe, Scenario, ScenarioError};
@@ -226,12 +226,12 @@ pub fn run(
     }
     let mechanics = scenario.mechanics()?;
     let (surface, settings) = (scenario.surface(), scenario.settings());
-    let trajectory = simulate(&mechanics, &surface, &settings)
-        .and_then(|chatter| Trajectory::of_step(&mechanics, &surface, &settings, chatter))
-        .map_err(|source| RunError::Mechanics {
+    let trajectory = Trajectory::of_step(&mechanics, &surface, &settings).map_err(|source| {
+        RunError::Mechanics {
             path: scenario.origin.clone(),
             source,
-        })?;
+        }
+    })?;
     let gap = GapProfile::from_trajectory(&trajectory);
     let chatter = trajectory.into_chatter();
     let (waveform, model) = contact_waveform(scenario, &chatter)?;

@@ -93,15 +93,7 @@ pub fn simulate_drive(
     drive: Drive<'_>,
 ) -> Result<Trajectory, DriveError> {
     match drive {
-        Drive::Step => {
-            let chatter = super::simulate(mechanics, &stops.make, settings)?;
-            Ok(Trajectory::of_step(
-                mechanics,
-                &stops.make,
-                settings,
-                chatter,
-            )?)
-        }
+        Drive::Step => Ok(Trajectory::of_step(mechanics, &stops.make, settings)?),
         Drive::Force(force) => {
             let cycle = simulate_cycle(mechanics, stops, settings, force)?;
             Ok(Trajectory::of_cycle(mechanics, stops, settings, cycle))
@@ -515,19 +507,20 @@ impl Trajectory {
 }
 
 impl Trajectory {
-    /// The trajectory of a step-force closing whose record the engine has
-    /// made ([`super::simulate`] of the same relay, surface and settings),
-    /// rebuilt from its exact event states.
+    /// The step-force closing of `m` onto `surface`: the exact engine's
+    /// record ([`super::simulate`]), with the motion between its events
+    /// rebuilt from the exact event states.
     pub fn of_step(
         m: &Mechanics,
         surface: &Surface,
         settings: &Settings,
-        chatter: Chatter,
     ) -> Result<Trajectory, MechanicsError> {
+        let chatter = super::simulate(m, surface, settings)?;
         step_trajectory(m, surface, settings, chatter)
     }
 }
 
+/// The trajectory of `chatter`, the engine's record of `m` on `surface`.
 fn step_trajectory(
     m: &Mechanics,
     surface: &Surface,
