@@ -441,7 +441,7 @@ fn check(args: &CheckArgs) -> Result<Status> {
 /// A measured chatter record (`--measured CSV`): its open/closed intervals.
 fn read_measured(csv: &Path) -> Result<Vec<chatterspice::chatter::Interval>> {
     report::protect_input(csv);
-    let text = std::fs::read_to_string(csv)
+    let text = chatterspice::input::read_to_string(csv)
         .with_context(|| format!("{}: cannot read the measured chatter", csv.display()))?;
     Ok(read_state_csv(&text, csv)?)
 }

@@ -20,6 +20,7 @@ pub mod capture;
 pub mod chatter;
 pub mod check;
 pub mod coil;
+pub mod input;
 pub mod mechanics;
 pub mod netlist;
 pub mod pipeline;

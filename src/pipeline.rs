@@ -122,17 +122,22 @@ pub enum RunError {
     #[error(
         "ngspice failed on the {run} run of {}{}",
         netlist.display(),
-        line.map_or_else(String::new, |l| format!(
-            ": the error is on line {l} of that file (ngspice counts the lines of the \
-             deck it ran, which has the `.include` added)"
-        ))
+        match line {
+            None => String::new(),
+            Some((file, l)) if file == netlist => format!(
+                ": the error is on line {l} of that file (ngspice counts the lines of the \
+                 deck it ran, which has the contact `.include` added and included files \
+                 written in)"
+            ),
+            Some((file, l)) => format!(": the error is on line {l} of {}, which it includes", file.display()),
+        }
     )]
     Spice {
         run: &'static str,
         netlist: PathBuf,
-        /// The netlist's own line, when ngspice named a deck line that
-        /// came from it.
-        line: Option<usize>,
+        /// The file (the netlist or one it includes) and line, when
+        /// ngspice named a deck line that came from one.
+        line: Option<(PathBuf, usize)>,
         #[source]
         source: Box<SpiceError>,
     },
@@ -780,6 +785,7 @@ fn simulation_of(
                 ..
             }) => deck
                 .source_line(*l)
+                .map(|(file, line)| (file.to_path_buf(), line))
                 // Only when the deck line is the one ngspice echoed.
                 .filter(|_| {
                     let deck_line = deck.text.lines().nth(l - 1).unwrap_or_default();

@@ -191,7 +191,7 @@ pub fn time_unit(header: &str) -> Option<f64> {
 /// Reads the capture at `path`; `channel` picks a value channel by name
 /// (`CH2`, `2`, `Channel B`, `B`) or 1-based number (default: the first).
 pub fn read_capture(path: &Path, channel: Option<&str>) -> Result<Trace, CaptureError> {
-    let text = std::fs::read_to_string(path).map_err(|source| CaptureError::Io {
+    let text = crate::input::read_to_string(path).map_err(|source| CaptureError::Io {
         path: path.to_path_buf(),
         source,
     })?;

@@ -81,7 +81,7 @@ fn read_record(args: &FitArgs) -> Result<(Option<Record>, Option<Captured>)> {
     let Some(csv) = &args.measured else {
         return Ok((None, None));
     };
-    let text = std::fs::read_to_string(csv)
+    let text = chatterspice::input::read_to_string(csv)
         .with_context(|| format!("{}: cannot read the measured chatter", csv.display()))?;
     let intervals = read_state_csv(&text, csv)?;
     let name = csv.file_name().map_or_else(
@@ -98,7 +98,7 @@ pub fn fit(args: &FitArgs) -> Result<()> {
             refuse_existing(Some(&dir.join(name)), args.force)?;
         }
     }
-    let text = std::fs::read_to_string(&args.scenario)
+    let text = chatterspice::input::read_to_string(&args.scenario)
         .with_context(|| format!("{}: cannot read the scenario", args.scenario.display()))?;
     let scenario = Scenario::parse(&text, &args.scenario)?;
     let (record, captured) = read_record(args)?;

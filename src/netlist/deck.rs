@@ -31,6 +31,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 use super::NetlistError;
+use super::inline::{Command, IncludeRef, Inliner, SourceLine, command_line, is_script_title};
 use super::number::parse_number;
 use crate::waveform::format_time;
 
@@ -68,21 +69,27 @@ pub struct DeckRequest<'a> {
 pub struct Deck {
     /// Title line first, `.end` last, `\n` line endings.
     pub text: String,
-    /// For each line of `text`, the 1-based line of the user's netlist it
-    /// came from; `None` for a line chatterspice added.
-    pub source_lines: Vec<Option<usize>>,
+    /// For each line of `text`, the file (an index into `files`) and
+    /// 1-based line it came from; `None` for a line chatterspice added.
+    pub source_lines: Vec<Option<SourceLine>>,
+    /// Every file the deck holds text of: the user's netlist first, then
+    /// each included file in the order it was inlined (a file included
+    /// twice is listed twice).
+    pub files: Vec<PathBuf>,
     pub warnings: Vec<DeckWarning>,
     /// The analysis the deck runs, as it is in the deck.
     pub tran: Tran,
 }
 
 impl Deck {
-    /// The user's netlist line behind line `deck_line` (1-based, the title
-    /// being line 1, as ngspice counts) of the deck, when it has one.
-    pub fn source_line(&self, deck_line: usize) -> Option<usize> {
-        deck_line
+    /// The file and line (1-based) behind line `deck_line` (1-based, the
+    /// title being line 1, as ngspice counts) of the deck, when it has one:
+    /// the user's netlist or a file it includes.
+    pub fn source_line(&self, deck_line: usize) -> Option<(&Path, usize)> {
+        let origin = deck_line
             .checked_sub(1)
-            .and_then(|i| self.source_lines.get(i).copied().flatten())
+            .and_then(|i| self.source_lines.get(i).copied().flatten())?;
+        Some((self.files.get(origin.file)?.as_path(), origin.line))
     }
 }
 
@@ -141,6 +148,11 @@ pub enum DeckWarning {
         netlist: PathBuf,
         line: usize,
     },
+    /// A `*#` line, which ngspice runs as a command.
+    CommandCommentRemoved {
+        netlist: PathBuf,
+        line: usize,
+    },
 }
 
 impl fmt::Display for DeckWarning {
@@ -152,6 +164,13 @@ impl fmt::Display for DeckWarning {
                  writes an interpolated raw file whose time stamps run slow wherever its time \
                  step exceeds the `.tran` step (and more points than it declares), so the \
                  analysis would be wrong; the run keeps every point ngspice computes instead",
+                netlist.display()
+            ),
+            DeckWarning::CommandCommentRemoved { netlist, line } => write!(
+                f,
+                "{}: line {line}: the `*#` line is left out of the run: ngspice runs such a \
+                 comment as a command, and chatterspice runs no commands from netlists; write \
+                 `* #` for a plain comment",
                 netlist.display()
             ),
             DeckWarning::ControlRemoved {
@@ -225,6 +244,12 @@ enum Fate {
     Keep,
     Drop,
     Replace(String),
+    /// An include card: the file (or its section) is inlined.
+    Inline {
+        path: PathBuf,
+        section: Option<String>,
+        card: String,
+    },
 }
 
 /// Build the run deck around the user's netlist (see the module overview).
@@ -259,6 +284,9 @@ pub fn prepare_deck_with_params(
     }
     let mut warnings = Vec::new();
     let title = lines[0];
+    if is_script_title(title) {
+        return Err(NetlistError::ScriptTitle { netlist });
+    }
     let title_word = title.split_whitespace().next().unwrap_or("");
     if title_word.starts_with('.') && !title_word.eq_ignore_ascii_case(".title") {
         warnings.push(DeckWarning::TitleIsCard {
@@ -275,10 +303,21 @@ pub fn prepare_deck_with_params(
     let mut i = 1;
     while i < lines.len() {
         let word = first_word(lines[i]);
-        if word == ".control" {
+        let command = command_line(lines[i]);
+        if command == Some(Command::Hash) {
+            live[i] = false;
+            fates[i] = Fate::Drop;
+            warnings.push(DeckWarning::CommandCommentRemoved {
+                netlist: netlist.clone(),
+                line: i + 1,
+            });
+            i += 1;
+            continue;
+        }
+        if command == Some(Command::ControlStart) {
             let start = i;
             let end = (i + 1..lines.len())
-                .find(|&j| first_word(lines[j]) == ".endc")
+                .find(|&j| command_line(lines[j]) == Some(Command::ControlEnd))
                 .ok_or(NetlistError::UnclosedControl {
                     netlist: netlist.clone(),
                     line: start + 1,
@@ -324,9 +363,16 @@ pub fn prepare_deck_with_params(
     for card in &cards {
         let keyword = card.keyword();
         match keyword.as_str() {
-            ".include" | ".inc" | ".lib" => {
-                if let Some((rewritten, path)) = resolve_include(card, &keyword, &base, &netlist)? {
-                    replace(&mut fates, card, rewritten);
+            k if k.starts_with(".inc") || k.starts_with(".lib") => {
+                if let Some((path, section)) = resolve_include(card, k, &base, &netlist)? {
+                    fates[card.first] = Fate::Inline {
+                        path: path.clone(),
+                        section,
+                        card: card.text.clone(),
+                    };
+                    for fate in &mut fates[card.first + 1..=card.last] {
+                        *fate = Fate::Drop;
+                    }
                     includes.push((card.line(), path));
                 }
             }
@@ -466,49 +512,69 @@ pub fn prepare_deck_with_params(
             wanted: round_up_2(req.stop_at_least),
         });
     }
-    let mut text = String::new();
-    let mut source_lines = Vec::new();
-    let mut emit = |line: &str, source: Option<usize>| {
-        text.push_str(line);
-        text.push('\n');
-        source_lines.push(source);
-    };
-    emit(title, Some(1));
-    emit(
-        &format!(
+    let mut inliner = Inliner::new(req.netlist_path, &mut warnings);
+    let own = |line: usize| Some(SourceLine { file: 0, line });
+    inliner.push(title.to_owned(), own(1));
+    inliner.push(
+        format!(
             "* chatterspice run deck for {}; that file is not modified",
             req.netlist_path.display()
         ),
         None,
     );
-    emit(
-        &format!(".include {}", quote_if_needed(req.include_file_name)),
+    inliner.push(
+        format!(".include {}", quote_if_needed(req.include_file_name)),
         None,
     );
     if let Some((coil_include, _)) = req.coil {
-        emit(&format!(".include {}", quote_if_needed(coil_include)), None);
+        inliner.push(format!(".include {}", quote_if_needed(coil_include)), None);
     }
     for (index, (line, fate)) in lines.iter().zip(&fates).enumerate().skip(1) {
         match fate {
-            Fate::Keep => emit(line, Some(index + 1)),
+            Fate::Keep => inliner.push((*line).to_owned(), own(index + 1)),
             Fate::Drop => {}
-            Fate::Replace(new) => emit(new, Some(index + 1)),
+            Fate::Replace(new) => inliner.push(new.clone(), own(index + 1)),
+            Fate::Inline {
+                path,
+                section,
+                card,
+            } => inliner.include(&IncludeRef {
+                path,
+                section: section.as_deref(),
+                card,
+                from: SourceLine {
+                    file: 0,
+                    line: index + 1,
+                },
+            })?,
         }
     }
     if !params.is_empty() {
-        emit("* chatterspice: the scenario's [circuit.params]", None);
+        inliner.push(
+            "* chatterspice: the scenario's [circuit.params]".to_owned(),
+            None,
+        );
         for (name, value) in params {
-            emit(&format!(".param {name}={}", format_time(*value)), None);
+            inliner.push(format!(".param {name}={}", format_time(*value)), None);
         }
     }
     if has_save && !save_lines.is_empty() {
-        emit("* chatterspice: the probes", None);
-        emit(&format!(".save {}", save_lines.join(" ")), None);
+        inliner.push("* chatterspice: the probes".to_owned(), None);
+        inliner.push(format!(".save {}", save_lines.join(" ")), None);
     }
-    emit(".end", None);
+    inliner.push(".end".to_owned(), None);
+    let files = std::mem::take(&mut inliner.files);
+    let mut text = String::new();
+    let mut source_lines = Vec::with_capacity(inliner.lines.len());
+    for (line, origin) in inliner.lines {
+        text.push_str(&line);
+        text.push('\n');
+        source_lines.push(origin);
+    }
     Ok(Deck {
         text,
         source_lines,
+        files,
         warnings,
         tran,
     })
@@ -580,7 +646,7 @@ fn include_params(
     if depth > MAX_INCLUDE_DEPTH || !seen.insert(path.to_path_buf()) {
         return;
     }
-    let Ok(text) = std::fs::read_to_string(path) else {
+    let Ok(text) = crate::input::read_to_string(path) else {
         return;
     };
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
@@ -674,7 +740,7 @@ fn is_blank_or_comment(line: &str) -> bool {
 
 /// The line without its inline comment (`;` anywhere, `$` after
 /// whitespace), and without a whole-line `*` comment.
-fn strip_comment(line: &str) -> &str {
+pub(super) fn strip_comment(line: &str) -> &str {
     if line.trim_start().starts_with('*') {
         return "";
     }
@@ -785,14 +851,15 @@ fn instantiates(card: &str, subckt: &str) -> bool {
     model.is_some_and(|m| m.eq_ignore_ascii_case(subckt))
 }
 
-/// The path of an include card, its rewritten card, or `None` when the
-/// card is left as it is (a `.lib` section header).
+/// The file an include card names and, for `.lib FILE SECTION`, the
+/// section; `None` when the card is left as it is (a `.lib` section
+/// header).
 fn resolve_include(
     card: &Card,
     keyword: &str,
     base: &Path,
     netlist: &Path,
-) -> Result<Option<(String, PathBuf)>, NetlistError> {
+) -> Result<Option<(PathBuf, Option<String>)>, NetlistError> {
     let original = card.text.split_whitespace().next().unwrap_or(keyword);
     let rest = card.text[original.len()..].trim();
     let (written, after) = split_path(rest);
@@ -800,12 +867,13 @@ fn resolve_include(
         return Ok(None);
     }
     let resolved = resolve(written, base);
+    let is_lib = keyword.starts_with(".lib");
     // `.lib name` alone is a section header inside a library file; with a
     // file behind it, PSpice-style, it includes the whole file.
-    if keyword == ".lib" && after.is_empty() && !resolved.is_file() {
+    if is_lib && after.is_empty() && !resolved.is_file() {
         return Ok(None);
     }
-    if !resolved.is_file() {
+    if !resolved.exists() {
         return Err(NetlistError::MissingInclude {
             netlist: netlist.to_path_buf(),
             line: card.line(),
@@ -813,16 +881,16 @@ fn resolve_include(
             resolved,
         });
     }
-    let mut rewritten = format!("{original} \"{}\"", resolved.display());
-    if !after.is_empty() {
-        rewritten.push(' ');
-        rewritten.push_str(after);
-    }
-    Ok(Some((rewritten, resolved)))
+    let section = after
+        .split_whitespace()
+        .next()
+        .filter(|_| is_lib)
+        .map(str::to_owned);
+    Ok(Some((resolved, section)))
 }
 
 /// A possibly quoted path and the rest of the card.
-fn split_path(rest: &str) -> (&str, &str) {
+pub(super) fn split_path(rest: &str) -> (&str, &str) {
     for quote in ['"', '\''] {
         if let Some(inner) = rest.strip_prefix(quote) {
             if let Some(end) = inner.find(quote) {
@@ -836,7 +904,7 @@ fn split_path(rest: &str) -> (&str, &str) {
     }
 }
 
-fn resolve(written: &str, base: &Path) -> PathBuf {
+pub(super) fn resolve(written: &str, base: &Path) -> PathBuf {
     if let Some(home_rel) = written.strip_prefix("~/") {
         if let Some(home) = std::env::var_os("HOME") {
             return PathBuf::from(home).join(home_rel);
@@ -861,7 +929,7 @@ fn include_instantiates(
     if depth > MAX_INCLUDE_DEPTH || !seen.insert(path.to_path_buf()) {
         return Ok(false);
     }
-    let bytes = std::fs::read(path).map_err(|source| NetlistError::ReadInclude {
+    let bytes = crate::input::read(path).map_err(|source| NetlistError::ReadInclude {
         netlist: netlist.to_path_buf(),
         line,
         included: path.to_path_buf(),
@@ -1031,7 +1099,7 @@ mod tests {
         let lines: Vec<&str> = deck.text.lines().collect();
         assert_eq!(&lines[2..4], [".include contact.inc", ".include coil.inc"]);
         assert_eq!(deck.source_line(4), None);
-        assert_eq!(deck.source_line(5), Some(2));
+        assert_eq!(deck.source_line(5).map(|(_, l)| l), Some(2));
     }
 
     #[test]

@@ -17,6 +17,7 @@
 pub mod coil;
 pub mod contact;
 pub mod deck;
+pub mod inline;
 pub mod number;
 
 use std::io;
@@ -128,6 +129,52 @@ pub enum NetlistError {
         included: PathBuf,
         #[source]
         source: io::Error,
+    },
+    #[error(
+        "{}: line 1 starts with `*ng_script`, which makes ngspice run the file as a command \
+         script: chatterspice runs circuits, not scripts; give the netlist a plain title line",
+        netlist.display()
+    )]
+    ScriptTitle { netlist: PathBuf },
+    #[error(
+        "{}: line {line}: `{}` is already being included (the files include each other in a \
+         circle): remove one of the includes",
+        netlist.display(), included.display()
+    )]
+    IncludeCycle {
+        netlist: PathBuf,
+        line: usize,
+        included: PathBuf,
+    },
+    #[error(
+        "{}: line {line}: includes nest more than {depth} deep: flatten the include chain",
+        netlist.display()
+    )]
+    IncludeTooDeep {
+        netlist: PathBuf,
+        line: usize,
+        depth: usize,
+    },
+    #[error(
+        "{}: line {line}: the included files come to more than {limit} bytes: include only the \
+         models the circuit uses",
+        netlist.display()
+    )]
+    IncludeTooLarge {
+        netlist: PathBuf,
+        line: usize,
+        limit: usize,
+    },
+    #[error(
+        "{}: line {line}: {} has no section `{section}` (`.lib {section}` ... `.endl`): check \
+         the section name",
+        netlist.display(), library.display()
+    )]
+    MissingLibSection {
+        netlist: PathBuf,
+        line: usize,
+        library: PathBuf,
+        section: String,
     },
     #[error("{}: line {line}: `.control` has no `.endc`: close the block with `.endc`", netlist.display())]
     UnclosedControl { netlist: PathBuf, line: usize },

@@ -371,7 +371,7 @@ impl RawFile {
                 limit: MAX_LOADED_BYTES,
             });
         }
-        let bytes = std::fs::read(path).map_err(io)?;
+        let bytes = crate::input::read_limited(path, MAX_LOADED_BYTES).map_err(io)?;
         RawFile::parse(&bytes).map_err(|error| RawError::InFile {
             path: path.to_path_buf(),
             error: Box::new(error),

@@ -59,7 +59,8 @@ pub fn stream_csv<W: Write>(
         source,
     };
     let len = regular_file(path)?.len();
-    let mut file = BufReader::with_capacity(BLOCK_BYTES, File::open(path).map_err(io)?);
+    let mut file =
+        BufReader::with_capacity(BLOCK_BYTES, crate::input::open_regular(path).map_err(io)?);
     let Some(plots) = locate(&mut file, len).map_err(|e| match e {
         Locate::Raw(e) => in_file(e),
         Locate::Io(e) => io(e),

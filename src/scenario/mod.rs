@@ -140,7 +140,7 @@ pub struct Scenario {
 impl Scenario {
     /// Read, parse and validate a scenario file.
     pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Read {
+        let text = crate::input::read_to_string(path).map_err(|source| ScenarioError::Read {
             path: path.to_owned(),
             source,
         })?;
@@ -233,7 +233,7 @@ impl Scenario {
         let circuit = self.circuit.as_ref()?;
         let path = circuit.netlist.clone();
         Some(
-            match (std::fs::read_to_string(&path), self.embedded_netlist) {
+            match (crate::input::read_to_string(&path), self.embedded_netlist) {
                 (Ok(text), _) => Ok((path, text)),
                 (Err(_), Some(text)) => Ok((path, text.to_owned())),
                 (Err(source), None) => Err(ScenarioError::NetlistRead {

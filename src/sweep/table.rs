@@ -401,7 +401,7 @@ pub fn merge_files(
     }
     let mut readers = Vec::with_capacity(inputs.len());
     for path in inputs {
-        let file = std::fs::File::open(path).map_err(|source| MergeFilesError::Open {
+        let file = crate::input::open_regular(path).map_err(|source| MergeFilesError::Open {
             path: path.clone(),
             source,
         })?;
