@@ -193,9 +193,24 @@ pub struct SimulatorArgs {
     #[arg(long, value_name = "S", default_value_t = CouplingOptions::default().tolerance,
           value_parser = parse_tolerance)]
     pub coupling_tolerance: f64,
+
+    /// Start ngspice without the user's own start-up file
+    /// (`~/.spiceinit`), as `ngspice -n` does; the system `spinit`, which
+    /// loads the XSPICE code models, is read either way.
+    #[arg(long)]
+    pub no_spiceinit: bool,
 }
 
 impl SimulatorArgs {
+    /// ngspice, located and probed within `--timeout`, started as these
+    /// arguments say.
+    fn ngspice(&self) -> Result<Ngspice> {
+        Ok(
+            Ngspice::locate_within(self.ngspice.as_deref(), self.timeout())?
+                .skip_user_init(self.no_spiceinit),
+        )
+    }
+
     /// `--timeout`, which covers the version check too.
     fn timeout(&self) -> Duration {
         Duration::from_secs_f64(self.timeout)
@@ -349,8 +364,7 @@ fn run(args: &RunArgs) -> Result<()> {
         refuse_existing_bundle(dir, args.force)?;
     }
     let scenario = load_scenario(args.scenario.as_deref())?;
-    let ngspice =
-        Ngspice::locate_within(args.simulator.ngspice.as_deref(), args.simulator.timeout())?;
+    let ngspice = args.simulator.ngspice()?;
     let options = RunOptions {
         keep_workdir: args.keep_workdir,
         compare_ideal: !args.no_ideal,
@@ -399,17 +413,13 @@ fn check(args: &CheckArgs) -> Result<Status> {
     let (verdict, evidence) = if let Some(csv) = &args.measured {
         let intervals = read_measured(csv)?;
         if check::needs_circuit(&scenario) {
-            let ngspice = Ngspice::locate_within(
-                args.simulator.ngspice.as_deref(),
-                args.simulator.timeout(),
-            )?;
+            let ngspice = args.simulator.ngspice()?;
             check::measured(&scenario, intervals, Some(&ngspice), &options)?
         } else {
             check::measured(&scenario, intervals, None, &options)?
         }
     } else if needs_ngspice {
-        let ngspice =
-            Ngspice::locate_within(args.simulator.ngspice.as_deref(), args.simulator.timeout())?;
+        let ngspice = args.simulator.ngspice()?;
         check::run_with(&scenario, &ngspice, &options)?
     } else {
         // The relay's limits alone: no circuit, no ngspice needed.
@@ -735,10 +745,7 @@ fn sweep(args: &SweepArgs) -> Result<Status> {
     let ngspice = if args.mechanics_only {
         None
     } else {
-        Some(Ngspice::locate_within(
-            args.simulator.ngspice.as_deref(),
-            args.simulator.timeout(),
-        )?)
+        Some(args.simulator.ngspice()?)
     };
     let mut options = SweepOptions::new(match &ngspice {
         Some(n) => Mode::Circuit(n),

@@ -21,6 +21,7 @@ pub mod chatter;
 pub mod check;
 pub mod coil;
 pub mod input;
+pub mod interrupt;
 pub mod mechanics;
 pub mod netlist;
 pub mod pipeline;

@@ -27,6 +27,11 @@ fn main() -> ExitCode {
             };
         }
     };
+    if let Err(e) = chatterspice::interrupt::install() {
+        eprintln!(
+            "warning: cannot watch for Ctrl-C ({e}): an interrupted run may leave ngspice running"
+        );
+    }
     match cli.command.run() {
         Ok(cli::Status::Success) => ExitCode::SUCCESS,
         Ok(cli::Status::CheckFailed) => ExitCode::from(EXIT_CHECK_FAILED),

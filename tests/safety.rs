@@ -162,3 +162,194 @@ fn an_include_cycle_is_refused() {
         "{stderr}"
     );
 }
+
+fn script(dir: &Path, name: &str, body: &str) -> PathBuf {
+    use std::os::unix::fs::PermissionsExt;
+    let path = dir.join(name);
+    std::fs::write(&path, format!("#!/bin/sh\n{body}")).unwrap();
+    std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).unwrap();
+    path
+}
+
+/// A stand-in for ngspice: answers the version check, then runs `body`.
+fn fake_ngspice(dir: &Path, body: &str) -> PathBuf {
+    script(
+        dir,
+        "fake-ngspice.sh",
+        &format!("if [ \"$1\" = -v ]; then echo '** ngspice-39 : fake'; exit 0; fi\n{body}"),
+    )
+}
+
+/// Whether process `pid` is running (a zombie is not).
+fn running(pid: &str) -> bool {
+    let stat = std::fs::read_to_string(format!("/proc/{}/stat", pid.trim())).unwrap_or_default();
+    let state = stat
+        .rsplit(')')
+        .next()
+        .unwrap_or("")
+        .split_whitespace()
+        .next();
+    !matches!(state, None | Some("Z") | Some("X"))
+}
+
+fn work_dirs(tmp: &Path) -> Vec<String> {
+    std::fs::read_dir(tmp)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with("chatterspice"))
+        .collect()
+}
+
+/// Waits for the child to exit, at most `limit`; kills it and fails the
+/// test when it does not.
+fn wait_for(
+    child: &mut std::process::Child,
+    limit: std::time::Duration,
+) -> std::process::ExitStatus {
+    let start = std::time::Instant::now();
+    loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            return status;
+        }
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            panic!("still running {limit:?} after the signal");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+}
+
+/// SIGINT to the whole process group (Ctrl-C) and SIGTERM or SIGINT to the
+/// tool alone: every ngspice it started is gone, its work directories are
+/// removed, and it exits with 130/143 within 3 s.
+#[test]
+fn a_signal_stops_ngspice_and_removes_the_work_directories() {
+    use std::os::unix::process::CommandExt;
+    for (signal, whole_group, code) in [
+        (libc::SIGINT, true, 130),
+        (libc::SIGTERM, false, 143),
+        (libc::SIGINT, false, 130),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        let tmp = dir.path().join("tmp");
+        std::fs::create_dir(&tmp).unwrap();
+        let pids = dir.path().join("pids");
+        let ngspice = fake_ngspice(
+            dir.path(),
+            &format!("echo $$ >> '{}'\nexec sleep 60\n", pids.display()),
+        );
+        let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("chatterspice"))
+            .args(["run", "--timeout", "100", "--ngspice"])
+            .arg(&ngspice)
+            .env("TMPDIR", &tmp)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .process_group(0)
+            .spawn()
+            .unwrap();
+        // Both runs (bounced and ideal) under way.
+        let start = std::time::Instant::now();
+        while std::fs::read_to_string(&pids)
+            .unwrap_or_default()
+            .lines()
+            .count()
+            < 2
+        {
+            assert!(start.elapsed().as_secs() < 20, "ngspice never started");
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        assert_eq!(work_dirs(&tmp).len(), 2);
+        let pid = child.id() as i32;
+        // SAFETY: kill(2) reads no memory of ours.
+        unsafe { libc::kill(if whole_group { -pid } else { pid }, signal) };
+        let status = wait_for(&mut child, std::time::Duration::from_secs(3));
+        assert_eq!(status.code(), Some(code), "signal {signal}");
+        for ngspice_pid in std::fs::read_to_string(&pids).unwrap().lines() {
+            assert!(
+                !running(ngspice_pid),
+                "ngspice {ngspice_pid} outlived signal {signal}"
+            );
+        }
+        assert_eq!(work_dirs(&tmp), Vec::<String>::new(), "signal {signal}");
+    }
+}
+
+/// An ngspice that prints without end, with or without newlines, is
+/// stopped at `--timeout` with exit 2, and the tool stays small.
+#[test]
+fn endless_ngspice_output_is_bounded_and_timed_out() {
+    for body in [
+        "exec yes 'Warning: again and again'\n",
+        "exec cat /dev/zero\n",
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        let ngspice = fake_ngspice(dir.path(), body);
+        let started = std::time::Instant::now();
+        let out = std::process::Command::new(assert_cmd::cargo::cargo_bin("chatterspice"))
+            .args(["run", "--no-ideal", "--timeout", "2", "--ngspice"])
+            .arg(&ngspice)
+            .output()
+            .unwrap();
+        let elapsed = started.elapsed();
+        assert_eq!(out.status.code(), Some(2), "{body}");
+        assert!(elapsed.as_secs_f64() < 4.0, "{body}: {elapsed:?}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains("timeout"), "{stderr}");
+        assert!(stderr.len() < 64 * 1024, "{} bytes of error", stderr.len());
+    }
+    // The largest resident size of any child this test process waited
+    // for, chatterspice and its ngspice included.
+    // SAFETY: getrusage writes the struct it is given.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    assert_eq!(
+        unsafe { libc::getrusage(libc::RUSAGE_CHILDREN, &mut usage) },
+        0
+    );
+    assert!(
+        usage.ru_maxrss < 500 * 1024,
+        "max RSS {} kB",
+        usage.ru_maxrss
+    );
+}
+
+/// ngspice unable to write its raw file (a full disk) is reported as
+/// that, naming the work directory, with no convergence wording.
+#[test]
+fn a_raw_file_write_failure_is_named_as_such() {
+    let dir = tempfile::tempdir().unwrap();
+    let ngspice = fake_ngspice(
+        dir.path(),
+        "echo 'binary raw file \"out.raw\"'\necho 'Warning: rawfile write error !!'\n\
+         echo 'doAnalyses: pause requested'\necho 'run simulation interrupted'\nexit 1\n",
+    );
+    let out = chatterspice()
+        .args(["run", "--no-ideal", "--ngspice"])
+        .arg(&ngspice)
+        .env("TMPDIR", dir.path())
+        .assert()
+        .code(2);
+    let stderr = String::from_utf8_lossy(&out.get_output().stderr).into_owned();
+    let named = stderr.find("could not write its raw file").expect(&stderr);
+    assert!(
+        stderr[named..].contains(&dir.path().display().to_string()),
+        "{stderr}"
+    );
+    assert!(named < stderr.find("ngspice log").unwrap(), "{stderr}");
+    assert!(!stderr.contains("operating point"), "{stderr}");
+}
+
+/// ngspice crashes when HOME is unset; the run gives it one.
+#[test]
+fn a_run_works_with_home_unset() {
+    let _ng = ngspice_or_skip!();
+    chatterspice()
+        .args(["run", "--no-ideal"])
+        .env_remove("HOME")
+        .assert()
+        .success();
+    chatterspice()
+        .args(["run", "--no-ideal", "--no-spiceinit"])
+        .env_remove("HOME")
+        .assert()
+        .success();
+}

@@ -133,15 +133,39 @@ pub fn log_tail(log: &str) -> String {
         "Total elapsed time",
         "Total analysis time",
     ];
-    let mut tail: Vec<&str> = log
+    let mut tail: Vec<String> = log
         .lines()
         .rev()
         .filter(|l| !l.trim().is_empty())
         .filter(|l| !noise.iter().any(|n| l.trim_start().starts_with(n)))
         .take(LOG_TAIL_LINES)
+        .map(|l| shorten(l, LOG_LINE_CHARS))
         .collect();
     tail.reverse();
     tail.join("\n")
+}
+
+/// The longest log line an error message quotes, in characters.
+const LOG_LINE_CHARS: usize = 300;
+
+/// `line`, cut to `max` characters (control characters shown escaped).
+fn shorten(line: &str, max: usize) -> String {
+    let mut out: String = line
+        .chars()
+        .take(max)
+        .flat_map(|c| {
+            if c.is_control() && c != '\t' {
+                c.escape_default().collect::<Vec<_>>()
+            } else {
+                vec![c]
+            }
+        })
+        .collect();
+    let total = line.chars().count();
+    if total > max {
+        out.push_str(&format!(" [... {} more characters]", total - max));
+    }
+    out
 }
 
 /// Why a run produced no usable result.
@@ -190,6 +214,15 @@ pub enum SpiceError {
         context: Box<RunContext>,
     },
     #[error(
+        "ngspice could not write its raw file in the temporary work directory {}: the file \
+         system is probably full; free space there, or set TMPDIR to a directory with room\n{context}",
+        dir.display()
+    )]
+    RawWrite {
+        dir: PathBuf,
+        context: Box<RunContext>,
+    },
+    #[error(
         "ngspice was still running after the {} s timeout and was killed; raise the \
          timeout, or shorten the analysis (a smaller stop time, a larger TMAX)\n{context}",
         limit.as_secs_f64()
@@ -223,6 +256,7 @@ impl SpiceError {
             SpiceError::Process { context, .. }
             | SpiceError::Failed { context, .. }
             | SpiceError::Timeout { context, .. }
+            | SpiceError::RawWrite { context, .. }
             | SpiceError::MissingRaw { context }
             | SpiceError::BadRaw { context, .. }
             | SpiceError::TruncatedRaw { context, .. } => Some(context),

@@ -38,6 +38,7 @@ pub struct Ngspice {
     program: PathBuf,
     version: Option<String>,
     workdir_parent: Option<PathBuf>,
+    skip_user_init: bool,
 }
 
 impl Ngspice {
@@ -66,6 +67,7 @@ impl Ngspice {
             program,
             version,
             workdir_parent: None,
+            skip_user_init: false,
         })
     }
 
@@ -77,6 +79,15 @@ impl Ngspice {
     /// Create work directories under `dir` instead of the system temp dir.
     pub fn workdir_parent(mut self, dir: impl Into<PathBuf>) -> Ngspice {
         self.workdir_parent = Some(dir.into());
+        self
+    }
+
+    /// Skip the user's own ngspice start-up files (`~/.spiceinit`, and a
+    /// `.spiceinit` in the run's directory, which holds none): ngspice is
+    /// started with `-n`. The system `spinit`, which loads the XSPICE code
+    /// models, is read either way.
+    pub fn skip_user_init(mut self, skip: bool) -> Ngspice {
+        self.skip_user_init = skip;
         self
     }
 
@@ -170,6 +181,7 @@ impl Runner for Ngspice {
                 parent: parent.clone(),
                 source,
             })?;
+        let _remove_at_stop = crate::interrupt::remove_at_stop(dir.path());
         let write = |name: &str, text: &str| {
             let path = dir.path().join(name);
             std::fs::write(&path, text).map_err(|source| SpiceError::Write { path, source })
@@ -180,8 +192,16 @@ impl Runner for Ngspice {
         }
 
         let mut cmd = Command::new(&self.program);
+        if self.skip_user_init {
+            cmd.arg("-n");
+        }
         cmd.args(["-b", "-r", RAW_NAME, DECK_NAME])
             .current_dir(dir.path());
+        // ngspice 39 crashes (SIGSEGV) looking for `~/.spiceinit` when HOME
+        // is unset; the work directory is a home with no start-up file.
+        if std::env::var_os("HOME").is_none_or(|h| h.is_empty()) {
+            cmd.env("HOME", dir.path());
+        }
         let started = Instant::now();
         let result = run_child(cmd, req.timeout);
         let elapsed = started.elapsed();
@@ -209,6 +229,12 @@ impl Runner for Ngspice {
             context: context(""),
         })?;
         let log = finished.log;
+        if log.contains("rawfile write error") {
+            return Err(SpiceError::RawWrite {
+                dir: workdir.clone(),
+                context: context(&log),
+            });
+        }
         let Some(status) = finished.status else {
             return Err(SpiceError::Timeout {
                 limit: req.timeout,
@@ -331,8 +357,10 @@ pub(crate) fn run_child(mut cmd: Command, timeout: Duration) -> io::Result<Finis
     #[cfg(unix)]
     std::os::unix::process::CommandExt::process_group(&mut cmd, 0);
     let started = Instant::now();
-    let mut child = spawn_retrying_busy(&mut cmd)?;
-    let (tx, rx) = mpsc::channel::<Option<String>>();
+    let (mut child, _registered) =
+        crate::interrupt::spawn_registered(|| spawn_retrying_busy(&mut cmd), Child::id)?;
+    // Bounded: a child that prints faster than the log takes it waits.
+    let (tx, rx) = mpsc::sync_channel::<Option<String>>(1024);
     let mut open_streams = 0;
     if let Some(out) = child.stdout.take() {
         spawn_reader(out, tx.clone());
@@ -410,9 +438,12 @@ fn kill_and_reap(child: &mut Child) -> io::Result<()> {
     child.wait().map(|_| ())
 }
 
+/// The longest line kept whole; longer output is split.
+const MAX_LINE: usize = 16 * 1024;
+
 /// Sends complete lines (split at `\n` or `\r`, progress lines dropped),
 /// then `None` at end of stream.
-fn spawn_reader(mut stream: impl Read + Send + 'static, tx: mpsc::Sender<Option<String>>) {
+fn spawn_reader(mut stream: impl Read + Send + 'static, tx: mpsc::SyncSender<Option<String>>) {
     thread::spawn(move || {
         let mut buf = [0u8; 8192];
         let mut pending: Vec<u8> = Vec::new();
@@ -440,6 +471,13 @@ fn spawn_reader(mut stream: impl Read + Send + 'static, tx: mpsc::Sender<Option<
                     pending.clear();
                 } else {
                     pending.push(b);
+                    // Output without newlines is cut into lines.
+                    if pending.len() >= MAX_LINE {
+                        if !send(&pending) {
+                            return;
+                        }
+                        pending.clear();
+                    }
                 }
             }
         }

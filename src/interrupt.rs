@@ -1,0 +1,182 @@
+//! Clean stops: what the process has started or left half-done, so that
+//! SIGINT or SIGTERM can undo it before the process exits.
+//!
+//! The library records, while it runs:
+//! - every child process group it starts (ngspice runs in a group of its
+//!   own, so a Ctrl-C at the terminal reaches only chatterspice, which then
+//!   decides), registered under the same lock as the spawn itself, so no
+//!   child can be started unseen while a stop is under way;
+//! - every temporary work directory it creates;
+//! - finishers: short actions that make a half-written output whole (a
+//!   sweep puts its finished rows where `--resume` finds them).
+//!
+//! [`install`] (called by the binary, never implicitly by the library)
+//! starts a thread that waits for SIGINT, SIGTERM or SIGHUP and then, with
+//! the registry locked: kills every registered process group (SIGKILL),
+//! removes every registered directory, runs the finishers, and exits with
+//! 128 + the signal number (130 for SIGINT, 143 for SIGTERM).
+
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicI32, Ordering};
+
+/// A finisher: run once, at a stop.
+type Finisher = Box<dyn FnOnce() + Send>;
+
+#[derive(Default)]
+struct Registry {
+    next: u64,
+    children: Vec<(u64, i32)>,
+    dirs: Vec<(u64, PathBuf)>,
+    finishers: Vec<(u64, Finisher)>,
+}
+
+static REGISTRY: Mutex<Option<Registry>> = Mutex::new(None);
+/// The signal that stopped the process, 0 while running.
+static STOPPING: AtomicI32 = AtomicI32::new(0);
+
+fn with<R>(f: impl FnOnce(&mut Registry) -> R) -> R {
+    let mut guard = REGISTRY.lock().unwrap_or_else(|e| e.into_inner());
+    f(guard.get_or_insert_with(Registry::default))
+}
+
+fn key(registry: &mut Registry) -> u64 {
+    registry.next += 1;
+    registry.next
+}
+
+/// The signal a stop is under way for, if one is.
+pub fn stopping() -> Option<i32> {
+    match STOPPING.load(Ordering::SeqCst) {
+        0 => None,
+        s => Some(s),
+    }
+}
+
+/// A registration: dropping it removes the entry (the work is done, or
+/// the caller cleans up itself).
+#[must_use = "the entry is removed when this is dropped"]
+pub struct Registered(u64);
+
+impl Drop for Registered {
+    fn drop(&mut self) {
+        let id = self.0;
+        with(|r| {
+            r.children.retain(|(k, _)| *k != id);
+            r.dirs.retain(|(k, _)| *k != id);
+            r.finishers.retain(|(k, _)| *k != id);
+        });
+    }
+}
+
+/// Spawns a child with `spawn` and registers its process group (the
+/// child must lead a group of its own), atomically with respect to a stop:
+/// once a stop has begun, nothing new is started.
+pub fn spawn_registered<T>(
+    spawn: impl FnOnce() -> std::io::Result<T>,
+    pid_of: impl FnOnce(&T) -> u32,
+) -> std::io::Result<(T, Registered)> {
+    with(|r| {
+        if stopping().is_some() {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::Interrupted,
+                "the run is being stopped by a signal",
+            ));
+        }
+        let child = spawn()?;
+        let id = key(r);
+        if let Ok(pid) = i32::try_from(pid_of(&child)) {
+            r.children.push((id, pid));
+        }
+        Ok((child, Registered(id)))
+    })
+}
+
+/// Removes `dir` (recursively) at a stop.
+pub fn remove_at_stop(dir: &Path) -> Registered {
+    with(|r| {
+        let id = key(r);
+        r.dirs.push((id, dir.to_path_buf()));
+        Registered(id)
+    })
+}
+
+/// Runs `finish` at a stop (unless the returned registration is dropped
+/// first).
+pub fn finish_at_stop(finish: impl FnOnce() + Send + 'static) -> Registered {
+    with(|r| {
+        let id = key(r);
+        r.finishers.push((id, Box::new(finish)));
+        Registered(id)
+    })
+}
+
+/// Stops everything registered, as the signal handler does, and returns
+/// the exit code for `signal`; the caller exits with it.
+pub fn stop(signal: i32) -> i32 {
+    STOPPING.store(signal, Ordering::SeqCst);
+    let mut guard = REGISTRY.lock().unwrap_or_else(|e| e.into_inner());
+    let registry = guard.get_or_insert_with(Registry::default);
+    #[cfg(unix)]
+    for (_, pid) in &registry.children {
+        // SAFETY: kill(2) with a negative pid signals that process group;
+        // it reads no memory of ours.
+        unsafe {
+            libc::kill(-pid, libc::SIGKILL);
+        }
+    }
+    // Reap them (they are this process's children), so that none is
+    // still running when the process exits; SIGKILL takes effect at once
+    // unless a process is stuck in the kernel, hence the bound.
+    #[cfg(unix)]
+    {
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(1);
+        for (_, pid) in &registry.children {
+            loop {
+                let mut status = 0;
+                // SAFETY: waitpid writes the status it is given.
+                let r = unsafe { libc::waitpid(*pid, &mut status, libc::WNOHANG) };
+                if r != 0 || std::time::Instant::now() > deadline {
+                    break;
+                }
+                std::thread::sleep(std::time::Duration::from_millis(2));
+            }
+        }
+    }
+    for (_, dir) in &registry.dirs {
+        let _ = std::fs::remove_dir_all(dir);
+    }
+    for (_, finish) in registry.finishers.drain(..) {
+        finish();
+    }
+    // The lock stays held: nothing else starts before the exit.
+    std::mem::forget(guard);
+    128 + signal
+}
+
+/// Installs the handler for SIGINT, SIGTERM and SIGHUP: a thread that
+/// [`stop`]s and exits. For binaries; call it once, early.
+#[cfg(unix)]
+pub fn install() -> std::io::Result<()> {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP])?;
+    std::thread::Builder::new()
+        .name("signals".to_owned())
+        .spawn(move || {
+            if let Some(signal) = signals.forever().next() {
+                let code = stop(signal);
+                eprintln!(
+                    "chatterspice: stopped by signal {signal}; ngspice runs and work directories \
+                     removed"
+                );
+                std::process::exit(code);
+            }
+        })?;
+    Ok(())
+}
+
+/// No signals to handle.
+#[cfg(not(unix))]
+pub fn install() -> std::io::Result<()> {
+    Ok(())
+}
