@@ -41,6 +41,20 @@ impl Outcome {
         }
     }
 
+    /// The outcome named `text` (as written by [`Outcome::as_str`]).
+    pub fn parse(text: &str) -> Option<Outcome> {
+        [
+            Outcome::Stuck,
+            Outcome::Resolved,
+            Outcome::NeverCloses,
+            Outcome::EndsOpen,
+            Outcome::EndOfTime,
+            Outcome::EventLimit,
+        ]
+        .into_iter()
+        .find(|o| o.as_str() == text)
+    }
+
     /// Whether the sequence ended with the contact closed for good.
     pub fn is_closed(self) -> bool {
         matches!(self, Outcome::Stuck | Outcome::Resolved)

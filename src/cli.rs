@@ -644,8 +644,15 @@ pub struct SweepArgs {
     /// Directory for sweep.csv, summary.json, sweep.svg and sweep.png (created if
     /// needed) [default: the current directory]. Existing files there are
     /// an error unless --force.
-    #[arg(long, value_name = "DIR")]
+    #[arg(long, value_name = "DIR", conflicts_with = "resume")]
     pub out: Option<PathBuf>,
+
+    /// Continue the sweep interrupted in DIR (by Ctrl-C or a signal) from
+    /// its finished rows: the scenario, seed, sample count, shard and
+    /// options must be the same (checked against DIR's sweep.meta.json);
+    /// the files written are those of an uninterrupted run.
+    #[arg(long, value_name = "DIR", conflicts_with = "force")]
+    pub resume: Option<PathBuf>,
 
     /// Simulate the mechanics only (bounces and times, no circuit, no
     /// ngspice): microseconds per sample.
@@ -729,17 +736,36 @@ impl sweep::Progress for Bar {
 
 /// Exit status 1 when a sample failed a limit or could not run: the
 /// sweep's files are written either way.
+///
+/// The CSV is written under a temporary name in the output directory and
+/// renamed into place at the end; a signal puts its whole rows in place
+/// with `sweep.meta.json` marked incomplete, for `--resume`.
 fn sweep(args: &SweepArgs) -> Result<Status> {
-    let scenario = load_scenario(Some(&args.scenario))?;
+    let (scenario, text) = load_scenario_text(&args.scenario)?;
     let sampler = Sampler::new(&scenario, args.samples, args.seed)?;
-    let dir = args.out.clone().unwrap_or_else(|| PathBuf::from("."));
+    let resume = args.resume.is_some();
+    let dir = args
+        .resume
+        .clone()
+        .or_else(|| args.out.clone())
+        .unwrap_or_else(|| PathBuf::from("."));
     let names = sweep_files(args.shard);
-    if !args.force {
-        if let Some(existing) = names.iter().map(|n| dir.join(n)).find(|p| p.exists()) {
-            bail!(
-                "{}: already exists; pass --force to overwrite the sweep's files, or choose another --out",
-                existing.display()
-            );
+    let csv_path = dir.join(&names[0]);
+    let meta_path = sweep::resume::meta_path(&csv_path);
+    let _lock = chatterspice::output::OutputLock::acquire(&dir, &names[0])?;
+    if !resume {
+        for path in names.iter().map(|n| dir.join(n)).chain([meta_path.clone()]) {
+            if let Err(e) = chatterspice::output::check_target(&path, args.force) {
+                if matches!(e, report::WriteError::Exists { .. }) && path == csv_path {
+                    bail!(
+                        "{}: already exists; pass --force to overwrite the sweep's files, \
+                         --resume {} to continue an interrupted sweep, or choose another --out",
+                        path.display(),
+                        dir.display()
+                    );
+                }
+                return Err(e.into());
+            }
         }
     }
     let ngspice = if args.mechanics_only {
@@ -762,20 +788,117 @@ fn sweep(args: &SweepArgs) -> Result<Status> {
         ideal_alongside: false,
         ..args.simulator.run_options()
     };
+    let netlist_text = match scenario.netlist() {
+        Some(Ok((_, netlist))) => netlist,
+        _ => String::new(),
+    };
+    let identity = sweep::resume::Identity {
+        tool: format!("chatterspice {}", env!("CARGO_PKG_VERSION")),
+        scenario_digest: sweep::resume::digest(&[text.as_bytes(), netlist_text.as_bytes()]),
+        seed: sampler.seed(),
+        samples: sampler.count(),
+        shard: args.shard.map(|s| s.to_string()),
+        mode: if args.mechanics_only {
+            "mechanics"
+        } else {
+            "circuit"
+        }
+        .to_owned(),
+        ideal: args.ideal,
+    };
 
-    std::fs::create_dir_all(&dir)
-        .with_context(|| format!("{}: cannot create the output directory", dir.display()))?;
-    let csv_path = dir.join(&names[0]);
-    let mut open = std::fs::OpenOptions::new();
-    open.write(true);
-    if args.force {
-        open.create(true).truncate(true);
+    let (partial_csv, partial_meta) = (
+        sweep::resume::partial(&csv_path),
+        sweep::resume::partial(&meta_path),
+    );
+    // What a run killed outright left, else what a signal left.
+    let (from_csv, from_meta) = if partial_csv.exists() && partial_meta.exists() {
+        (partial_csv.clone(), partial_meta.clone())
     } else {
-        open.create_new(true);
+        (csv_path.clone(), meta_path.clone())
+    };
+    let kept = if resume {
+        sweep::resume::check_meta(&from_meta, &identity)?;
+        let (header, signals, columns) = sweep::run::layout(&scenario, &sampler, &options)?;
+        Some(sweep::resume::finished_rows(
+            &from_csv,
+            &header,
+            sampler.keys().len(),
+            signals.len(),
+            columns,
+            options.shard,
+        )?)
+    } else {
+        if partial_csv.exists() {
+            eprintln!(
+                "note: {} holds the rows of an interrupted sweep; this new sweep replaces it \
+                 (--resume {} would have continued it)",
+                partial_csv.display(),
+                dir.display()
+            );
+        }
+        None
+    };
+    let mut staged =
+        chatterspice::output::Staged::with_name(&csv_path, &partial_csv, args.force || resume)?;
+    let partial_meta_text = sweep::resume::Meta {
+        identity: identity.clone(),
+        complete: false,
+        rows: 0,
     }
-    let mut csv = open
-        .open(&csv_path)
-        .with_context(|| format!("{}: cannot create the sweep's CSV", csv_path.display()))?;
+    .to_json();
+    std::fs::write(&partial_meta, partial_meta_text)
+        .with_context(|| format!("{}: cannot write it", partial_meta.display()))?;
+    // Gone with the partial CSV when the sweep fails; kept beside it when
+    // the process is killed.
+    let _partial_meta = tempfile::TempPath::try_from_path(&partial_meta)
+        .with_context(|| format!("{}: cannot hold it", partial_meta.display()))?;
+    let done = match kept {
+        Some((bytes, done)) => {
+            staged.file().write_all(&bytes).with_context(|| {
+                format!("{}: cannot write the sweep's CSV", partial_csv.display())
+            })?;
+            eprintln!(
+                "resuming {}: {} of {} samples done",
+                from_csv.display(),
+                done.len(),
+                options.shard.len(sampler.count())
+            );
+            done
+        }
+        None => Vec::new(),
+    };
+    // At a signal: the rows written so far, whole, where --resume finds them.
+    let at_stop = {
+        let (tmp, csv, meta, tmp_meta, identity) = (
+            partial_csv.clone(),
+            csv_path.clone(),
+            meta_path.clone(),
+            partial_meta.clone(),
+            identity.clone(),
+        );
+        chatterspice::interrupt::finish_at_stop(move || {
+            if sweep::resume::truncate_to_whole_lines(&tmp).is_err() {
+                return;
+            }
+            let rows = std::fs::read(&tmp).map_or(0, |b| sweep::resume::row_count(&b));
+            if std::fs::rename(&tmp, &csv).is_ok() {
+                let record = sweep::resume::Meta {
+                    identity,
+                    complete: false,
+                    rows,
+                };
+                if std::fs::write(&meta, record.to_json()).is_ok() {
+                    let _ = std::fs::remove_file(&tmp_meta);
+                }
+                eprintln!(
+                    "sweep interrupted: {rows} finished rows kept in {}; continue with --resume {}",
+                    csv.display(),
+                    csv.parent().unwrap_or(Path::new(".")).display()
+                );
+            }
+        })
+    };
 
     let bar = if io::stderr().is_terminal() {
         let bar = indicatif::ProgressBar::new(0);
@@ -793,19 +916,32 @@ fn sweep(args: &SweepArgs) -> Result<Status> {
         Some(b) => b,
         None => &sweep::NoProgress,
     };
-    let collected = sweep::run(&scenario, &sampler, &options, &mut csv, progress)
+    let collected = sweep::run_from(&scenario, &sampler, &options, staged.file(), progress, done)
         .with_context(|| format!("{}: the sweep stopped", csv_path.display()))?;
     let summary = collected.summary(&sampler)?;
+    let rows = collected.len() as u64;
+    let mut files = Vec::new();
     if args.shard.is_none() {
-        report::write_new_file(
-            &dir.join(&names[1]),
-            summary.to_json().as_bytes(),
-            args.force,
-        )?;
         let svg = sweep::plot::render(&collected, &sampler)?;
-        report::write_new_file(&dir.join(&names[2]), svg.as_bytes(), args.force)?;
         let png = report::png::render(&svg)?;
-        report::write_new_file(&dir.join(&names[3]), &png.bytes, args.force)?;
+        files.push((names[1].clone(), summary.to_json().into_bytes()));
+        files.push((names[2].clone(), svg.into_bytes()));
+        files.push((names[3].clone(), png.bytes));
+    }
+    let meta = sweep::resume::Meta {
+        identity,
+        complete: true,
+        rows,
+    };
+    let meta_name = meta_path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    files.push((meta_name, meta.to_json().into_bytes()));
+    drop(at_stop);
+    staged.commit()?;
+    report::write_bundle(&dir, &files, true)?;
+    if args.shard.is_none() {
         warn_if_no_fonts();
     }
     let mut text = summary.render_table();
@@ -823,6 +959,38 @@ fn sweep(args: &SweepArgs) -> Result<Status> {
     } else {
         Status::Success
     })
+}
+
+/// A scenario file (or `-`, standard input) and its text, its files
+/// protected as inputs.
+fn load_scenario_text(path: &Path) -> Result<(Scenario, String)> {
+    let text = if path == Path::new("-") {
+        let mut text = String::new();
+        io::stdin()
+            .read_to_string(&mut text)
+            .context("cannot read the scenario from standard input")?;
+        text
+    } else {
+        chatterspice::input::read_to_string(path).map_err(|source| {
+            chatterspice::scenario::ScenarioError::Read {
+                path: path.to_owned(),
+                source,
+            }
+        })?
+    };
+    let origin = if path == Path::new("-") {
+        Path::new("<stdin>")
+    } else {
+        path
+    };
+    let scenario = Scenario::parse(&text, origin)?;
+    if path != Path::new("-") {
+        report::protect_input(path);
+    }
+    if let Some(circuit) = &scenario.circuit {
+        report::protect_input(&circuit.netlist);
+    }
+    Ok((scenario, text))
 }
 
 fn merge(args: &MergeArgs) -> Result<()> {

@@ -55,6 +55,7 @@ pub fn stopping() -> Option<i32> {
 
 /// A registration: dropping it removes the entry (the work is done, or
 /// the caller cleans up itself).
+#[derive(Debug)]
 #[must_use = "the entry is removed when this is dropped"]
 pub struct Registered(u64);
 
@@ -92,7 +93,7 @@ pub fn spawn_registered<T>(
     })
 }
 
-/// Removes `dir` (recursively) at a stop.
+/// Removes `dir` (recursively; or the file of that name) at a stop.
 pub fn remove_at_stop(dir: &Path) -> Registered {
     with(|r| {
         let id = key(r);
@@ -143,8 +144,10 @@ pub fn stop(signal: i32) -> i32 {
             }
         }
     }
-    for (_, dir) in &registry.dirs {
-        let _ = std::fs::remove_dir_all(dir);
+    for (_, path) in &registry.dirs {
+        if std::fs::remove_dir_all(path).is_err() {
+            let _ = std::fs::remove_file(path);
+        }
     }
     for (_, finish) in registry.finishers.drain(..) {
         finish();

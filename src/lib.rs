@@ -24,6 +24,7 @@ pub mod input;
 pub mod interrupt;
 pub mod mechanics;
 pub mod netlist;
+pub mod output;
 pub mod pipeline;
 pub mod rawfile;
 pub mod report;

@@ -363,8 +363,9 @@ fn an_interrupted_sweep_leaves_the_header_and_whole_rows() {
         .stdout(std::process::Stdio::null())
         .spawn()
         .unwrap();
-    let csv = out.join("sweep.csv");
-    // Until some rows are on disk, then stop it as a scheduler would.
+    // A running sweep writes here; SIGKILL leaves it for --resume.
+    let csv = out.join("sweep.csv.partial");
+    // Until some rows are on disk, then kill it as a scheduler would.
     let started = std::time::Instant::now();
     while std::fs::metadata(&csv).map_or(0, |m| m.len()) < 100_000 {
         assert!(started.elapsed().as_secs() < 60, "no rows written");
@@ -387,6 +388,8 @@ fn an_interrupted_sweep_leaves_the_header_and_whole_rows() {
     }
     assert!(rows > 500, "{rows}");
     assert!(!out.join("summary.json").exists());
+    assert!(!out.join("sweep.csv").exists());
+    assert!(out.join("sweep.meta.json.partial").exists());
 }
 
 #[test]
@@ -652,4 +655,257 @@ fn the_worst_sample_ranks_errors_first_and_columns_align() {
         assert_eq!(line.chars().count(), header.chars().count(), "{stdout}");
     }
     let _ = end;
+}
+
+/// The files of a sweep directory, sorted.
+fn listing(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// Starts a mechanics-only sweep of `samples` into `out`, waits until
+/// `min_bytes` of rows are in its partial CSV, and stops it with `signal`.
+fn interrupted_sweep(
+    scenario: &Path,
+    out: &Path,
+    samples: &str,
+    min_bytes: u64,
+    signal: i32,
+) -> std::process::ExitStatus {
+    let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("chatterspice"))
+        .arg("sweep")
+        .arg(scenario)
+        .args([
+            "--mechanics-only",
+            "--jobs",
+            "1",
+            "--samples",
+            samples,
+            "--out",
+        ])
+        .arg(out)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let partial = out.join("sweep.csv.partial");
+    let started = std::time::Instant::now();
+    while std::fs::metadata(&partial).map_or(0, |m| m.len()) < min_bytes {
+        assert!(started.elapsed().as_secs() < 60, "no rows written");
+        if let Some(status) = child.try_wait().unwrap() {
+            panic!("the sweep ended ({status}) before it could be interrupted");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    // SAFETY: kill(2) reads no memory of ours.
+    unsafe { libc::kill(child.id() as i32, signal) };
+    child.wait().unwrap()
+}
+
+/// SIGTERM and SIGKILL in the middle of a sweep, then `--resume`: the
+/// same CSV, summary and identity file as an uninterrupted run, and no
+/// lock, partial or temporary file left.
+#[test]
+fn an_interrupted_sweep_resumes_to_the_same_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = scenario(dir.path(), VARY);
+    let samples = "60000";
+    let whole = dir.path().join("whole");
+    chatterspice()
+        .arg("sweep")
+        .arg(&s)
+        .args(["--mechanics-only", "--samples", samples, "--out"])
+        .arg(&whole)
+        .assert()
+        .success();
+    let expected = listing(&whole);
+    assert_eq!(
+        expected,
+        [
+            "summary.json",
+            "sweep.csv",
+            "sweep.meta.json",
+            "sweep.png",
+            "sweep.svg"
+        ]
+    );
+    for (signal, code) in [(libc::SIGTERM, Some(143)), (libc::SIGKILL, None)] {
+        let out = dir.path().join(format!("cut{signal}"));
+        let status = interrupted_sweep(&s, &out, samples, 200_000, signal);
+        assert_eq!(status.code(), code, "signal {signal}");
+        if signal == libc::SIGTERM {
+            // The finished rows in place, marked incomplete; nothing else.
+            assert_eq!(listing(&out), ["sweep.csv", "sweep.meta.json"]);
+            let meta: serde_json::Value =
+                serde_json::from_slice(&std::fs::read(out.join("sweep.meta.json")).unwrap())
+                    .unwrap();
+            assert_eq!(meta["complete"], false);
+            let rows = meta["rows"].as_u64().unwrap();
+            assert!(rows > 1000, "{meta}");
+            let text = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+            assert!(text.ends_with('\n'));
+            assert_eq!(text.lines().count() as u64, rows + 1);
+            // A fresh sweep into it is refused without --force.
+            chatterspice()
+                .arg("sweep")
+                .arg(&s)
+                .args(["--mechanics-only", "--samples", samples, "--out"])
+                .arg(&out)
+                .assert()
+                .code(2)
+                .stderr(predicate::str::contains("--resume"));
+        }
+        chatterspice()
+            .arg("sweep")
+            .arg(&s)
+            .args([
+                "--mechanics-only",
+                "--jobs",
+                "2",
+                "--samples",
+                samples,
+                "--resume",
+            ])
+            .arg(&out)
+            .assert()
+            .success()
+            .stderr(predicate::str::contains("resuming"));
+        assert_eq!(listing(&out), expected, "signal {signal}");
+        for name in ["sweep.csv", "summary.json", "sweep.meta.json"] {
+            assert!(
+                std::fs::read(out.join(name)).unwrap() == std::fs::read(whole.join(name)).unwrap(),
+                "{name} differs after signal {signal} and --resume"
+            );
+        }
+    }
+}
+
+/// `--resume` checks it is the same sweep: another seed is exit 2 naming
+/// the seed, and a complete sweep has nothing to resume.
+#[test]
+fn resume_refuses_another_sweep() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = scenario(dir.path(), VARY);
+    let out = dir.path().join("out");
+    let status = interrupted_sweep(&s, &out, "100000000", 50_000, libc::SIGINT);
+    assert_eq!(status.code(), Some(130));
+    chatterspice()
+        .arg("sweep")
+        .arg(&s)
+        .args([
+            "--mechanics-only",
+            "--samples",
+            "100000000",
+            "--seed",
+            "12",
+            "--resume",
+        ])
+        .arg(&out)
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("seed is 11, this one's is 12"));
+    let done = dir.path().join("done");
+    chatterspice()
+        .arg("sweep")
+        .arg(&s)
+        .args(["--mechanics-only", "--out"])
+        .arg(&done)
+        .assert()
+        .success();
+    chatterspice()
+        .arg("sweep")
+        .arg(&s)
+        .args(["--mechanics-only", "--resume"])
+        .arg(&done)
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("nothing to resume"));
+}
+
+/// Two sweeps into one directory at once: the second is refused while
+/// the first runs, and the first's CSV is whole.
+#[test]
+fn a_second_sweep_into_the_same_directory_is_refused_while_the_first_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = scenario(dir.path(), VARY);
+    let out = dir.path().join("out");
+    let mut first = std::process::Command::new(assert_cmd::cargo::cargo_bin("chatterspice"))
+        .arg("sweep")
+        .arg(&s)
+        .args([
+            "--mechanics-only",
+            "--jobs",
+            "1",
+            "--samples",
+            "100000",
+            "--force",
+            "--out",
+        ])
+        .arg(&out)
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    while !out.join("sweep.csv.partial").exists() {
+        assert!(started.elapsed().as_secs() < 60);
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    chatterspice()
+        .arg("sweep")
+        .arg(&s)
+        .args(["--mechanics-only", "--samples", "50", "--force", "--out"])
+        .arg(&out)
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("another chatterspice run"));
+    assert!(first.wait().unwrap().success());
+    let mut reader = csv::Reader::from_path(out.join("sweep.csv")).unwrap();
+    let width = reader.headers().unwrap().len();
+    let rows: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
+    assert_eq!(rows.len(), 100_000);
+    for (i, row) in rows.iter().enumerate() {
+        assert_eq!((row.len(), row[0].parse::<usize>().unwrap()), (width, i));
+    }
+}
+
+/// `--force` never writes through a link onto an input, nor over the
+/// scenario itself.
+#[cfg(unix)]
+#[test]
+fn a_sweep_never_overwrites_an_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = scenario(dir.path(), VARY);
+    let netlist = Path::new(env!("CARGO_MANIFEST_DIR")).join("netlists/mcu_input.cir");
+    let before = std::fs::read(&netlist).unwrap();
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    std::os::unix::fs::symlink(&netlist, out.join("sweep.csv")).unwrap();
+    chatterspice()
+        .arg("sweep")
+        .arg(&s)
+        .args(["--mechanics-only", "--force", "--out"])
+        .arg(&out)
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("input of the run"));
+    assert_eq!(std::fs::read(&netlist).unwrap(), before);
+    // The scenario living at DIR/sweep.csv.
+    let inside = dir.path().join("inside");
+    std::fs::create_dir(&inside).unwrap();
+    std::fs::copy(&s, inside.join("sweep.csv")).unwrap();
+    let text = std::fs::read(inside.join("sweep.csv")).unwrap();
+    chatterspice()
+        .arg("sweep")
+        .arg(inside.join("sweep.csv"))
+        .args(["--mechanics-only", "--force", "--out"])
+        .arg(&inside)
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("input of the run"));
+    assert_eq!(std::fs::read(inside.join("sweep.csv")).unwrap(), text);
+    assert_eq!(listing(&inside), ["sweep.csv"]);
 }

@@ -28,6 +28,7 @@
 //! byte.
 
 pub mod plot;
+pub mod resume;
 pub mod run;
 pub mod sample;
 pub mod summary;
@@ -43,7 +44,7 @@ use thiserror::Error;
 use crate::chatter::Outcome;
 use crate::scenario::ScenarioError;
 
-pub use run::{Mode, NoProgress, Progress, SweepOptions, evaluate, run};
+pub use run::{Mode, NoProgress, Progress, SweepOptions, evaluate, run, run_from};
 pub use sample::Sampler;
 pub use summary::{Collected, Summary};
 pub use verdict::Verdict;

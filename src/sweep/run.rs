@@ -124,49 +124,65 @@ pub fn run(
     out: &mut dyn Write,
     progress: &dyn Progress,
 ) -> Result<Collected, SweepError> {
-    let coil = scenario.coil.is_some();
-    let signals: Vec<String> = match options.mode {
-        Mode::Mechanics if coil => {
-            return Err(SweepError::CoilNeedsCircuit {
-                path: scenario.origin.clone(),
-            });
-        }
-        Mode::Mechanics if scenario.limits.is_some_and(|l| l.has_arc_limits()) => {
-            return Err(SweepError::ArcLimitsNeedCircuit {
-                path: scenario.origin.clone(),
-            });
-        }
-        Mode::Mechanics => Vec::new(),
-        Mode::Circuit(_) => {
-            if scenario.circuit.is_none() || scenario.probes.is_empty() {
-                return Err(SweepError::NeedsCircuit {
-                    path: scenario.origin.clone(),
-                });
-            }
-            // A netlist that cannot be read would fail every sample.
-            if let Some(Err(e)) = scenario.netlist() {
-                return Err(e.into());
-            }
-            scenario.probes.iter().map(|p| p.signal.clone()).collect()
-        }
-    };
-    let ideal = options.run.compare_ideal && matches!(options.mode, Mode::Circuit(_));
-    let columns = table::Columns {
-        coil,
-        ideal,
-        arc: scenario.arc.is_some() && matches!(options.mode, Mode::Circuit(_)),
-    };
-    let header = table::header(sampler.keys(), &signals, columns);
-    let probes = signals.len();
-    out.write_all(&header)
-        .and_then(|()| out.flush())
-        .map_err(SweepError::Write)?;
+    run_from(scenario, sampler, options, out, progress, Vec::new())
+}
 
+/// The CSV header and columns of `scenario`'s sweep with `sampler`'s keys
+/// under `options`: what [`run`] writes first.
+pub fn layout(
+    scenario: &Scenario,
+    sampler: &Sampler,
+    options: &SweepOptions<'_>,
+) -> Result<(Vec<u8>, Vec<String>, table::Columns), SweepError> {
+    let signals = signals(scenario, options)?;
+    let columns = columns(scenario, options);
+    Ok((
+        table::header(sampler.keys(), &signals, columns),
+        signals,
+        columns,
+    ))
+}
+
+fn columns(scenario: &Scenario, options: &SweepOptions<'_>) -> table::Columns {
+    let circuit = matches!(options.mode, Mode::Circuit(_));
+    table::Columns {
+        coil: scenario.coil.is_some(),
+        ideal: options.run.compare_ideal && circuit,
+        arc: scenario.arc.is_some() && circuit,
+    }
+}
+
+/// [`run`], continuing a sweep whose first `done.len()` samples of the
+/// shard have their rows already (read back by
+/// [`super::resume::finished_rows`]): `out` already holds the header and
+/// those rows, and gets the rest.
+pub fn run_from(
+    scenario: &Scenario,
+    sampler: &Sampler,
+    options: &SweepOptions<'_>,
+    out: &mut dyn Write,
+    progress: &dyn Progress,
+    done: Vec<Record>,
+) -> Result<Collected, SweepError> {
+    let signals = signals(scenario, options)?;
+    let columns = columns(scenario, options);
+    let probes = signals.len();
+    if done.is_empty() {
+        let header = table::header(sampler.keys(), &signals, columns);
+        out.write_all(&header)
+            .and_then(|()| out.flush())
+            .map_err(SweepError::Write)?;
+    }
     let total = options.shard.len(sampler.count());
+    let first = (done.len() as u64).min(total);
     let chunk = chunk_len(options.mode);
-    let chunks = total.div_ceil(chunk);
+    let chunks = (total - first).div_ceil(chunk);
     let mut collected = Collected::new(sampler.keys().to_vec(), signals);
     progress.start(total);
+    for record in &done {
+        collected.add(record);
+    }
+    progress.advance(first);
 
     let next = AtomicU64::new(0);
     let stop = AtomicBool::new(false);
@@ -183,7 +199,7 @@ pub fn run(
                     if c >= chunks || stop.load(Ordering::Relaxed) {
                         break;
                     }
-                    let positions = c * chunk..((c + 1) * chunk).min(total);
+                    let positions = first + c * chunk..(first + (c + 1) * chunk).min(total);
                     let records: Vec<Record> = positions
                         .map(|p| worker.evaluate(options.shard.sample(p)))
                         .collect();
@@ -218,6 +234,35 @@ pub fn run(
     written?;
     progress.finish();
     Ok(collected)
+}
+
+/// The probed signals of a sweep, or why it cannot run.
+fn signals(scenario: &Scenario, options: &SweepOptions<'_>) -> Result<Vec<String>, SweepError> {
+    Ok(match options.mode {
+        Mode::Mechanics if scenario.coil.is_some() => {
+            return Err(SweepError::CoilNeedsCircuit {
+                path: scenario.origin.clone(),
+            });
+        }
+        Mode::Mechanics if scenario.limits.is_some_and(|l| l.has_arc_limits()) => {
+            return Err(SweepError::ArcLimitsNeedCircuit {
+                path: scenario.origin.clone(),
+            });
+        }
+        Mode::Mechanics => Vec::new(),
+        Mode::Circuit(_) => {
+            if scenario.circuit.is_none() || scenario.probes.is_empty() {
+                return Err(SweepError::NeedsCircuit {
+                    path: scenario.origin.clone(),
+                });
+            }
+            // A netlist that cannot be read would fail every sample.
+            if let Some(Err(e)) = scenario.netlist() {
+                return Err(e.into());
+            }
+            scenario.probes.iter().map(|p| p.signal.clone()).collect()
+        }
+    })
 }
 
 /// Evaluate sample `index` of `sampler`'s sweep of `scenario` on its own

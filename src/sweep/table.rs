@@ -83,6 +83,18 @@ pub fn header(keys: &[String], signals: &[String], columns: Columns) -> Vec<u8> 
     w.into_inner().expect("writing to memory")
 }
 
+/// The number of columns of a sweep of `keys` varied keys and `signals`
+/// probes, with the optional columns `columns` asks for.
+pub fn width(keys: usize, signals: usize, columns: Columns) -> usize {
+    let Columns { coil, ideal, arc } = columns;
+    1 + keys
+        + OUTCOME_COLUMNS.len()
+        + if coil { RELEASE_COLUMNS.len() } else { 0 }
+        + if arc { ARC_COLUMNS.len() } else { 0 }
+        + signals * if ideal { 3 } else { 2 }
+        + 3
+}
+
 /// The rows of `records` for a sweep of `keys` varied keys and `probes`
 /// probes, each `\n`-terminated. A record without values or probes (a
 /// sample that failed before them) has empty cells there, so every row
