@@ -360,10 +360,18 @@ fn bounce(args: &BounceArgs) -> Result<()> {
 }
 
 fn run(args: &RunArgs) -> Result<()> {
-    if let Some(dir) = &args.out {
-        refuse_existing_bundle(dir, args.force)?;
-    }
     let scenario = load_scenario(args.scenario.as_deref())?;
+    if let Some(csv) = &args.measured {
+        report::protect_input(csv);
+    }
+    let _lock = match &args.out {
+        Some(dir) => {
+            let lock = chatterspice::output::OutputLock::acquire(dir, "run")?;
+            refuse_existing_bundle(dir, args.force)?;
+            Some(lock)
+        }
+        None => None,
+    };
     let ngspice = args.simulator.ngspice()?;
     let options = RunOptions {
         keep_workdir: args.keep_workdir,
@@ -467,32 +475,26 @@ fn warn_if_no_fonts() {
 }
 
 /// Fail before any work if `--out DIR` already holds a file the run
-/// would write.
+/// would write (or something in the way of one, or an input).
 fn refuse_existing_bundle(dir: &Path, force: bool) -> Result<()> {
     let names = [
         "report.json",
         "waveforms.csv",
+        "waveforms_ideal.csv",
         "netlist.cir",
         pipeline::INCLUDE_FILE,
         "plot.svg",
         "plot.png",
     ];
-    if let Some(input) = names
-        .iter()
-        .map(|n| dir.join(n))
-        .find(|p| report::is_input(p))
-    {
-        return Err(report::WriteError::IsInput { path: input }.into());
-    }
-    if force {
-        return Ok(());
-    }
-    if let Some(existing) = names.iter().map(|n| dir.join(n)).find(|p| p.exists()) {
-        bail!(
-            "{}: already exists; pass --force to overwrite the files in {}, or choose another --out",
-            existing.display(),
-            dir.display()
-        );
+    for path in names.iter().map(|n| dir.join(n)) {
+        match chatterspice::output::check_target(&path, force) {
+            Err(report::WriteError::Exists { path }) => bail!(
+                "{}: already exists; pass --force to overwrite the files in {}, or choose another --out",
+                path.display(),
+                dir.display()
+            ),
+            other => other?,
+        }
     }
     Ok(())
 }
@@ -994,6 +996,9 @@ fn load_scenario_text(path: &Path) -> Result<(Scenario, String)> {
 }
 
 fn merge(args: &MergeArgs) -> Result<()> {
+    for input in &args.inputs {
+        report::protect_input(input);
+    }
     let report = sweep::table::merge_files(
         &args.output,
         &args.inputs,

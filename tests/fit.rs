@@ -335,6 +335,35 @@ fn the_fit_command_writes_json_a_scenario_and_a_report_and_never_overwrites() {
         .arg(&fitted)
         .assert()
         .code(2);
+    // Never over an input, even with --force: the prior itself, the
+    // record, or a link to the record.
+    let link = dir.path().join("link.toml");
+    std::os::unix::fs::symlink(&measured, &link).unwrap();
+    let before = (
+        std::fs::read(&prior).unwrap(),
+        std::fs::read(&measured).unwrap(),
+    );
+    for target in [&prior, &measured, &link] {
+        Command::cargo_bin("chatterspice")
+            .unwrap()
+            .arg("fit")
+            .arg(&prior)
+            .arg("--measured")
+            .arg(&measured)
+            .arg("-o")
+            .arg(target)
+            .arg("--force")
+            .assert()
+            .code(2)
+            .stderr(predicates::str::contains("input of the run"));
+    }
+    assert_eq!(
+        (
+            std::fs::read(&prior).unwrap(),
+            std::fs::read(&measured).unwrap()
+        ),
+        before
+    );
     // No free keys: exit 2 with a message naming what to add.
     Command::cargo_bin("chatterspice")
         .unwrap()

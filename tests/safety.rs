@@ -7,6 +7,7 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use assert_cmd::Command;
+use predicates::prelude::*;
 
 fn chatterspice() -> Command {
     Command::cargo_bin("chatterspice").unwrap()
@@ -350,6 +351,71 @@ fn a_run_works_with_home_unset() {
     chatterspice()
         .args(["run", "--no-ideal", "--no-spiceinit"])
         .env_remove("HOME")
+        .assert()
+        .success();
+}
+
+/// A directory where the last file of `run --out` goes: with --force the
+/// run is refused before it starts, the earlier bundle and the directory
+/// stay, and a rerun after moving it works without --force.
+#[test]
+fn a_run_bundle_is_all_or_nothing() {
+    let _ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    chatterspice()
+        .args(["run", "--no-ideal", "--out"])
+        .arg(&out)
+        .assert()
+        .success();
+    let report = std::fs::read(out.join("report.json")).unwrap();
+    std::fs::remove_file(out.join("plot.png")).unwrap();
+    std::fs::create_dir(out.join("plot.png")).unwrap();
+    std::fs::write(out.join("plot.png/mine.txt"), "mine").unwrap();
+    chatterspice()
+        .args(["run", "--no-ideal", "--force", "--out"])
+        .arg(&out)
+        .assert()
+        .code(2)
+        .stderr(predicates::str::contains("plot.png").and(predicates::str::contains("in the way")));
+    assert_eq!(std::fs::read(out.join("report.json")).unwrap(), report);
+    assert_eq!(
+        std::fs::read(out.join("plot.png/mine.txt")).unwrap(),
+        b"mine"
+    );
+    // Nothing of ours but the bundle: no lock, no temporary file.
+    let mut names: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "contact.inc",
+            "netlist.cir",
+            "plot.png",
+            "plot.svg",
+            "report.json",
+            "waveforms.csv"
+        ]
+    );
+    // A fresh directory: a run that fails leaves nothing to block its rerun.
+    let fresh = dir.path().join("fresh");
+    chatterspice()
+        .args([
+            "run",
+            "--no-ideal",
+            "--ngspice",
+            "/nonexistent/ngspice",
+            "--out",
+        ])
+        .arg(&fresh)
+        .assert()
+        .code(2);
+    chatterspice()
+        .args(["run", "--no-ideal", "--out"])
+        .arg(&fresh)
         .assert()
         .success();
 }

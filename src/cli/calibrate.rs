@@ -92,15 +92,34 @@ fn read_record(args: &FitArgs) -> Result<(Option<Record>, Option<Captured>)> {
 }
 
 pub fn fit(args: &FitArgs) -> Result<()> {
-    refuse_existing(args.output.as_deref(), args.force)?;
-    if let Some(dir) = &args.report {
-        for name in ["fit.json", "overlay.svg"] {
-            refuse_existing(Some(&dir.join(name)), args.force)?;
-        }
+    // Outputs never replace what the fit reads.
+    for input in [
+        Some(&args.scenario),
+        args.capture.as_ref(),
+        args.measured.as_ref(),
+    ]
+    .into_iter()
+    .flatten()
+    {
+        report::protect_input(input);
     }
+    refuse_existing(args.output.as_deref(), args.force)?;
+    let _lock = match &args.report {
+        Some(dir) => {
+            let lock = chatterspice::output::OutputLock::acquire(dir, "fit")?;
+            for name in ["fit.json", "overlay.svg"] {
+                refuse_existing(Some(&dir.join(name)), args.force)?;
+            }
+            Some(lock)
+        }
+        None => None,
+    };
     let text = chatterspice::input::read_to_string(&args.scenario)
         .with_context(|| format!("{}: cannot read the scenario", args.scenario.display()))?;
     let scenario = Scenario::parse(&text, &args.scenario)?;
+    if let Some(circuit) = &scenario.circuit {
+        report::protect_input(&circuit.netlist);
+    }
     let (record, captured) = read_record(args)?;
     let request = FitRequest {
         record: record.clone(),
@@ -120,13 +139,6 @@ pub fn fit(args: &FitArgs) -> Result<()> {
         report::write_new_file(path, toml.as_bytes(), args.force)?;
     }
     if let Some(dir) = &args.report {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("{}: cannot create the report directory", dir.display()))?;
-        report::write_new_file(
-            &dir.join("fit.json"),
-            render::json(&result).as_bytes(),
-            args.force,
-        )?;
         let intervals = record.map(|r| r.intervals).unwrap_or_default();
         let overlay = captured.as_ref().map(|(trace, c)| render::TraceOverlay {
             time: &trace.time,
@@ -137,7 +149,11 @@ pub fn fit(args: &FitArgs) -> Result<()> {
             high: c.thresholds.high,
         });
         let svg = render::overlay_svg_with(&intervals, &result, overlay);
-        report::write_new_file(&dir.join("overlay.svg"), svg.as_bytes(), args.force)?;
+        let files = [
+            ("fit.json".to_owned(), render::json(&result).into_bytes()),
+            ("overlay.svg".to_owned(), svg.into_bytes()),
+        ];
+        report::write_bundle(dir, &files, args.force)?;
     }
     let out = match args.format {
         FitFormat::Table => render::table(&result),

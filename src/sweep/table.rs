@@ -406,11 +406,7 @@ pub fn merge_files(
         path: output.to_owned(),
         source,
     };
-    if !overwrite && output.symlink_metadata().is_ok() {
-        return Err(MergeFilesError::Exists {
-            path: output.to_owned(),
-        });
-    }
+    let mut staged = crate::output::Staged::new(output, overwrite)?;
     let mut readers = Vec::with_capacity(inputs.len());
     for path in inputs {
         let file = crate::input::open_regular(path).map_err(|source| MergeFilesError::Open {
@@ -419,39 +415,11 @@ pub fn merge_files(
         })?;
         readers.push((path.clone(), std::io::BufReader::new(file)));
     }
-    let dir = match output.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => dir,
-        _ => Path::new("."),
-    };
-    let tmp = tempfile::Builder::new()
-        .prefix(".chatterspice-")
-        .suffix(".tmp")
-        .tempfile_in(dir)
-        .map_err(io)?;
-    let mut buffered = std::io::BufWriter::new(tmp);
+    let mut buffered = std::io::BufWriter::new(staged.file());
     let report = merge(readers, &mut buffered, expected, allow_missing)?;
-    let tmp = buffered.into_inner().map_err(|e| io(e.into_error()))?;
-    // A temporary file is private (0600); a CSV is an ordinary file.
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        tmp.as_file()
-            .set_permissions(std::fs::Permissions::from_mode(0o644))
-            .map_err(io)?;
-    }
-    if overwrite {
-        tmp.persist(output).map_err(|e| io(e.error))?;
-    } else {
-        tmp.persist_noclobber(output).map_err(|e| {
-            if e.error.kind() == std::io::ErrorKind::AlreadyExists {
-                MergeFilesError::Exists {
-                    path: output.to_owned(),
-                }
-            } else {
-                io(e.error)
-            }
-        })?;
-    }
+    buffered.flush().map_err(io)?;
+    drop(buffered);
+    staged.commit()?;
     Ok(report)
 }
 
@@ -466,8 +434,8 @@ pub enum MergeFilesError {
     },
     #[error(transparent)]
     Merge(#[from] MergeError),
-    #[error("{}: already exists; pass --force to overwrite it, or choose another file", path.display())]
-    Exists { path: PathBuf },
+    #[error(transparent)]
+    Write(#[from] crate::output::WriteError),
     #[error("{}: cannot write the merged CSV", path.display())]
     Output {
         path: PathBuf,
