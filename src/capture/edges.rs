@@ -48,6 +48,12 @@ pub enum EdgeError {
     #[error("the trace is flat ({value} throughout): there is no second level to find")]
     Flat { value: f64 },
     #[error(
+        "the trace stays at one level ({level}, noise σ {noise}): its other values (up to \
+         {other}) are within the noise, so it shows no make or break; check the channel \
+         (--channel) and that the capture caught the closing"
+    )]
+    OneLevel { level: f64, other: f64, noise: f64 },
+    #[error(
         "the thresholds low = {low} and high = {high} must be finite with low < high, \
          in the trace's unit"
     )]
@@ -92,7 +98,50 @@ pub fn levels(value: &[f64]) -> Result<(f64, f64), EdgeError> {
         }
     };
     let (a, b) = (refine(first), refine(second));
-    Ok(if a < b { (a, b) } else { (b, a) })
+    let (lower, upper) = if a < b { (a, b) } else { (b, a) };
+    let (noise, quantum) = spread(value, 0.5 * (lower + upper));
+    if upper - lower < (LEVEL_NOISE_RATIO * noise).max(LEVEL_QUANTA * quantum) {
+        return Err(EdgeError::OneLevel {
+            level: if a < b { lower } else { upper },
+            other: if a < b { upper } else { lower },
+            noise,
+        });
+    }
+    Ok((lower, upper))
+}
+
+/// Two levels must lie this many noise σ apart: a flat trace's noise puts
+/// its "second mode" 3 to 5 σ from the first.
+const LEVEL_NOISE_RATIO: f64 = 10.0;
+/// ... and this many steps of the trace's resolution (an 8-bit scope's
+/// flat trace flickers between two adjacent codes).
+const LEVEL_QUANTA: f64 = 4.0;
+
+/// The noise (σ, from the median absolute deviation of the samples on each
+/// side of `mid`, the larger of the two) and the resolution (the smallest
+/// step between distinct values) of `value`.
+fn spread(value: &[f64], mid: f64) -> (f64, f64) {
+    let mad = |mut side: Vec<f64>| {
+        if side.is_empty() {
+            return 0.0;
+        }
+        let n = side.len() / 2;
+        let median = *side.select_nth_unstable_by(n, f64::total_cmp).1;
+        let mut deviations: Vec<f64> = side.iter().map(|v| (v - median).abs()).collect();
+        *deviations.select_nth_unstable_by(n, f64::total_cmp).1
+    };
+    let below: Vec<f64> = value.iter().copied().filter(|&v| v < mid).collect();
+    let above: Vec<f64> = value.iter().copied().filter(|&v| v >= mid).collect();
+    // σ of a normal distribution from its MAD.
+    let noise = 1.4826 * mad(below).max(mad(above));
+    let mut sorted = value.to_vec();
+    sorted.sort_unstable_by(f64::total_cmp);
+    let quantum = sorted
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|&d| d > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    (noise, if quantum.is_finite() { quantum } else { 0.0 })
 }
 
 /// The edges of (`time`, `value`): thresholds `low`/`high` (default 30 %
@@ -211,6 +260,39 @@ fn mid_crossing(time: &[f64], value: &[f64], k: usize, mid: f64, up: bool) -> f6
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A flat trace with noise, or flickering between two codes of an
+    /// 8-bit scope, shows no contact: refused, not read as hundreds of
+    /// bounces. The same noise on a real 3.3 V step is read.
+    #[test]
+    fn noise_on_one_level_is_not_a_second_level() {
+        let n = 20_000;
+        // A deterministic pseudo-random sequence, roughly normal (sum of 4 uniforms).
+        let mut state = 12345u64;
+        let mut uniform = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let noise: Vec<f64> = (0..n)
+            .map(|_| 1e-3 * ((0..4).map(|_| uniform()).sum::<f64>() - 2.0) * 1.732)
+            .collect();
+        let flat: Vec<f64> = noise.iter().map(|e| 3.3 + e).collect();
+        let err = levels(&flat).unwrap_err();
+        assert!(matches!(err, EdgeError::OneLevel { .. }), "{err:?}");
+        let codes: Vec<f64> = (0..n)
+            .map(|i| if i % 7 == 3 { 3.32 } else { 3.30 })
+            .collect();
+        assert!(matches!(levels(&codes), Err(EdgeError::OneLevel { .. })));
+        let step: Vec<f64> = noise
+            .iter()
+            .enumerate()
+            .map(|(i, e)| if i < n / 10 { *e } else { 3.3 + e })
+            .collect();
+        let (lo, hi) = levels(&step).unwrap();
+        assert!(lo.abs() < 1e-3 && (hi - 3.3).abs() < 1e-3, "{lo} {hi}");
+    }
 
     #[test]
     fn levels_of_a_noisy_two_level_trace() {
