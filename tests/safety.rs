@@ -16,6 +16,7 @@ fn chatterspice() -> Command {
 /// A scenario in `dir` using the default relay, with `netlist` as its
 /// `[circuit]` netlist (written to `circuit.cir`) and one probe.
 fn scenario_with_netlist(dir: &Path, netlist: &str) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
     std::fs::write(dir.join("circuit.cir"), netlist).unwrap();
     let relay = chatterspice::scenario::DEFAULT_SCENARIO_TOML;
     let cut = relay.find("[circuit]").unwrap();
@@ -418,4 +419,109 @@ fn a_run_bundle_is_all_or_nothing() {
         .arg(&fresh)
         .assert()
         .success();
+}
+
+/// The solenoid example with a 10 µg armature: bounded in steps and
+/// memory, exit 2 within seconds naming `mechanics.mass`.
+#[test]
+fn a_featherweight_armature_ends_with_exit_2_naming_the_mass() {
+    let _ng = ngspice_or_skip!();
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenarios");
+    let text = std::fs::read_to_string(examples.join("solenoid.toml")).unwrap();
+    let netlists = Path::new(env!("CARGO_MANIFEST_DIR")).join("netlists");
+    let light: String = text
+        .lines()
+        .map(|l| {
+            if l.starts_with("mass =") {
+                "mass = 1e-8".to_owned()
+            } else {
+                l.replace("../../netlists/", &format!("{}/", netlists.display()))
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("light.toml");
+    std::fs::write(&path, light).unwrap();
+    let started = std::time::Instant::now();
+    let out = chatterspice()
+        .args(["run", "--no-ideal"])
+        .arg(&path)
+        .timeout(std::time::Duration::from_secs(60))
+        .assert()
+        .code(2);
+    assert!(started.elapsed().as_secs() < 20, "{:?}", started.elapsed());
+    let stderr = String::from_utf8_lossy(&out.get_output().stderr).into_owned();
+    assert!(stderr.contains("`mechanics.mass` = 1e-8"), "{stderr}");
+}
+
+/// A FIFO given as any input is refused at once (exit 2, naming it),
+/// not waited on for a writer that never comes.
+#[test]
+fn a_fifo_as_any_input_is_refused_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let fifo = d.join("pipe");
+    let c = std::ffi::CString::new(fifo.as_os_str().as_encoded_bytes()).unwrap();
+    // SAFETY: mkfifo reads the NUL-terminated path only.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+    // A scenario whose netlist is the FIFO.
+    let relay = chatterspice::scenario::DEFAULT_SCENARIO_TOML;
+    let cut = relay.find("[circuit]").unwrap();
+    let scenario = d.join("relay.toml");
+    std::fs::write(
+        &scenario,
+        format!(
+            "{}[circuit]\nnetlist = \"pipe\"\n\n[[probe]]\nsignal = \"v(sw)\"\nlow = 1\nhigh = 2\n",
+            &relay[..cut]
+        ),
+    )
+    .unwrap();
+    // An include that is the FIFO.
+    let with_include = scenario_with_netlist(
+        &d.join("inc"),
+        "t\n.include ../pipe\nX1 sw 0 CONTACT\n.tran 1u 5m\n.end\n",
+    );
+    let cases: Vec<(Vec<std::ffi::OsString>, &str)> = vec![
+        (vec!["bounce".into(), fifo.clone().into()], "pipe"),
+        (
+            vec!["run".into(), "--no-ideal".into(), scenario.clone().into()],
+            "pipe",
+        ),
+        (
+            vec!["run".into(), "--no-ideal".into(), with_include.into()],
+            "pipe",
+        ),
+        (vec!["capture".into(), fifo.clone().into()], "pipe"),
+        (
+            vec!["bounce".into(), "--measured".into(), fifo.clone().into()],
+            "pipe",
+        ),
+        (vec!["raw".into(), fifo.clone().into()], "pipe"),
+        (
+            vec![
+                "fit".into(),
+                scenario.clone().into(),
+                "--measured".into(),
+                fifo.clone().into(),
+            ],
+            "pipe",
+        ),
+    ];
+    for (args, name) in cases {
+        let started = std::time::Instant::now();
+        let out = chatterspice()
+            .args(&args)
+            .timeout(std::time::Duration::from_secs(10))
+            .output()
+            .unwrap();
+        assert!(started.elapsed().as_secs() < 5, "{args:?}");
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            stderr.contains(name)
+                && (stderr.contains("FIFO") || stderr.contains("not a regular file")),
+            "{args:?}: {stderr}"
+        );
+    }
 }

@@ -745,6 +745,17 @@ impl<D: Drive> Sim<'_, D> {
             } else {
                 rec.segments.push(Segment::integrated(step, te, ye, side));
             }
+            if rec.segments.len() > crate::mechanics::MAX_DRIVEN_STEPS {
+                let m = &model.m;
+                return Err(DriveError::TooManySteps {
+                    steps: crate::mechanics::MAX_DRIVEN_STEPS,
+                    time: te,
+                    t_end,
+                    mass: m.mass,
+                    stiffness: m.stiffness,
+                    period: std::f64::consts::TAU * (m.mass / m.stiffness).sqrt(),
+                });
+            }
             if let Some(found) = found {
                 return Ok(found);
             }

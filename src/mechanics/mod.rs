@@ -205,6 +205,11 @@ pub const MAX_EVENTS: usize = 100_000;
 /// before it is given up as unphysical.
 pub const MAX_CONTACT_STEPS: usize = 2_000_000;
 
+/// The most integration steps one simulation under a varying drive (the
+/// coil) takes, about 100 MB of trajectory: a real relay's cycle takes a
+/// few thousand.
+pub const MAX_DRIVEN_STEPS: usize = 500_000;
+
 /// What the driven mechanics (a drive that varies in time and position:
 /// the coil) can fail on. Parameter errors name the key to change;
 /// run-time errors carry the time and state.
@@ -224,6 +229,21 @@ pub enum DriveError {
          `surface.stiffness`, lower the drive, or end the run earlier with `simulation.t_end`"
     )]
     ArmatureAtPole { time: f64, position: f64, pole: f64 },
+    #[error(
+        "the motion needs more than {steps} integration steps by t = {time:.4e} s of the run's \
+         {t_end} s: with `mechanics.mass` = {mass:e} kg on `mechanics.stiffness` = {stiffness:e} \
+         N/m the armature's natural period is {period:.3e} s, too short to follow over the run; check \
+         `mechanics.mass` (in kg: a signal relay's armature is 0.1 to 5 g) and the stiffnesses, \
+         or shorten `simulation.t_end`"
+    )]
+    TooManySteps {
+        steps: usize,
+        time: f64,
+        t_end: f64,
+        mass: f64,
+        stiffness: f64,
+        period: f64,
+    },
     #[error(
         "the drive force is {value} N at t = {time} s, x = {position} m: \
          the force function must return a finite force for every time and position"
