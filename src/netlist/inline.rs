@@ -143,6 +143,8 @@ impl<'w> Inliner<'w> {
                 limit: MAX_INLINED_BYTES,
             });
         }
+        // An output of this process never replaces a file the run reads.
+        crate::output::protect_input(include.path);
         let text = String::from_utf8_lossy(&bytes);
         let file = self.files.len();
         self.files.push(include.path.to_path_buf());
