@@ -10,10 +10,13 @@
 //!
 //! [`prepare_deck`] copies the netlist line by line and changes only this:
 //! - `.include <contact include>` right after the title;
-//! - relative paths in `.include`/`.inc`/`.lib` become absolute, resolved
-//!   against the netlist's directory (the deck runs from a temporary work
-//!   directory); a missing file is an error naming the line;
-//! - `.control` … `.endc` blocks are left out, with a warning. In batch mode
+//! - each `.include`/`.inc…`/`.lib FILE [SECTION]` card is replaced by the
+//!   file's (or the section's) text, read and checked by
+//!   [`super::inline`]; a relative path is resolved against the netlist's
+//!   directory, and a missing file is an error naming the line;
+//! - `.control` … `.endc` blocks (matched by prefix, as ngspice does) and
+//!   `*#` lines are left out, with a warning; a `*ng_script` title is
+//!   refused. ngspice runs these as commands. In batch mode
 //!   (`ngspice -b -r out.raw`) the runner owns the analysis and the raw
 //!   file; a control block would run its own `tran` a second time, `write`
 //!   elsewhere, or `quit` before the raw file exists;

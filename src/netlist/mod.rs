@@ -6,10 +6,12 @@
 //!   any data files it reads.
 //! - [`deck`]: the run deck built around the user's netlist, which is read
 //!   and never written: the title is kept, the contact include is added,
-//!   relative `.include`/`.lib` paths are made absolute (the deck runs in a
-//!   temporary directory), `.control` blocks are left out, probes are
-//!   saved, and the netlist is checked for what the run needs (an `X` line
-//!   using the contact, a `.tran` long enough to cover the chatter).
+//!   the files it includes are written in ([`inline`]), `.control` blocks
+//!   and `*#` command lines are left out, probes are saved, and the
+//!   netlist is checked for what the run needs (an `X` line using the
+//!   contact, a `.tran` long enough to cover the chatter).
+//! - [`inline`]: included files and `.lib` sections, read, checked and
+//!   written into the deck, so that ngspice runs no command from data.
 //! - [`number`]: SPICE numbers with scale suffixes (`10u`, `1meg`).
 //!
 //! Everything here is text in, text out, and deterministic.
