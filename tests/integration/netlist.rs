@@ -7,8 +7,6 @@
 //! Tests that need ngspice skip with a note when it is missing, and fail
 //! when `REQUIRE_NGSPICE=1` (CI sets it).
 
-mod common;
-
 use std::path::{Path, PathBuf};
 
 use chatterspice::chatter::{ContactState, Interval};

@@ -2,8 +2,6 @@
 //! binary and real ngspice: run a command, destroy an input, hang the
 //! tool, or leave processes and work directories behind.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 
 use assert_cmd::Command;

@@ -7,7 +7,7 @@
 //! `type`, `properties`, `required`, `additionalProperties`, `items`,
 //! `enum`, `oneOf`, `minimum` and local `$ref`s.
 
-mod common;
+use crate::common;
 
 use std::path::PathBuf;
 

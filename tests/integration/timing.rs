@@ -2,7 +2,7 @@
 //! from the moment the coil is energized, so moving the driver's pulse in
 //! the netlist moves the simulated instants but changes no reported time.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -3,7 +3,7 @@
 //! it declares; a killed run, fewer. Every whole point is read, no vector
 //! is misaligned, and a warning says what happened.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -4,8 +4,6 @@
 //! `run` must see through the filter exactly the openings that the RC
 //! closed form says are long enough.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 
 use assert_cmd::Command;

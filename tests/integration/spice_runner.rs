@@ -11,8 +11,6 @@ use std::time::{Duration, Instant};
 
 use chatterspice::spice::{Exit, Failure, Ngspice, RunRequest, Runner, SpiceError};
 
-mod common;
-
 const RC: &str =
     "RC step\nV1 in 0 PWL(0 0 1n 1)\nR1 in out 1k\nC1 out 0 1u\n.tran 50u 5m 0 50u\n.end\n";
 

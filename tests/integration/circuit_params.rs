@@ -1,7 +1,7 @@
 //! `[circuit.params]`: values for the netlist's own `.param` names, in a
 //! run and as sweep keys, without editing the netlist.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 

@@ -5,7 +5,7 @@
 //! Tests that need ngspice skip with a note when it is missing, and fail
 //! when `REQUIRE_NGSPICE=1` (CI sets it).
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -1,5 +1,4 @@
 //! Helpers shared by the integration tests that need ngspice.
-#![allow(dead_code)] // each test crate uses its own subset
 
 use chatterspice::spice::Ngspice;
 
@@ -37,10 +36,9 @@ pub fn chain(e: &dyn std::error::Error) -> String {
 }
 
 /// `let ng = ngspice_or_skip!();` at the top of a test.
-#[macro_export]
 macro_rules! ngspice_or_skip {
     () => {
-        match common::ngspice() {
+        match $crate::common::ngspice() {
             Some(n) => n,
             None => return,
         }
