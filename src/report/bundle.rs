@@ -16,7 +16,9 @@
 use thiserror::Error;
 
 use super::svg::{self, ContactTrace, ProbePanel, Series, SvgPlot};
-use super::{csv, json, png};
+#[cfg(feature = "png")]
+use super::png;
+use super::{csv, json};
 use crate::analysis::{AnalysisError, signal_values};
 use crate::mechanics::Dimensionless;
 use crate::pipeline::{INCLUDE_FILE, RunResult};
@@ -30,6 +32,7 @@ pub enum BundleError {
     #[error("cannot draw the plot")]
     Plot(#[from] svg::SvgError),
     #[error("cannot render the plot as PNG")]
+    #[cfg(feature = "png")]
     Png(#[from] png::PngError),
 }
 
@@ -65,6 +68,7 @@ pub fn run_files(
         files.push((name.clone(), contents.clone().into_bytes()));
     }
     let svg = plot(run)?;
+    #[cfg(feature = "png")]
     files.push(("plot.png".to_owned(), png::render(&svg)?.bytes));
     files.push(("plot.svg".to_owned(), svg.into_bytes()));
     Ok(files)

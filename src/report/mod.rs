@@ -17,6 +17,7 @@
 pub mod bundle;
 pub mod csv;
 pub mod json;
+#[cfg(feature = "png")]
 pub mod png;
 pub mod svg;
 pub mod table;
