@@ -15,9 +15,9 @@
 
 use thiserror::Error;
 
-use super::svg::{self, ContactTrace, ProbePanel, Series, SvgPlot};
 #[cfg(feature = "png")]
 use super::png;
+use super::svg::{self, ContactTrace, ProbePanel, Series, SvgPlot};
 use super::{csv, json};
 use crate::analysis::{AnalysisError, signal_values};
 use crate::mechanics::Dimensionless;
