@@ -270,22 +270,40 @@ pub fn prepare_deck_with_params(
     req: &DeckRequest<'_>,
     params: &[(&str, f64)],
 ) -> Result<Deck, NetlistError> {
-    let netlist = req.netlist_path.to_path_buf();
-    let base = req
-        .netlist_path
-        .parent()
-        .map(Path::to_path_buf)
-        .unwrap_or_default();
+    let netlist = req.netlist_path;
     let mut save_lines: Vec<String> = Vec::new();
     for probe in req.probes {
         save_lines.extend(save_names(probe)?);
     }
-
     let lines = physical_lines(req.netlist_text);
+    let mut warnings = Vec::new();
+    check_title(&lines, netlist, &mut warnings)?;
+    let (mut fates, control_line) = leave_out_commands(&lines, netlist, &mut warnings)?;
+    let scan = scan_cards(req, &lines, &mut fates, &mut warnings)?;
+    check_instances(req, &scan)?;
+    check_params(req, params, &scan)?;
+    let tran = check_tran(req, scan.tran, control_line, &mut warnings)?;
+    let deck = Written {
+        lines: &lines,
+        fates: &fates,
+        params,
+        save: if scan.has_save { &save_lines } else { &[] },
+        tran,
+    };
+    write_deck(req, &deck, warnings)
+}
+
+/// The title line: never a `*ng_script`, and a warning when it looks like
+/// a card (ngspice ignores it as the title).
+fn check_title(
+    lines: &[&str],
+    netlist: &Path,
+    warnings: &mut Vec<DeckWarning>,
+) -> Result<(), NetlistError> {
+    let netlist = netlist.to_path_buf();
     if lines.iter().all(|l| l.trim().is_empty()) {
         return Err(NetlistError::EmptyNetlist { netlist });
     }
-    let mut warnings = Vec::new();
     let title = lines[0];
     if is_script_title(title) {
         return Err(NetlistError::ScriptTitle { netlist });
@@ -293,22 +311,29 @@ pub fn prepare_deck_with_params(
     let title_word = title.split_whitespace().next().unwrap_or("");
     if title_word.starts_with('.') && !title_word.eq_ignore_ascii_case(".title") {
         warnings.push(DeckWarning::TitleIsCard {
-            netlist: netlist.clone(),
+            netlist,
             text: title.trim().to_owned(),
         });
     }
+    Ok(())
+}
 
+/// Each line's fate after the command lines (`.control` blocks, `*#`) and
+/// everything from `.end` on are left out, and the first line of a
+/// `.control` block, if any.
+fn leave_out_commands(
+    lines: &[&str],
+    netlist: &Path,
+    warnings: &mut Vec<DeckWarning>,
+) -> Result<(Vec<Fate>, Option<usize>), NetlistError> {
+    let netlist = netlist.to_path_buf();
     let mut fates: Vec<Fate> = (0..lines.len()).map(|_| Fate::Keep).collect();
-    // Control blocks and `.end` first: cards are only read outside them.
-    let mut live = vec![true; lines.len()];
-    live[0] = false;
     let mut control_line = None;
     let mut i = 1;
     while i < lines.len() {
         let word = first_word(lines[i]);
         let command = command_line(lines[i]);
         if command == Some(Command::Hash) {
-            live[i] = false;
             fates[i] = Fate::Drop;
             warnings.push(DeckWarning::CommandCommentRemoved {
                 netlist: netlist.clone(),
@@ -325,10 +350,7 @@ pub fn prepare_deck_with_params(
                     netlist: netlist.clone(),
                     line: start + 1,
                 })?;
-            for j in start..=end {
-                live[j] = false;
-                fates[j] = Fate::Drop;
-            }
+            fates[start..=end].fill_with(|| Fate::Drop);
             control_line.get_or_insert(start + 1);
             warnings.push(DeckWarning::ControlRemoved {
                 netlist: netlist.clone(),
@@ -339,10 +361,7 @@ pub fn prepare_deck_with_params(
             continue;
         }
         if word == ".end" {
-            for j in i..lines.len() {
-                live[j] = false;
-                fates[j] = Fate::Drop;
-            }
+            fates[i..].fill_with(|| Fate::Drop);
             if let Some(j) = (i + 1..lines.len()).find(|&j| !is_blank_or_comment(lines[j])) {
                 warnings.push(DeckWarning::IgnoredAfterEnd {
                     netlist: netlist.clone(),
@@ -354,7 +373,43 @@ pub fn prepare_deck_with_params(
         i += 1;
     }
 
-    let cards = cards(&lines, &live);
+    Ok((fates, control_line))
+}
+
+/// What the netlist's own cards hold.
+struct Scan {
+    instances: usize,
+    coil_instances: usize,
+    has_save: bool,
+    tran: Option<Tran>,
+    /// The include cards: line and file.
+    includes: Vec<(usize, PathBuf)>,
+    /// Top-level `.param` names, lower case.
+    defined: HashSet<String>,
+}
+
+/// Reads the cards of the lines `fates` keeps: include cards become
+/// [`Fate::Inline`], `.options interp` is left out, and the rest is
+/// recorded in a [`Scan`].
+fn scan_cards(
+    req: &DeckRequest<'_>,
+    lines: &[&str],
+    fates: &mut [Fate],
+    warnings: &mut Vec<DeckWarning>,
+) -> Result<Scan, NetlistError> {
+    let netlist = req.netlist_path.to_path_buf();
+    let base = req
+        .netlist_path
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_default();
+    // Cards are only read outside the lines left out, and not the title.
+    let live: Vec<bool> = fates
+        .iter()
+        .enumerate()
+        .map(|(i, f)| i > 0 && !matches!(f, Fate::Drop))
+        .collect();
+    let cards = cards(lines, &live);
     let mut instances = 0;
     let mut coil_instances = 0;
     let mut has_save = false;
@@ -390,7 +445,7 @@ pub fn prepare_deck_with_params(
                     } else {
                         "* chatterspice: `.options interp` left out".to_owned()
                     };
-                    replace(&mut fates, card, text);
+                    replace(fates, card, text);
                     warnings.push(DeckWarning::InterpRemoved {
                         netlist: netlist.clone(),
                         line: card.line(),
@@ -436,6 +491,22 @@ pub fn prepare_deck_with_params(
         }
     }
 
+    Ok(Scan {
+        instances,
+        coil_instances,
+        has_save,
+        tran,
+        includes,
+        defined,
+    })
+}
+
+/// Some `X` card, in the netlist or a file it includes, uses the contact
+/// (and the coil, for a coil-driven relay).
+fn check_instances(req: &DeckRequest<'_>, scan: &Scan) -> Result<(), NetlistError> {
+    let netlist = req.netlist_path.to_path_buf();
+    let (instances, coil_instances, includes) =
+        (scan.instances, scan.coil_instances, &scan.includes);
     if instances == 0 {
         let mut seen = HashSet::new();
         let found = includes.iter().try_fold(false, |found, (line, path)| {
@@ -454,7 +525,7 @@ pub fn prepare_deck_with_params(
     if let Some((_, coil)) = req.coil {
         let mut seen = HashSet::new();
         let mut found = coil_instances > 0;
-        for (line, path) in &includes {
+        for (line, path) in includes {
             if found {
                 break;
             }
@@ -468,9 +539,22 @@ pub fn prepare_deck_with_params(
         }
     }
 
+    Ok(())
+}
+
+/// Every `[circuit.params]` name is a top-level `.param` of the netlist
+/// or of a file it includes.
+fn check_params(
+    req: &DeckRequest<'_>,
+    params: &[(&str, f64)],
+    scan: &Scan,
+) -> Result<(), NetlistError> {
+    let netlist = req.netlist_path.to_path_buf();
+    let mut defined = scan.defined.clone();
+    let includes = &scan.includes;
     if !params.is_empty() {
         let mut seen = HashSet::new();
-        for (_, path) in &includes {
+        for (_, path) in includes {
             include_params(path, 1, &mut seen, &mut defined);
         }
         if let Some((name, _)) = params
@@ -489,6 +573,18 @@ pub fn prepare_deck_with_params(
         }
     }
 
+    Ok(())
+}
+
+/// The one `.tran`, long enough for the chatter (an error) and for the
+/// circuit to settle after it (a warning).
+fn check_tran(
+    req: &DeckRequest<'_>,
+    tran: Option<Tran>,
+    control_line: Option<usize>,
+    warnings: &mut Vec<DeckWarning>,
+) -> Result<Tran, NetlistError> {
+    let netlist = req.netlist_path.to_path_buf();
     let Some(tran) = tran else {
         return Err(NetlistError::NoTran {
             netlist,
@@ -515,6 +611,35 @@ pub fn prepare_deck_with_params(
             wanted: round_up_2(req.stop_at_least),
         });
     }
+    Ok(tran)
+}
+
+/// What [`write_deck`] writes.
+struct Written<'a> {
+    lines: &'a [&'a str],
+    fates: &'a [Fate],
+    params: &'a [(&'a str, f64)],
+    /// The probes' `.save` vectors, when the netlist saves its own.
+    save: &'a [String],
+    tran: Tran,
+}
+
+/// The deck: title, the contact (and coil) includes, the netlist's lines
+/// by their fates with included files written in, the scenario's
+/// parameters, the probes' saves, `.end`.
+fn write_deck(
+    req: &DeckRequest<'_>,
+    deck: &Written<'_>,
+    mut warnings: Vec<DeckWarning>,
+) -> Result<Deck, NetlistError> {
+    let Written {
+        lines,
+        fates,
+        params,
+        save,
+        tran,
+    } = *deck;
+    let title = lines[0];
     let mut inliner = Inliner::new(req.netlist_path, &mut warnings);
     let own = |line: usize| Some(SourceLine { file: 0, line });
     inliner.push(title.to_owned(), own(1));
@@ -532,7 +657,7 @@ pub fn prepare_deck_with_params(
     if let Some((coil_include, _)) = req.coil {
         inliner.push(format!(".include {}", quote_if_needed(coil_include)), None);
     }
-    for (index, (line, fate)) in lines.iter().zip(&fates).enumerate().skip(1) {
+    for (index, (line, fate)) in lines.iter().zip(fates).enumerate().skip(1) {
         match fate {
             Fate::Keep => inliner.push((*line).to_owned(), own(index + 1)),
             Fate::Drop => {}
@@ -561,9 +686,9 @@ pub fn prepare_deck_with_params(
             inliner.push(format!(".param {name}={}", format_time(*value)), None);
         }
     }
-    if has_save && !save_lines.is_empty() {
+    if !save.is_empty() {
         inliner.push("* chatterspice: the probes".to_owned(), None);
-        inliner.push(format!(".save {}", save_lines.join(" ")), None);
+        inliner.push(format!(".save {}", save.join(" ")), None);
     }
     inliner.push(".end".to_owned(), None);
     let files = std::mem::take(&mut inliner.files);
