@@ -756,58 +756,15 @@ fn sweep(args: &SweepArgs) -> Result<Status> {
     let meta_path = sweep::resume::meta_path(&csv_path);
     let _lock = chatterspice::output::OutputLock::acquire(&dir, &names[0])?;
     if !resume {
-        for path in names.iter().map(|n| dir.join(n)).chain([meta_path.clone()]) {
-            if let Err(e) = chatterspice::output::check_target(&path, args.force) {
-                if matches!(e, report::WriteError::Exists { .. }) && path == csv_path {
-                    bail!(
-                        "{}: already exists; pass --force to overwrite the sweep's files, \
-                         --resume {} to continue an interrupted sweep, or choose another --out",
-                        path.display(),
-                        dir.display()
-                    );
-                }
-                return Err(e.into());
-            }
-        }
+        refuse_existing_sweep(&dir, &names, &meta_path, args.force)?;
     }
     let ngspice = if args.mechanics_only {
         None
     } else {
         Some(args.simulator.ngspice()?)
     };
-    let mut options = SweepOptions::new(match &ngspice {
-        Some(n) => Mode::Circuit(n),
-        None => Mode::Mechanics,
-    });
-    if let Some(jobs) = args.jobs {
-        options.jobs = jobs;
-    }
-    options.shard = args.shard.unwrap_or(Shard::WHOLE);
-    // A sample is one ngspice process (two with --ideal, in turn), so
-    // --jobs is the number of ngspice processes at once.
-    options.run = RunOptions {
-        compare_ideal: args.ideal,
-        ideal_alongside: false,
-        ..args.simulator.run_options()
-    };
-    let netlist_text = match scenario.netlist() {
-        Some(Ok((_, netlist))) => netlist,
-        _ => String::new(),
-    };
-    let identity = sweep::resume::Identity {
-        tool: format!("chatterspice {}", env!("CARGO_PKG_VERSION")),
-        scenario_digest: sweep::resume::digest(&[text.as_bytes(), netlist_text.as_bytes()]),
-        seed: sampler.seed(),
-        samples: sampler.count(),
-        shard: args.shard.map(|s| s.to_string()),
-        mode: if args.mechanics_only {
-            "mechanics"
-        } else {
-            "circuit"
-        }
-        .to_owned(),
-        ideal: args.ideal,
-    };
+    let options = sweep_options(args, ngspice.as_ref());
+    let identity = sweep_identity(args, &scenario, &text, &sampler);
 
     let (partial_csv, partial_meta) = (
         sweep::resume::partial(&csv_path),
@@ -870,50 +827,15 @@ fn sweep(args: &SweepArgs) -> Result<Status> {
         }
         None => Vec::new(),
     };
-    // At a signal: the rows written so far, whole, where --resume finds them.
-    let at_stop = {
-        let (tmp, csv, meta, tmp_meta, identity) = (
-            partial_csv.clone(),
-            csv_path.clone(),
-            meta_path.clone(),
-            partial_meta.clone(),
-            identity.clone(),
-        );
-        chatterspice::interrupt::finish_at_stop(move || {
-            if sweep::resume::truncate_to_whole_lines(&tmp).is_err() {
-                return;
-            }
-            let rows = std::fs::read(&tmp).map_or(0, |b| sweep::resume::row_count(&b));
-            if std::fs::rename(&tmp, &csv).is_ok() {
-                let record = sweep::resume::Meta {
-                    identity,
-                    complete: false,
-                    rows,
-                };
-                if std::fs::write(&meta, record.to_json()).is_ok() {
-                    let _ = std::fs::remove_file(&tmp_meta);
-                }
-                eprintln!(
-                    "sweep interrupted: {rows} finished rows kept in {}; continue with --resume {}",
-                    csv.display(),
-                    csv.parent().unwrap_or(Path::new(".")).display()
-                );
-            }
-        })
-    };
+    let at_stop = keep_rows_at_stop(
+        &partial_csv,
+        &csv_path,
+        &meta_path,
+        &partial_meta,
+        &identity,
+    );
 
-    let bar = if io::stderr().is_terminal() {
-        let bar = indicatif::ProgressBar::new(0);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{bar:40} {pos}/{len} samples, {per_sec}, {eta} left",
-            )
-            .expect("a valid template"),
-        );
-        Some(Bar(bar))
-    } else {
-        None
-    };
+    let bar = progress_bar();
     let progress: &dyn sweep::Progress = match &bar {
         Some(b) => b,
         None => &sweep::NoProgress,
@@ -961,6 +883,138 @@ fn sweep(args: &SweepArgs) -> Result<Status> {
     } else {
         Status::Success
     })
+}
+
+/// Fail before any work if the sweep's files exist (unless `force`), or
+/// something is in the way of one.
+fn refuse_existing_sweep(
+    dir: &Path,
+    names: &[String],
+    meta_path: &Path,
+    force: bool,
+) -> Result<()> {
+    let csv_path = dir.join(&names[0]);
+    for path in names
+        .iter()
+        .map(|n| dir.join(n))
+        .chain([meta_path.to_path_buf()])
+    {
+        if let Err(e) = chatterspice::output::check_target(&path, force) {
+            if matches!(e, report::WriteError::Exists { .. }) && path == csv_path {
+                bail!(
+                    "{}: already exists; pass --force to overwrite the sweep's files, \
+                         --resume {} to continue an interrupted sweep, or choose another --out",
+                    path.display(),
+                    dir.display()
+                );
+            }
+            return Err(e.into());
+        }
+    }
+    Ok(())
+}
+
+/// How the sweep runs, from the command line.
+fn sweep_options<'n>(args: &SweepArgs, ngspice: Option<&'n Ngspice>) -> SweepOptions<'n> {
+    let mut options = SweepOptions::new(match ngspice {
+        Some(n) => Mode::Circuit(n),
+        None => Mode::Mechanics,
+    });
+    if let Some(jobs) = args.jobs {
+        options.jobs = jobs;
+    }
+    options.shard = args.shard.unwrap_or(Shard::WHOLE);
+    // A sample is one ngspice process (two with --ideal, in turn), so
+    // --jobs is the number of ngspice processes at once.
+    options.run = RunOptions {
+        compare_ideal: args.ideal,
+        ideal_alongside: false,
+        ..args.simulator.run_options()
+    };
+    options
+}
+
+/// Which sweep this is, for `sweep.meta.json` and `--resume`.
+fn sweep_identity(
+    args: &SweepArgs,
+    scenario: &Scenario,
+    text: &str,
+    sampler: &Sampler,
+) -> sweep::resume::Identity {
+    let netlist_text = match scenario.netlist() {
+        Some(Ok((_, netlist))) => netlist,
+        _ => String::new(),
+    };
+    sweep::resume::Identity {
+        tool: format!("chatterspice {}", env!("CARGO_PKG_VERSION")),
+        scenario_digest: sweep::resume::digest(&[text.as_bytes(), netlist_text.as_bytes()]),
+        seed: sampler.seed(),
+        samples: sampler.count(),
+        shard: args.shard.map(|s| s.to_string()),
+        mode: if args.mechanics_only {
+            "mechanics"
+        } else {
+            "circuit"
+        }
+        .to_owned(),
+        ideal: args.ideal,
+    }
+}
+
+/// At a signal: the rows written so far into `partial_csv`, whole, moved
+/// to `csv`, and `meta` saying they are incomplete, where `--resume`
+/// finds them.
+fn keep_rows_at_stop(
+    partial_csv: &Path,
+    csv: &Path,
+    meta: &Path,
+    partial_meta: &Path,
+    identity: &sweep::resume::Identity,
+) -> chatterspice::interrupt::Registered {
+    let (tmp, csv, meta, tmp_meta, identity) = (
+        partial_csv.to_path_buf(),
+        csv.to_path_buf(),
+        meta.to_path_buf(),
+        partial_meta.to_path_buf(),
+        identity.clone(),
+    );
+    chatterspice::interrupt::finish_at_stop(move || {
+        if sweep::resume::truncate_to_whole_lines(&tmp).is_err() {
+            return;
+        }
+        let rows = std::fs::read(&tmp).map_or(0, |b| sweep::resume::row_count(&b));
+        if std::fs::rename(&tmp, &csv).is_ok() {
+            let record = sweep::resume::Meta {
+                identity,
+                complete: false,
+                rows,
+            };
+            if std::fs::write(&meta, record.to_json()).is_ok() {
+                let _ = std::fs::remove_file(&tmp_meta);
+            }
+            eprintln!(
+                "sweep interrupted: {rows} finished rows kept in {}; continue with --resume {}",
+                csv.display(),
+                csv.parent().unwrap_or(Path::new(".")).display()
+            );
+        }
+    })
+}
+
+/// A progress bar on stderr when it is a terminal.
+fn progress_bar() -> Option<Bar> {
+    if io::stderr().is_terminal() {
+        let bar = indicatif::ProgressBar::new(0);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{bar:40} {pos}/{len} samples, {per_sec}, {eta} left",
+            )
+            .expect("a valid template"),
+        );
+        Some(Bar(bar))
+    } else {
+        None
+    }
 }
 
 /// A scenario file (or `-`, standard input) and its text, its files
