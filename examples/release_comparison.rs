@@ -12,7 +12,7 @@ use std::error::Error;
 use std::path::{Path, PathBuf};
 
 use chatterspice::analysis::{Direction, Edge};
-use chatterspice::coil::{Coupled, CouplingOptions, run_coupled};
+use chatterspice::pipeline::{Coupled, CouplingOptions, run_coupled};
 use chatterspice::report::svg::{self, ProbePanel, Series, SvgPlot};
 use chatterspice::scenario::Scenario;
 use chatterspice::spice::Ngspice;

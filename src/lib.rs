@@ -26,6 +26,7 @@ pub mod mechanics;
 pub mod netlist;
 pub mod output;
 pub mod pipeline;
+pub mod plan;
 pub mod rawfile;
 pub mod report;
 pub mod scenario;

@@ -94,18 +94,18 @@ pub fn settle(
             coil,
             run,
             &driver,
-            &super::coupled::thin(&current.path(), tolerances.path),
+            &super::samples::thin(&current.path(), tolerances.path),
         );
         let estimate: Vec<(f64, f64)> = (0..run.time.len())
             .map(|j| (run.time[j], run.flux[j] + phi[j] - base[j]))
             .collect();
-        let flux_at = super::coupled::Cursor::new(&estimate);
+        let flux_at = super::samples::Cursor::new(&estimate);
         let pull = |t: f64, _x: f64| coil.force_from_flux(flux_at.at(t));
         let next = simulate_drive(mechanics, stops, settings, Drive::Force(&pull))?;
-        let moved = super::coupled::event_change(current.chatter(), next.chatter()).max(
-            super::coupled::event_change(
-                super::coupled::back_of(&current),
-                super::coupled::back_of(&next),
+        let moved = super::samples::event_change(current.chatter(), next.chatter()).max(
+            super::samples::event_change(
+                super::samples::back_of(&current),
+                super::samples::back_of(&next),
             ),
         );
         current = next;
@@ -135,7 +135,7 @@ fn flux_under(coil: &Coil, run: &CircuitRun, driver: &Driver, path: &[(f64, f64)
     let k = coil.permeance_length();
     let a = coil.air_gap + coil.iron_gap;
     // dψ/dt = u − c ψ with c = (R − s)(a − x)/k (see [`Driver`]).
-    let x = super::coupled::Cursor::new(path);
+    let x = super::samples::Cursor::new(path);
     let rate = |j: usize| (coil.resistance - driver.slope[j]) * (a - x.at(run.time[j])) / k;
     let mut psi = first;
     let mut c0 = rate(0);
@@ -174,7 +174,7 @@ impl Driver {
         let n = run.time.len();
         let k = coil.permeance_length();
         let a = coil.air_gap + coil.iron_gap;
-        let x = super::coupled::Cursor::new(run.path);
+        let x = super::samples::Cursor::new(run.path);
         let current: Vec<f64> = (0..n)
             .map(|j| run.flux[j] * (a - x.at(run.time[j])) / k)
             .collect();

@@ -33,24 +33,25 @@
 //!   one ODE in (ψ, x, ẋ) with no circuit simulator: the independent
 //!   cross-check of the coupled ngspice runs, and the reference case of
 //!   docs/model.md §7.
-//! - [`coupled`] and [`accelerate`]: the waveform relaxation with ngspice,
-//!   which feeds the mechanics `F_m(i(t), x)`.
+//! - [`accelerate`]: the coupling's inner loop, which settles the
+//!   mechanics against an estimate of the driver circuit between two
+//!   ngspice passes; the passes themselves (the waveform relaxation that
+//!   feeds the mechanics `F_m(i(t), x)`) are run by the pipeline, which
+//!   owns the circuit simulator.
+//! - [`samples`]: the sampled records those passes exchange.
 //! - [`timing`]: each operation's times as datasheets define them.
 
 pub mod accelerate;
-pub mod coupled;
 pub mod direct;
+pub mod samples;
 pub mod timing;
 
 pub use crate::mechanics::cycle::{Cycle, Stops, Stroke};
 pub use crate::mechanics::forced::{simulate_cycle, simulate_forced, simulate_forced_path};
-pub use coupled::{Coupled, CouplingError, CouplingOptions, run_coupled};
 pub use direct::{
     CoilEvents, CoilRun, CoilState, EnergyBalance, PullInDip, Source, simulate_direct,
 };
 pub use timing::{Closing, Operation, Switching, operations};
-
-use crate::scenario::CoilSection;
 
 /// H/m, the vacuum permeability (CODATA 2018; 4π·10⁻⁷ to 6e-10).
 pub const MU0: f64 = 1.256_637_062_12e-6;
@@ -69,18 +70,6 @@ pub struct Coil {
     pub air_gap: f64,
     /// m, the iron path as an equivalent air gap `l_eq = l_fe/μr`.
     pub iron_gap: f64,
-}
-
-impl From<&CoilSection> for Coil {
-    fn from(c: &CoilSection) -> Self {
-        Coil {
-            resistance: c.resistance,
-            turns: f64::from(c.turns),
-            pole_area: c.pole_area,
-            air_gap: c.air_gap,
-            iron_gap: c.iron_gap,
-        }
-    }
 }
 
 impl Coil {

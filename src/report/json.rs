@@ -13,9 +13,9 @@ use crate::analysis::{Comparison, ProbeAnalysis};
 use crate::arc::{ArcEvent, ArcModel, ArcTotals, Breakdown};
 use crate::chatter::Chatter;
 use crate::check::{Evidence, Verdict};
-use crate::coil::coupled::Iteration;
 use crate::coil::{Closing, Operation};
 use crate::mechanics::Dimensionless;
+use crate::pipeline::coupled::Iteration;
 use crate::pipeline::{RunResult, Simulation};
 
 /// The bounce object, ready to serialize alone or to embed (as `bounce`)
@@ -29,6 +29,8 @@ pub struct BounceJson<'a> {
 }
 
 impl<'a> BounceJson<'a> {
+    /// The object for `chatter`, with the relay's dimensionless groups
+    /// when given.
     pub fn new(chatter: &'a Chatter, dimensionless: Option<&Dimensionless>) -> Self {
         BounceJson {
             chatter,
@@ -145,6 +147,8 @@ struct ContactJson<'a> {
 }
 
 impl<'a> RunJson<'a> {
+    /// The object for `run`; its bounce carries the relay's
+    /// dimensionless groups when given.
     pub fn new(run: &'a RunResult, dimensionless: Option<&Dimensionless>) -> Self {
         let sim = |s: &'a Simulation| (s.elapsed.as_secs_f64(), s.plot.points());
         RunJson {

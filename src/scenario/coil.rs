@@ -56,3 +56,16 @@ impl Check<'_> {
         )
     }
 }
+
+/// The magnet of the section.
+impl From<&CoilSection> for crate::coil::Coil {
+    fn from(c: &CoilSection) -> Self {
+        crate::coil::Coil {
+            resistance: c.resistance,
+            turns: f64::from(c.turns),
+            pole_area: c.pole_area,
+            air_gap: c.air_gap,
+            iron_gap: c.iron_gap,
+        }
+    }
+}

@@ -314,7 +314,7 @@ impl Scenario {
 
     /// The loader's physics rules on the scenario as it now is; the
     /// probes only when asked (their keys are formatted, which allocates).
-    pub(super) fn revalidate(
+    pub(crate) fn revalidate(
         &self,
         probes: bool,
     ) -> Result<(Surface, Option<Surface>), ScenarioError> {

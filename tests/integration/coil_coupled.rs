@@ -9,8 +9,9 @@ use crate::common;
 
 use std::path::Path;
 
-use chatterspice::coil::{Coil, CouplingOptions, Source, run_coupled, simulate_direct};
+use chatterspice::coil::{Coil, Source, simulate_direct};
 use chatterspice::mechanics::Mechanics;
+use chatterspice::pipeline::{CouplingOptions, run_coupled};
 use chatterspice::scenario::Scenario;
 
 fn reference() -> Scenario {
@@ -102,7 +103,7 @@ fn a_coupling_that_cannot_converge_says_so_with_its_last_change() {
     assert!(
         matches!(
             err,
-            chatterspice::coil::CouplingError::NotConverged { iterations: 2, .. }
+            chatterspice::pipeline::CouplingError::NotConverged { iterations: 2, .. }
         ),
         "{text}"
     );

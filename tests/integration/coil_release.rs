@@ -10,7 +10,8 @@ use crate::common;
 use std::path::Path;
 
 use chatterspice::chatter::ContactState;
-use chatterspice::coil::{Coupled, CouplingOptions, Operation, run_coupled};
+use chatterspice::coil::Operation;
+use chatterspice::pipeline::{Coupled, CouplingOptions, run_coupled};
 use chatterspice::scenario::Scenario;
 use chatterspice::spice::Ngspice;
 

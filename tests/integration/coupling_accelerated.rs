@@ -12,7 +12,7 @@ use crate::common;
 use std::path::Path;
 
 use chatterspice::chatter::Chatter;
-use chatterspice::coil::{Coupled, CouplingOptions, run_coupled};
+use chatterspice::pipeline::{Coupled, CouplingOptions, run_coupled};
 use chatterspice::scenario::Scenario;
 
 fn load(name: &str) -> Scenario {

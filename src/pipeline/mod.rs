@@ -17,6 +17,10 @@
 //! the deck and the include that were run, and the raw data, for the
 //! reports to write wherever the caller wants.
 
+pub mod coupled;
+
+pub use coupled::{Coupled, CouplingError, CouplingOptions, Iteration, nc_include, run_coupled};
+
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -26,9 +30,7 @@ use crate::analysis::{self, AnalysisError, Comparison, ProbeAnalysis};
 use crate::arc::element::{ArcVectors, with_arc};
 use crate::arc::{ArcModel, ArcReport, GapProfile, analysis::MissingArcVector};
 use crate::chatter::{Chatter, ContactState, Interval};
-use crate::coil::coupled::Iteration;
-use crate::coil::coupled::nc_include;
-use crate::coil::{CouplingError, CouplingOptions, Operation, run_coupled};
+use crate::coil::Operation;
 use crate::mechanics::{MechanicsError, Trajectory, contact_forces};
 use crate::netlist::{self, ContactElement, ContactInclude, Deck, DeckRequest, NetlistError};
 use crate::rawfile::Plot;
@@ -528,7 +530,7 @@ fn run_coil(
         let text = netlist::coil::coil_include(coil, &circuit.coil_subckt, &coupled.path)?;
         include
             .data_files
-            .push((crate::coil::coupled::COIL_FILE.to_owned(), text));
+            .push((coupled::COIL_FILE.to_owned(), text));
     }
     if let Some(nc) = &circuit.nc_subckt {
         let nc = nc_include(&coupled.back, &model, nc, &scenario.origin)

@@ -7,10 +7,10 @@
 //! following its chatter, reads the coil's flux linkage ψ(t) back, and
 //! runs the mechanics under the magnetic pull it makes,
 //! F_m = ψ²/(2 μ0 N² A) ([`Coil::force_from_flux`]), which depends on the
-//! flux alone and not on where the armature is ([`super::simulate_forced_path`]).
+//! flux alone and not on where the armature is ([`crate::coil::simulate_forced_path`]).
 //! The new path goes into the next circuit run, after the coil and the
 //! mechanics have been settled against that run's coil voltage with no
-//! ngspice ([`super::accelerate`], unless `accelerate` is off): the same
+//! ngspice ([`crate::coil::accelerate`], unless `accelerate` is off): the same
 //! fixed point in fewer runs. The first iteration holds
 //! the armature closed, at the fixed contact: it probes the driver's
 //! voltage with the coil's inductance of the long held stretch and of the
@@ -30,12 +30,15 @@ use std::time::{Duration, Instant};
 
 use thiserror::Error;
 
-use super::accelerate::{CircuitRun, Tolerances, settle};
-use super::timing::{Operation, Switching, operations};
-use super::{Coil, CoilError};
 use crate::arc::GapProfile;
 use crate::arc::element::{ArcVectors, with_arc};
 use crate::chatter::{Chatter, ContactState, Interval};
+use crate::coil::accelerate::{CircuitRun, Tolerances, settle};
+#[cfg(test)]
+use crate::coil::samples::interpolate_at;
+use crate::coil::samples::{Cursor, back_of, event_change, thin};
+use crate::coil::timing::{Operation, Switching, operations};
+use crate::coil::{Coil, CoilError};
 use crate::mechanics::Mechanics;
 use crate::mechanics::cycle::{Stops, Stroke};
 use crate::mechanics::{Drive, Trajectory, simulate_drive};
@@ -64,7 +67,7 @@ pub struct CouplingOptions {
     /// warnings of `run`).
     pub keep_workdir: bool,
     /// Settle the coil and the mechanics against each ngspice run's coil
-    /// voltage before the next run (see [`super::accelerate`]); `false`
+    /// voltage before the next run (see [`crate::coil::accelerate`]); `false`
     /// is the plain relaxation, which hands the mechanics' path straight
     /// back to ngspice. Both converge to the same events.
     pub accelerate: bool,
@@ -103,7 +106,7 @@ pub struct Iteration {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Coupled {
     /// The normally-open contact over the whole run (see
-    /// [`super::Cycle::make`]).
+    /// [`crate::coil::Cycle::make`]).
     pub chatter: Chatter,
     /// The rest stop as the normally-closed contact.
     pub back: Chatter,
@@ -496,50 +499,6 @@ pub fn run_coupled(
 /// many as ngspice's own steps over it.
 const PATH_TOLERANCE: f64 = 1e-5;
 
-/// The points of `path` (s, m) that its linear interpolation needs to
-/// stay within `tolerance` (m) of every point: the integrator's steps
-/// are far denser than the path's shape needs (thousands of them while
-/// the contact rests), and each one would be a breakpoint for ngspice.
-/// The first and last points are always kept.
-pub fn thin(path: &[(f64, f64)], tolerance: f64) -> Vec<(f64, f64)> {
-    let Some(&first) = path.first() else {
-        return Vec::new();
-    };
-    let mut out = vec![first];
-    let mut start = 0;
-    let mut end = 2;
-    // The chord from `start` passes within `tolerance` of an intermediate
-    // point (t, x) exactly when its slope lies in
-    // [(x − tol − x0)/(t − t0), (x + tol − x0)/(t − t0)]: keep the
-    // intersection over the points passed so far, one point per step.
-    let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
-    while end < path.len() {
-        let (t0, x0) = path[start];
-        let (tm, xm) = path[end - 1];
-        let dt = tm - t0;
-        if dt > 0.0 {
-            lo = lo.max((xm - tolerance - x0) / dt);
-            hi = hi.min((xm + tolerance - x0) / dt);
-        } else if (xm - x0).abs() > tolerance {
-            (lo, hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        }
-        let (t1, x1) = path[end];
-        let slope = (x1 - x0) / (t1 - t0);
-        if slope >= lo && slope <= hi {
-            end += 1;
-        } else {
-            start = end - 1;
-            out.push(path[start]);
-            end = start + 2;
-            (lo, hi) = (f64::NEG_INFINITY, f64::INFINITY);
-        }
-    }
-    if path.len() > 1 {
-        out.push(path[path.len() - 1]);
-    }
-    out
-}
-
 /// The normally-closed contact's subcircuit `subckt`, following the
 /// rest stop's chatter `back`, with the NO contact's electrical model: a
 /// PWL include appended to the contact's (its few dozen points never need
@@ -571,13 +530,6 @@ fn records(
     (make, back, path, strokes)
 }
 
-/// The rest stop's record of a driven cycle.
-pub(super) fn back_of(trajectory: &Trajectory) -> &Chatter {
-    trajectory
-        .back()
-        .expect("a driven cycle records its rest stop")
-}
-
 /// A contact in `state` from 0 to `t_end`: before the first iteration,
 /// the NO contact open and the NC contact closed (the armature at rest).
 fn steady_chatter(state: ContactState, t_end: f64) -> Chatter {
@@ -588,24 +540,6 @@ fn steady_chatter(state: ContactState, t_end: f64) -> Chatter {
     }])
 }
 
-/// s, the largest move of an impact or release time between two
-/// sequences; infinite when they do not have the same events.
-pub(super) fn event_change(a: &Chatter, b: &Chatter) -> f64 {
-    if a.impacts.len() != b.impacts.len() {
-        return f64::INFINITY;
-    }
-    let mut change: f64 = 0.0;
-    for (p, q) in a.impacts.iter().zip(&b.impacts) {
-        change = change.max((p.impact_time - q.impact_time).abs());
-        match (p.release_time, q.release_time) {
-            (Some(r), Some(s)) => change = change.max((r - s).abs()),
-            (None, None) => {}
-            _ => return f64::INFINITY,
-        }
-    }
-    change
-}
-
 /// (time, value) of vector `name` in a transient plot.
 fn series(plot: &Plot, name: &str) -> Option<Vec<(f64, f64)>> {
     let Some(Vector::Real(time)) = plot.scale() else {
@@ -613,59 +547,6 @@ fn series(plot: &Plot, name: &str) -> Option<Vec<(f64, f64)>> {
     };
     let values = plot.real(name)?;
     Some(time.iter().copied().zip(values.iter().copied()).collect())
-}
-
-/// Linear interpolation in (time, value) samples, held before the first
-/// and after the last, for a caller that asks at times close to the last
-/// (an integrator stepping through the record): it first tries the
-/// interval of the previous call and its neighbour before searching.
-pub(super) struct Cursor<'a> {
-    samples: &'a [(f64, f64)],
-    hint: std::cell::Cell<usize>,
-}
-
-impl<'a> Cursor<'a> {
-    pub(super) fn new(samples: &'a [(f64, f64)]) -> Self {
-        Cursor {
-            samples,
-            hint: std::cell::Cell::new(1),
-        }
-    }
-
-    /// The sample value at `t`.
-    pub(super) fn at(&self, t: f64) -> f64 {
-        let s = self.samples;
-        // k is the first index whose time is past t: unique, so a hint
-        // that brackets t is the answer the search would give.
-        let brackets = |k: usize| k > 0 && k < s.len() && s[k - 1].0 <= t && s[k].0 > t;
-        let hint = self.hint.get();
-        let k = if brackets(hint) {
-            hint
-        } else if brackets(hint + 1) {
-            hint + 1
-        } else {
-            s.partition_point(|&(ts, _)| ts <= t)
-        };
-        self.hint.set(k);
-        interpolate_at(s, t, k)
-    }
-}
-
-/// The value at `t` given `k`, the first sample past `t`.
-fn interpolate_at(samples: &[(f64, f64)], t: f64, k: usize) -> f64 {
-    if k == 0 {
-        return samples.first().map_or(0.0, |&(_, v)| v);
-    }
-    if k == samples.len() {
-        return samples[k - 1].1;
-    }
-    let (t0, v0) = samples[k - 1];
-    let (t1, v1) = samples[k];
-    if t1 > t0 {
-        v0 + (v1 - v0) * (t - t0) / (t1 - t0)
-    } else {
-        v1
-    }
 }
 
 #[cfg(test)]
