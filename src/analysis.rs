@@ -55,13 +55,18 @@ use crate::scenario::Probe;
 
 /// Why a signal could not be analysed.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum AnalysisError {
+    /// The probed signal is neither a vector of the plot nor a `v(a,b)`
+    /// of two node voltages it holds.
     #[error(
         "`{signal}` is not a vector of the plot \"{plot}\"; change the probe's `signal` to one of: {}",
         available.join(", ")
     )]
     MissingSignal {
+        /// The probe's signal, as written.
         signal: String,
+        /// The plot's name (its `Plotname:`).
         plot: String,
         /// The plot's vector names, sorted.
         available: Vec<String>,
@@ -69,75 +74,130 @@ pub enum AnalysisError {
     #[error(
         "`{signal}` in the plot \"{plot}\" is complex; edges need a transient analysis (`.tran`)"
     )]
-    ComplexSignal { signal: String, plot: String },
+    /// The signal's vector holds complex values (an AC or noise plot).
+    ComplexSignal {
+        /// The probe's signal, as written.
+        signal: String,
+        /// The plot's name.
+        plot: String,
+    },
     #[error(
         "the plot \"{plot}\" has {} as its scale, not time; analyse the transient plot (`.tran`)",
         scale.as_deref().map_or_else(|| "no vector".to_owned(), |s| format!("`{s}`"))
     )]
-    NotTransient { plot: String, scale: Option<String> },
+    /// The plot's scale (its first vector) is not a real `time` vector.
+    NotTransient {
+        /// The plot's name.
+        plot: String,
+        /// The name of the plot's scale vector; `None` if it has no vectors.
+        scale: Option<String>,
+    },
+    /// The signal has no samples.
     #[error("`{signal}` has no samples; the simulation wrote no points")]
-    Empty { signal: String },
+    Empty {
+        /// The signal's name.
+        signal: String,
+    },
     #[error(
         "`{signal}` has {values} samples but time has {time}; \
          the raw file's vectors must have one value per time point"
     )]
+    /// The signal and the time scale have different numbers of samples.
     LengthMismatch {
+        /// The signal's name.
         signal: String,
+        /// The number of time samples.
         time: usize,
+        /// The number of signal samples.
         values: usize,
     },
     #[error(
         "`{signal}` is {value} at t = {time:e} s (sample {index}); \
          the simulation diverged there, check the circuit and the ngspice log"
     )]
+    /// A sample of the signal, or of time (then `signal` is `"time"`), is
+    /// NaN or infinite.
     NotFinite {
+        /// The signal's name, or `"time"`.
         signal: String,
+        /// The 0-based index of the sample.
         index: usize,
         /// s; NaN itself when the time is what is not finite.
         time: f64,
+        /// The sample that is not finite, in the signal's unit.
         value: f64,
     },
     #[error(
         "time goes back from {previous:e} s to {time:e} s at sample {index}; \
          the scale must not decrease (is this the transient plot?)"
     )]
+    /// A time sample is smaller than the one before it.
     TimeGoesBack {
+        /// The 0-based index of the sample.
         index: usize,
+        /// s, the sample before.
         previous: f64,
+        /// s, the sample at `index`.
         time: f64,
     },
     #[error(
         "probe `{signal}`: thresholds low = {low} and high = {high} need low < high, both finite; \
          change the probe's `low`/`high`"
     )]
-    Thresholds { signal: String, low: f64, high: f64 },
+    /// The probe's thresholds are not finite with `low < high`.
+    Thresholds {
+        /// The probe's signal.
+        signal: String,
+        /// The `low` threshold, in the signal's unit.
+        low: f64,
+        /// The `high` threshold, in the signal's unit.
+        high: f64,
+    },
     #[error(
         "closure {index} of `{signal}` runs from {start:e} s to {end:e} s; \
          a closure needs finite start <= end"
     )]
+    /// A closure window is not finite or ends before it starts.
     BadClosure {
+        /// The current probe's signal.
         signal: String,
+        /// The 0-based index of the closure.
         index: usize,
+        /// s
         start: f64,
+        /// s
         end: f64,
     },
     #[error(
         "closure {index} ({start:e} s to {end:e} s) lies outside the record of `{signal}` \
          ({record_start:e} s to {record_end:e} s); simulate up to the sequence's end"
     )]
+    /// A closure window lies wholly before or after the simulated record.
     ClosureOutsideRecord {
+        /// The current probe's signal.
         signal: String,
+        /// The 0-based index of the closure.
         index: usize,
+        /// s
         start: f64,
+        /// s
         end: f64,
+        /// s, the first time sample.
         record_start: f64,
+        /// s, the last time sample.
         record_end: f64,
     },
     #[error(
         "cannot compare `{bounced}` with `{ideal}`: the ideal run must analyse the same signal \
          with the same thresholds"
     )]
-    NotComparable { bounced: String, ideal: String },
+    /// [`compare`] was given analyses of different signals or thresholds.
+    NotComparable {
+        /// The bounced run's signal.
+        bounced: String,
+        /// The ideal run's signal.
+        ideal: String,
+    },
 }
 
 /// What a probed vector measures, deciding units and the current analysis.
@@ -187,7 +247,9 @@ impl ProbeKind {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Level {
+    /// The signal last reached `low` (v ≤ low), not `high` since.
     Low,
+    /// The signal last reached `high` (v ≥ high), not `low` since.
     High,
     /// Between the thresholds and neither reached yet.
     Undetermined,
@@ -208,6 +270,7 @@ pub enum Direction {
 pub struct Edge {
     /// s, the interpolated crossing of the threshold.
     pub time: f64,
+    /// Rising (crossed `high`) or falling (crossed `low`).
     pub direction: Direction,
     /// s, time to the next edge: the width of the pulse this edge starts.
     /// `None` for the last edge, whose level lasts to the end of the record.
@@ -260,6 +323,7 @@ pub struct CurrentAnalysis {
 /// `null` in JSON, never omitted.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ProbeAnalysis {
+    /// The probe's signal, as written in the scenario.
     pub signal: String,
     /// Number of Schmitt edges.
     pub edges: usize,
@@ -273,11 +337,15 @@ pub struct ProbeAnalysis {
     pub min: f64,
     /// Largest sample.
     pub max: f64,
+    /// Voltage, current or other: decides the unit and the current analysis.
     pub kind: ProbeKind,
-    /// The thresholds used, in the signal's unit.
+    /// The `low` threshold used, in the signal's unit.
     pub low: f64,
+    /// The `high` threshold used, in the signal's unit.
     pub high: f64,
+    /// Schmitt level at the first sample.
     pub initial_state: Level,
+    /// Schmitt level at the last sample.
     pub final_state: Level,
     /// The last sample.
     pub final_value: f64,
@@ -332,6 +400,7 @@ impl ProbeAnalysis {
 /// Every difference is *bounced − ideal*: positive means the bounce added.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Comparison {
+    /// The bounced run's signal.
     pub signal: String,
     /// Edges the bounce added (negative if it removed some).
     pub extra_edges: i64,

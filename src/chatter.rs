@@ -132,7 +132,9 @@ impl Impact {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ContactState {
+    /// The contacts are apart: no current flows.
     Open,
+    /// The contacts touch: the contact conducts.
     Closed,
 }
 
@@ -151,6 +153,7 @@ impl ContactState {
 /// of zero length).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Interval {
+    /// The state throughout the interval.
     pub state: ContactState,
     /// s
     pub start: f64,
@@ -161,6 +164,7 @@ pub struct Interval {
 /// The complete result of one closing.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Chatter {
+    /// How the sequence ended.
     pub outcome: Outcome,
     /// s, the first touch; `None` if the contact never closes.
     pub first_impact: Option<f64>,
@@ -169,7 +173,11 @@ pub struct Chatter {
     pub settle_time: Option<f64>,
     /// Releases after the first impact that opened the contact.
     pub bounce_count: usize,
+    /// Every impact, in time order; empty for a recorded sequence of
+    /// states ([`Chatter::from_intervals`]).
     pub impacts: Vec<Impact>,
+    /// The contact's states, in time order, each starting where the one
+    /// before ends.
     pub intervals: Vec<Interval>,
     /// m, for `never_closes`: how far short of the gap the moving contact
     /// turns back (gap − largest reach). `None` otherwise.

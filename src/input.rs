@@ -21,11 +21,17 @@ pub const MAX_TEXT_BYTES: u64 = 512 * 1024 * 1024;
 /// What a path that is not a regular file turned out to be.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum NotRegular {
+    /// A directory.
     Directory,
+    /// A FIFO (named pipe): reading it would wait for a writer.
     Fifo,
+    /// A Unix domain socket.
     Socket,
+    /// A character device, such as `/dev/zero`, which may never end.
     CharDevice,
+    /// A block device, such as a disk.
     BlockDevice,
+    /// Anything else that is not a regular file.
     Other,
 }
 

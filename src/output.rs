@@ -33,29 +33,54 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum WriteError {
+    /// The output exists and `--force` was not given.
     #[error("{}: already exists; it was left untouched (pass --force to replace it)", path.display())]
-    Exists { path: PathBuf },
+    Exists {
+        /// The output path.
+        path: PathBuf,
+    },
+    /// The output resolves to a file the run reads.
     #[error(
         "{}: this is an input of the run (the scenario, its netlist, a file it includes or a \
          record); --force overwrites earlier outputs, never inputs: choose another output",
         path.display()
     )]
-    IsInput { path: PathBuf },
+    IsInput {
+        /// The output path, as given.
+        path: PathBuf,
+    },
+    /// With `--force`, the output path holds something other than a
+    /// regular file or a symbolic link.
     #[error(
         "{}: {what} is in the way of an output and is left alone: move it, or choose another \
          output",
         path.display()
     )]
-    InTheWay { path: PathBuf, what: &'static str },
+    InTheWay {
+        /// The output path.
+        path: PathBuf,
+        /// What is there: `"a directory"` or `"a special file"`.
+        what: &'static str,
+    },
+    /// Another process holds the output's lock.
     #[error(
         "{}: another chatterspice run is writing these outputs now (it holds {}): wait for it, \
          or choose another output",
         dir.display(), lock.display()
     )]
-    Busy { dir: PathBuf, lock: PathBuf },
+    Busy {
+        /// The directory of the outputs.
+        dir: PathBuf,
+        /// The lock file held.
+        lock: PathBuf,
+    },
+    /// The file system refused an operation on an output or its directory
+    /// (creating, writing, renaming, locking).
     #[error("{}: cannot write it", path.display())]
     Io {
+        /// The file or directory the operation was on.
         path: PathBuf,
+        /// The operating system's error.
         #[source]
         source: std::io::Error,
     },

@@ -67,6 +67,19 @@ impl Plan {
         })
     }
 
+    /// [`Plan::new`] without reading the netlist: for what runs no
+    /// circuit (the mechanics alone), so that a netlist that cannot be
+    /// read does not stop it; [`Plan::netlist`] is then `None`.
+    pub fn without_circuit(scenario: Scenario) -> Result<Plan, ScenarioError> {
+        let (surface, back_stop) = scenario.revalidate(true)?;
+        Ok(Plan {
+            scenario,
+            surface,
+            back_stop,
+            netlist: None,
+        })
+    }
+
     /// A new plan with the numbers `values` (`key`, value) set, each key as
     /// in a scenario file (`mechanics.mass`, `circuit.params.cf`, ...):
     /// validated again, the netlist's text shared, not read again.

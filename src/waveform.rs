@@ -65,13 +65,20 @@ const MIN_EDGE_RELATIVE: f64 = 9.094_947_017_729_282e-13;
 /// Errors of this stage. Contact parameters name their scenario key; CSV
 /// problems name the file and line.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum WaveformError {
+    /// A contact parameter is out of its range or not finite.
     #[error("`{key}` = {value:?} {requirement}")]
     InvalidContact {
+        /// The scenario key, e.g. `contact.r_closed`.
         key: &'static str,
+        /// The value given, in the key's unit (Ω, s, N, ...).
         value: f64,
+        /// What the value must satisfy.
         requirement: String,
     },
+    /// `edge_time` is too small for the waveform's times to resolve
+    /// (below about 9.1e-13 of the largest time).
     #[error(
         "the waveform runs to {t_end:?} s (`simulation.t_end`), so long that its times cannot \
          resolve edges of `contact.edge_time` = {edge_time:?} s: lower `simulation.t_end` to \
@@ -79,31 +86,53 @@ pub enum WaveformError {
          `contact.edge_time` to at least {minimum:e} s"
     )]
     EdgeBelowResolution {
+        /// s, `contact.edge_time`.
         edge_time: f64,
+        /// s, the end of the sequence.
         t_end: f64,
+        /// s, the smallest edge time it resolves.
         minimum: f64,
     },
+    /// The sequence of states is empty.
     #[error("the state sequence has no intervals: give at least one")]
     NoIntervals,
+    /// An interval is not finite, ends before it starts, or does not
+    /// start where the one before it ends.
     #[error("interval {index} ({start:?} s to {end:?} s) {problem}")]
     BadInterval {
+        /// The 0-based index of the interval.
         index: usize,
+        /// s
         start: f64,
+        /// s
         end: f64,
+        /// What is wrong with it.
         problem: &'static str,
     },
+    /// A state CSV's first non-blank line is not `time,state`.
     #[error("{}: line {line}: the header must be `time,state`, found `{found}`: add that header as the first line", path.display())]
     CsvHeader {
+        /// The CSV file.
         path: PathBuf,
+        /// 1-based line of the header.
         line: usize,
+        /// The line found instead.
         found: String,
     },
+    /// A state CSV has a header and no rows.
     #[error("{}: no state rows after the header: add at least one `time,state` row", path.display())]
-    CsvEmpty { path: PathBuf },
+    CsvEmpty {
+        /// The CSV file.
+        path: PathBuf,
+    },
+    /// A row of a state CSV cannot be read.
     #[error("{}: line {line}: {problem}", path.display())]
     CsvRow {
+        /// The CSV file.
         path: PathBuf,
+        /// 1-based line of the row.
         line: usize,
+        /// What is wrong with it.
         problem: CsvProblem,
     },
 }
@@ -111,21 +140,47 @@ pub enum WaveformError {
 /// What is wrong with one row of a state-change CSV.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum CsvProblem {
+    /// The row does not have two fields.
     #[error("expected 2 fields `time,state`, found {found}")]
-    FieldCount { found: usize },
+    FieldCount {
+        /// The number of fields found.
+        found: usize,
+    },
+    /// The time is not a number.
     #[error("time `{text}` is not a number: write seconds, e.g. 1.5e-3")]
-    BadTime { text: String },
+    BadTime {
+        /// The time field, as written.
+        text: String,
+    },
+    /// The time is NaN or infinite.
     #[error("time `{text}` is not finite: write seconds, e.g. 1.5e-3")]
-    NonFiniteTime { text: String },
+    NonFiniteTime {
+        /// The time field, as written.
+        text: String,
+    },
+    /// The time is below 0.
     #[error("time {time:?} s is negative: shift the record so that it starts at t >= 0")]
-    NegativeTime { time: f64 },
+    NegativeTime {
+        /// s
+        time: f64,
+    },
+    /// The time is not after the previous row's.
     #[error(
         "time {time:?} s does not follow the previous row's {previous:?} s: \
          rows must be in strictly increasing time"
     )]
-    NonIncreasingTime { time: f64, previous: f64 },
+    NonIncreasingTime {
+        /// s, this row's time.
+        time: f64,
+        /// s, the previous row's time.
+        previous: f64,
+    },
+    /// The state is none of `open`, `closed`, `0`, `1`.
     #[error("state `{text}` is not one of `open`, `closed`, `0` (open), `1` (closed)")]
-    UnknownState { text: String },
+    UnknownState {
+        /// The state field, as written.
+        text: String,
+    },
 }
 
 /// The contact as a resistor (`[contact]` of the scenario). SI units.
@@ -509,10 +564,12 @@ impl Waveform {
         self.make_edges + self.break_edges
     }
 
+    /// Make edges emitted (open to closed).
     pub fn make_edges(&self) -> usize {
         self.make_edges
     }
 
+    /// Break edges emitted (closed to open).
     pub fn break_edges(&self) -> usize {
         self.break_edges
     }

@@ -61,7 +61,9 @@ pub struct ArcEvent {
 /// to arc).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Breakdown {
+    /// Which operation (0-based), as [`ArcEvent::operation`].
     pub operation: usize,
+    /// Which opening it happened in, as [`ArcEvent::opening`].
     pub opening: String,
     /// s
     pub start: f64,
@@ -80,9 +82,11 @@ pub struct Breakdown {
 /// The totals over the run.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ArcTotals {
+    /// The number of arcs.
     pub count: usize,
     /// J, all arcs.
     pub energy: f64,
+    /// The number of breakdowns.
     pub breakdowns: usize,
     /// J, all breakdowns.
     pub breakdown_energy: f64,
@@ -98,9 +102,13 @@ pub struct ArcTotals {
 /// Arcs, breakdowns and totals of one run.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ArcReport {
+    /// The arc model the run used.
     pub model: ArcModel,
+    /// Every arc, in time order.
     pub arcs: Vec<ArcEvent>,
+    /// Every breakdown, in time order.
     pub breakdowns: Vec<Breakdown>,
+    /// Counts and energies over the run.
     pub totals: ArcTotals,
     /// V, the largest |v| across the contact over the run.
     pub peak_voltage: f64,
@@ -114,7 +122,10 @@ pub struct ArcReport {
      save everything in the contact's subcircuit, or instantiate the contact at the top level"
 )]
 pub struct MissingArcVector {
+    /// The contact instance, e.g. `x1`.
     pub instance: String,
+    /// The vector not found, e.g. `i(v.x1.vsense)`, or `time` when the
+    /// plot has no real time scale.
     pub vector: String,
 }
 

@@ -80,6 +80,7 @@ pub struct ArcVectors {
 }
 
 impl ArcVectors {
+    /// The vectors of `instance` at the top level of the netlist.
     pub fn of(instance: &str) -> ArcVectors {
         ArcVectors {
             current: format!("i(v.{instance}.vsense)"),
@@ -89,6 +90,7 @@ impl ArcVectors {
         }
     }
 
+    /// The four names: current, voltage, state, clamp.
     pub fn all(&self) -> [&str; 4] {
         [&self.current, &self.voltage, &self.state, &self.clamp]
     }

@@ -45,6 +45,7 @@ impl GapProfile {
         }
     }
 
+    /// The `(time, gap)` points (s, m), times strictly increasing, gaps ≥ 0.
     pub fn samples(&self) -> &[(f64, f64)] {
         &self.samples
     }

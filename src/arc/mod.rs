@@ -29,16 +29,24 @@ pub use gap::GapProfile;
 /// A contact material with published minimum arc voltage and current.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Material {
+    /// Silver.
     Ag,
+    /// Silver–nickel.
     AgNi,
+    /// Silver–tin oxide.
     AgSnO2,
+    /// Gold.
     Au,
+    /// Copper.
     Cu,
+    /// Palladium.
     Pd,
+    /// Tungsten.
     W,
 }
 
 impl Material {
+    /// Every material, in the order above.
     pub const ALL: [Material; 7] = [
         Material::Ag,
         Material::AgNi,

@@ -95,73 +95,126 @@ const SURVEY_PER_KEY: usize = 40;
 
 /// Why a fit cannot start.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum FitError {
+    /// Neither the request nor the scenario's `[fit]` names a free key.
     #[error(
         "no free keys: list the keys the fit may move in [fit] free = [...] or with --free KEY,..."
     )]
     NoFreeKeys,
+    /// A free key is not a number key of the scenario.
     #[error("{path}: free key `{key}`: {source}")]
     UnknownKey {
+        /// The scenario file.
         path: String,
+        /// The free key, e.g. `surface.damping`.
         key: String,
+        /// Why the scenario does not know the key.
         #[source]
         source: Box<ScenarioError>,
     },
+    /// A free key is left unset in the scenario: there is no prior.
     #[error(
         "{path}: free key `{key}` has no value in the scenario to start from: give it a prior value"
     )]
-    NoPrior { path: String, key: String },
+    NoPrior {
+        /// The scenario file.
+        path: String,
+        /// The free key.
+        key: String,
+    },
+    /// A free key's prior is zero, negative or not finite: the fit works
+    /// in logarithms.
     #[error(
         "{path}: free key `{key}` = {value} cannot be fitted: the fit works in logarithms and needs a positive prior"
     )]
     NotPositive {
+        /// The scenario file.
         path: String,
+        /// The free key.
         key: String,
+        /// The prior value, in the key's unit.
         value: f64,
     },
+    /// A key's `[fit] bounds` are not positive and increasing, or do not
+    /// contain its prior.
     #[error(
         "{path}: [fit] bounds for `{key}` = [{low}, {high}] must be positive, increasing and contain the prior {prior}"
     )]
     Bounds {
+        /// The scenario file.
         path: String,
+        /// The free key.
         key: String,
+        /// The lower bound, in the key's unit.
         low: f64,
+        /// The upper bound, in the key's unit.
         high: f64,
+        /// The prior value, in the key's unit.
         prior: f64,
     },
+    /// Neither a record nor a `[datasheet]` figure was given.
     #[error(
         "nothing to fit to: pass --capture or --measured, or give figures in the scenario's [datasheet]"
     )]
     NoEvidence,
+    /// The scenario has datasheet figures but no `[coil]` to compute them.
     #[error(
         "{path}: [datasheet] {figure} needs a coil: add a [coil] section (the datasheet figures are those of a coil-driven relay)"
     )]
-    NeedsCoil { path: String, figure: &'static str },
+    NeedsCoil {
+        /// The scenario file.
+        path: String,
+        /// The first datasheet figure given, e.g. `pick_up_voltage`.
+        figure: &'static str,
+    },
+    /// A time figure, or a record of a coil-driven relay, needs the
+    /// `[datasheet] coil_voltage` it was measured with.
     #[error(
         "{path}: [datasheet] coil_voltage is needed: the times and a coil-driven record are measured with that DC step on the coil"
     )]
-    NeedsVoltage { path: String },
+    NeedsVoltage {
+        /// The scenario file.
+        path: String,
+    },
+    /// A datasheet figure (or `coil_voltage`) is not positive and finite.
     #[error("{path}: [datasheet] {figure} = {value} must be a positive, finite number")]
     BadFigure {
+        /// The scenario file.
         path: String,
+        /// The figure's key, e.g. `operate_time`.
         figure: &'static str,
+        /// The value given (V or s).
         value: f64,
     },
+    /// The record has a single state: no event to match.
     #[error("{name}: the record has no make or break edge to fit")]
-    EmptyRecord { name: String },
+    EmptyRecord {
+        /// The record's name.
+        name: String,
+    },
+    /// The scenario with its prior values fails to simulate.
     #[error("{path}: the prior scenario cannot be simulated: {message}")]
-    Prior { path: String, message: String },
+    Prior {
+        /// The scenario file.
+        path: String,
+        /// Why it cannot be simulated.
+        message: String,
+    },
 }
 
 /// A make (the contact closes) or a break (it opens).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum EventKind {
+    /// The contact closes.
     Make,
+    /// The contact opens.
     Break,
 }
 
 impl EventKind {
+    /// `"make"` or `"break"`, as in the JSON report.
     pub fn as_str(self) -> &'static str {
         match self {
             EventKind::Make => "make",
@@ -173,6 +226,7 @@ impl EventKind {
 /// One change of contact state.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Event {
+    /// Make or break.
     pub kind: EventKind,
     /// s
     pub time: f64,
@@ -198,7 +252,9 @@ pub fn events_of(intervals: &[Interval]) -> Vec<Event> {
 /// provenance) and its states.
 #[derive(Debug, Clone)]
 pub struct Record {
+    /// The file or capture it came from, as messages name it.
     pub name: String,
+    /// The contact's states, tiling the record's time in order.
     pub intervals: Vec<Interval>,
 }
 
@@ -214,17 +270,23 @@ pub struct FitRequest {
 /// One free key's outcome.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ParameterRow {
+    /// The scenario key, e.g. `mechanics.preload`.
     pub key: String,
+    /// The value the fit started from, in the key's unit.
     pub prior: f64,
+    /// The fitted value, in the key's unit.
     pub value: f64,
     /// 1σ; `None` for a key held at its prior.
     pub sigma: Option<f64>,
+    /// Whether the evidence fixes the key: not held at its prior, and its
+    /// 1σ smaller than its value.
     pub determined: bool,
 }
 
 /// One measured event against the model's.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct EventRow {
+    /// Make or break.
     pub kind: EventKind,
     /// s, on the record's time axis; `None` for a model event the record
     /// lacks.
@@ -232,23 +294,32 @@ pub struct EventRow {
     /// s, on the record's time axis (model time less the offset); `None`
     /// for a measured event the model lacks.
     pub model: Option<f64>,
+    /// s, model − measured; `None` unless both are known.
     pub residual: Option<f64>,
     /// The event was set aside as the one bad edge.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub dropped: bool,
 }
 
+/// The bounces (breaks) of the record against the model's, over the
+/// matched events.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct BounceCount {
+    /// Breaks in the record.
     pub measured: usize,
+    /// Breaks in the model.
     pub model: usize,
 }
 
 /// One datasheet figure against the model's.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FigureRow {
+    /// The `[datasheet]` key, e.g. `pick_up_voltage`.
     pub figure: &'static str,
+    /// The datasheet's value (V for a voltage, s for a time).
     pub target: f64,
+    /// The model's value, same unit; `None` when the model does not show
+    /// it (it never closes, say) or does not model it (`release_time`).
     pub model: Option<f64>,
     /// (model − target)/target.
     pub residual: Option<f64>,
@@ -259,21 +330,31 @@ pub struct FigureRow {
 /// The result of [`fit`].
 #[derive(Debug, Clone, Serialize)]
 pub struct FitReport {
+    /// One row per free key, in the order given.
     pub parameters: Vec<ParameterRow>,
+    /// The record's events against the model's, in time order; empty
+    /// without a record.
     pub events: Vec<EventRow>,
     /// `None` (null) without a record.
     pub bounce_count: Option<BounceCount>,
+    /// One row per datasheet figure given; empty without a datasheet.
     pub datasheet: Vec<FigureRow>,
+    /// s, model time minus record time (the record's trigger is not the
+    /// model's zero); `None` without a record.
     pub time_offset: Option<f64>,
     /// s for a record fit (events only); relative for a datasheet-only fit.
     pub rms_residual: f64,
+    /// How many times the model was simulated.
     pub evaluations: usize,
     /// s, wall clock.
     pub elapsed: f64,
     /// What the fit decided on its own (held keys, a dropped edge).
     pub notes: Vec<String>,
+    /// The scenario with the fitted values and its `[provenance]`.
     #[serde(skip)]
     pub fitted: Scenario,
+    /// What was fitted to: the record's name and/or `datasheet`, joined
+    /// by ` + `.
     #[serde(skip)]
     pub fitted_to: String,
 }

@@ -22,7 +22,9 @@ use crate::scenario::{Scenario, ScenarioError};
 #[derive(Debug, Error)]
 #[error("no bundled part `{name}`; the parts are: {known}")]
 pub struct UnknownPart {
+    /// The name asked for.
     pub name: String,
+    /// The bundled parts' names, comma-separated.
     pub known: String,
 }
 
@@ -126,18 +128,33 @@ pub fn find(name: &str) -> Result<Part, UnknownPart> {
 #[derive(Debug, Clone, Serialize)]
 #[serde(untagged)]
 pub enum Figure {
-    Given { value: f64, model: Option<f64> },
+    /// The datasheet prints it.
+    Given {
+        /// The printed value (V, Ω or s).
+        value: f64,
+        /// The fitted scenario's value, same unit; `None` when it does not
+        /// model it.
+        model: Option<f64>,
+    },
+    /// The datasheet does not print it: the text to show instead.
     NotGiven(&'static str),
 }
 
 /// One part as `parts --format json` lists it.
 #[derive(Debug, Clone, Serialize)]
 pub struct Listing {
+    /// As [`Part::name`].
     pub name: &'static str,
+    /// As [`Part::class`].
     pub class: &'static str,
+    /// Every datasheet figure (`coil_voltage`, `pick_up_voltage`, …), by
+    /// key, printed or not.
     pub datasheet: std::collections::BTreeMap<&'static str, Figure>,
+    /// As [`Part::contact_rating`].
     pub contact_rating: &'static str,
+    /// As [`Part::source`].
     pub source: &'static str,
+    /// As [`Part::remark`].
     pub remark: &'static str,
 }
 

@@ -108,11 +108,17 @@ pub fn overlay_svg(measured: &[Interval], report: &FitReport) -> String {
 /// times on the record's axis, its levels and thresholds in its unit.
 #[derive(Debug, Clone, Copy)]
 pub struct TraceOverlay<'a> {
+    /// s, the samples' times on the record's axis.
     pub time: &'a [f64],
+    /// The samples (V, or whatever the capture measured), one per time.
     pub value: &'a [f64],
+    /// The trace's level while the contact is open.
     pub open: f64,
+    /// The trace's level while the contact is closed.
     pub closed: f64,
+    /// The lower edge threshold, in the trace's unit.
     pub low: f64,
+    /// The upper edge threshold, in the trace's unit.
     pub high: f64,
 }
 

@@ -22,21 +22,26 @@ use crate::chatter::{ContactState, Interval};
 /// Which level means closed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Closed {
+    /// The higher of the two levels means closed.
     High,
+    /// The lower of the two levels means closed.
     Low,
 }
 
 /// What the trace shows.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Edges {
-    /// The open and closed levels, in the trace's unit.
+    /// The open level, in the trace's unit.
     pub open: f64,
+    /// The closed level, in the trace's unit.
     pub closed: f64,
-    /// The hysteresis thresholds (low < high).
+    /// The lower hysteresis threshold (low < high), in the trace's unit.
     pub low: f64,
+    /// The upper hysteresis threshold, in the trace's unit.
     pub high: f64,
-    /// s, every make and break, in order.
+    /// s, every make, in order.
     pub makes: Vec<f64>,
+    /// s, every break, in order.
     pub breaks: Vec<f64>,
     /// The contact's states from the first sample to the last.
     pub intervals: Vec<Interval>,
@@ -44,20 +49,40 @@ pub struct Edges {
 
 /// Why a trace has no chatter to find.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum EdgeError {
+    /// Every sample has the same value.
     #[error("the trace is flat ({value} throughout): there is no second level to find")]
-    Flat { value: f64 },
+    Flat {
+        /// The trace's only value.
+        value: f64,
+    },
+    /// The two most populated levels are within the trace's noise (or a
+    /// few steps of its resolution): the trace shows one level only.
     #[error(
         "the trace stays at one level ({level}, noise σ {noise}): its other values (up to \
          {other}) are within the noise, so it shows no make or break; check the channel \
          (--channel) and that the capture caught the closing"
     )]
-    OneLevel { level: f64, other: f64, noise: f64 },
+    OneLevel {
+        /// The level the trace stays at.
+        level: f64,
+        /// The other candidate level, within the noise of `level`.
+        other: f64,
+        /// The trace's noise, 1σ.
+        noise: f64,
+    },
+    /// The user's thresholds are not finite with `low < high`.
     #[error(
         "the thresholds low = {low} and high = {high} must be finite with low < high, \
          in the trace's unit"
     )]
-    Thresholds { low: f64, high: f64 },
+    Thresholds {
+        /// The lower threshold given.
+        low: f64,
+        /// The upper threshold given.
+        high: f64,
+    },
 }
 
 /// The two levels of `value`, lower first.

@@ -30,16 +30,24 @@ use thiserror::Error;
 /// Which exporter wrote the file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Layout {
+    /// A header row, then rows of time and values.
     Plain,
+    /// Tektronix TDS: settings in columns 1–3, time and value in 4 and 5.
     TektronixTds,
+    /// Tektronix MSO/MDO: metadata rows, then a `TIME,CH1,...` header.
     TektronixMso,
+    /// Keysight / Agilent InfiniiVision: `x-axis,1,...` and a unit row.
     Keysight,
+    /// Rigol: sample numbers, with `Start` and `Increment` giving the time.
     Rigol,
+    /// Siglent: metadata rows, then a `Second,Value` header.
     Siglent,
+    /// PicoScope: a name row, a unit row and a blank line.
     PicoScope,
 }
 
 impl Layout {
+    /// The layout's name in reports, e.g. `tektronix-mso`.
     pub fn as_str(self) -> &'static str {
         match self {
             Layout::Plain => "plain",
@@ -56,33 +64,52 @@ impl Layout {
 /// One channel of a capture, times in s.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Trace {
+    /// The exporter that wrote the file.
     pub layout: Layout,
     /// The channel's name as the file gives it.
     pub channel: String,
     /// Every channel the file has, in order.
     pub channels: Vec<String>,
+    /// s, strictly increasing, at least 3 samples.
     pub time: Vec<f64>,
+    /// The channel's samples in the file's unit (usually V), one per time.
     pub value: Vec<f64>,
 }
 
 /// Why a capture could not be read.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum CaptureError {
+    /// The file cannot be read.
     #[error("{}: cannot read the capture", path.display())]
     Io {
+        /// The capture file.
         path: PathBuf,
+        /// Why it cannot be read.
         #[source]
         source: std::io::Error,
     },
+    /// A cell that must hold a number (a time, a value, a unit) does not.
     #[error("{}:{line}: column {column}: {problem}", path.display())]
     Cell {
+        /// The capture file.
         path: PathBuf,
+        /// 1-based line.
         line: usize,
+        /// 1-based column.
         column: usize,
+        /// What was expected and what was found.
         problem: String,
     },
+    /// The file as a whole does not make a trace: empty, no such channel,
+    /// fewer than 3 samples, times that do not increase, ...
     #[error("{}: {problem}", path.display())]
-    File { path: PathBuf, problem: String },
+    File {
+        /// The capture file.
+        path: PathBuf,
+        /// What is wrong and how to fix it.
+        problem: String,
+    },
 }
 
 /// A row of cells with its 1-based line number.

@@ -15,31 +15,53 @@ pub use layout::{CaptureError, Layout, Trace, parse_capture, read_capture};
 /// What a capture shows: the JSON of `chatterspice capture`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Capture {
+    /// What the trace was read from, as given (usually the file's path).
     pub source: String,
+    /// The exporter's layout, as [`Layout::as_str`] names it.
     pub layout: &'static str,
+    /// The channel analysed, as the file names it.
     pub channel: String,
+    /// The number of samples in the trace.
     pub samples: usize,
     /// s, the median spacing of the samples.
     pub sample_interval: f64,
+    /// The trace's open and closed levels.
     pub levels: Levels,
+    /// The hysteresis thresholds the edges were found with.
     pub thresholds: Thresholds,
+    /// s, on the capture's time axis: the first make; `None` if the
+    /// contact never closes.
     pub first_make: Option<f64>,
+    /// s, the start of the final closed interval; `None` if the capture
+    /// does not end closed.
     pub settle_time: Option<f64>,
+    /// Openings after the first make.
     pub bounce_count: usize,
+    /// s, every make, in order.
     pub makes: Vec<f64>,
+    /// s, every break, in order.
     pub breaks: Vec<f64>,
+    /// The contact's states from the first sample to the last, on the
+    /// capture's time axis.
     pub intervals: Vec<Interval>,
 }
 
+/// The two levels of a capture's trace, in the trace's unit (usually V).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Levels {
+    /// The level while the contact is open.
     pub open: f64,
+    /// The level while the contact is closed.
     pub closed: f64,
 }
 
+/// The hysteresis thresholds of a capture's edges, in the trace's unit
+/// (`low < high`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Thresholds {
+    /// The lower threshold.
     pub low: f64,
+    /// The upper threshold.
     pub high: f64,
 }
 

@@ -110,6 +110,7 @@ pub struct Cycle {
     /// The rest stop as the normally-closed contact, closed while the
     /// armature is on it; its impacts are the landings.
     pub back: Chatter,
+    /// Every stroke of the armature, in time order.
     pub strokes: Vec<Stroke>,
     /// (s, m): the armature's path, at every accepted step and event.
     pub path: Vec<(f64, f64)>,

@@ -206,16 +206,22 @@ const D: [[f64; 12]; 4] = [
 /// One accepted step from `t0` to `t1`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Dop853Step<const N: usize> {
+    /// The independent variable at the start of the step.
     pub t0: f64,
+    /// The independent variable at the end of the step.
     pub t1: f64,
+    /// The state at `t0`.
     pub y0: SVector<f64, N>,
+    /// The state at `t1`.
     pub y1: SVector<f64, N>,
 }
 
 /// The 7th-order continuous extension of one step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Dense<const N: usize> {
+    /// The independent variable at the start of the step.
     pub t0: f64,
+    /// The independent variable at the end of the step.
     pub t1: f64,
     /// y0, then the seven correction terms of the nested form.
     c: [SVector<f64, N>; 8],

@@ -375,7 +375,12 @@ impl<'a> Engine<'a> {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ResponseEnd {
     /// Released after `contact_time` s with `velocity` m/s (≤ 0).
-    Released { contact_time: f64, velocity: f64 },
+    Released {
+        /// s, from touch to release.
+        contact_time: f64,
+        /// m/s, the velocity at release (≤ 0: away from the contact).
+        velocity: f64,
+    },
     /// Never releases.
     Stuck,
     /// Still in contact when the time budget ran out.
@@ -385,6 +390,7 @@ pub enum ResponseEnd {
 /// One contact, from touch to release: what the surface does to an impact.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ImpactResponse {
+    /// Whether and how the contact released.
     pub end: ResponseEnd,
     /// N, largest contact force (`None` for a rigid impulse).
     pub peak_force: Option<f64>,

@@ -45,6 +45,7 @@ use super::{Mechanics, MechanicsError};
 /// Everything the contact integration needs (SI units).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HcContact {
+    /// kg, moving mass m.
     pub mass: f64,
     /// N·s/m, structural damping c.
     pub damping: f64,
@@ -56,6 +57,7 @@ pub struct HcContact {
     pub gap: f64,
     /// N/mⁿ
     pub surface_stiffness: f64,
+    /// The force law's exponent n (1 linear, 1.5 Hertz).
     pub exponent: f64,
     /// s/m
     pub chi: f64,
@@ -65,9 +67,17 @@ pub struct HcContact {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum HcEnd {
     /// Released `after` seconds with velocity `velocity` (< 0).
-    Released { after: f64, velocity: f64 },
+    Released {
+        /// s, from touch to release.
+        after: f64,
+        /// m/s, the velocity at release (< 0).
+        velocity: f64,
+    },
     /// Energy fell below the release threshold `after` seconds in.
-    Stuck { after: f64 },
+    Stuck {
+        /// s, from touch to the moment it stuck.
+        after: f64,
+    },
     /// Still in contact at the time budget.
     Horizon,
 }
@@ -75,6 +85,7 @@ pub enum HcEnd {
 /// The result of one contact.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HcOutcome {
+    /// Whether and how the contact ended.
     pub end: HcEnd,
     /// N, largest contact force seen.
     pub peak_force: f64,

@@ -22,7 +22,9 @@ use super::MechanicsError;
 /// is within `atol[i] + rtol·|y[i]|`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Tolerance<const N: usize> {
+    /// The relative tolerance, the same for every component.
     pub rtol: f64,
+    /// The absolute tolerance of each component, in its unit.
     pub atol: SVector<f64, N>,
 }
 
@@ -30,9 +32,13 @@ pub struct Tolerance<const N: usize> {
 /// continuous extension.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Step<const N: usize> {
+    /// The independent variable at the start of the step.
     pub t0: f64,
+    /// The independent variable at the end of the step.
     pub t1: f64,
+    /// The state at `t0`.
     pub y0: SVector<f64, N>,
+    /// The state at `t1`.
     pub y1: SVector<f64, N>,
     cont: [SVector<f64, N>; 4],
 }

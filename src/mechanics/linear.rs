@@ -203,7 +203,9 @@ pub struct Crossing {
 /// A combination `P·E(t) + Q·G(t)` of the two basis functions.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Combo {
+    /// The coefficient P of E(t).
     pub p: f64,
+    /// The coefficient Q of G(t).
     pub q: f64,
 }
 

@@ -102,9 +102,13 @@ pub fn illinois(
 /// A function's value and first two derivatives at `t`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Jet {
+    /// Where the function was evaluated.
     pub t: f64,
+    /// The value f(t).
     pub f: f64,
+    /// The first derivative f'(t).
     pub d1: f64,
+    /// The second derivative f''(t).
     pub d2: f64,
 }
 

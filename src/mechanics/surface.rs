@@ -7,18 +7,29 @@
 pub enum Surface {
     /// Rigid, with constant restitution `e ∈ [0, 1]`: at the touch
     /// `ẋ ← −e ẋ`, contact time zero.
-    Rigid { restitution: f64 },
+    Rigid {
+        /// e, the ratio of rebound to impact speed, in [0, 1].
+        restitution: f64,
+    },
     /// The paper's linear "equivalent stiffness surface":
     /// `Fc = s0 δ + r0 δ̇` (N/m, N·s/m). Released when x returns to g
     /// moving away (the paper's rule), so Fc may be negative just before
     /// release (the Kelvin–Voigt "sticky force").
-    KelvinVoigt { stiffness: f64, damping: f64 },
+    KelvinVoigt {
+        /// N/m, the surface stiffness s0.
+        stiffness: f64,
+        /// N·s/m, the surface damping r0.
+        damping: f64,
+    },
     /// Hunt–Crossley: `Fc = k δⁿ (1 + χ δ̇)`, clamped at Fc ≥ 0.
     /// `stiffness` is k (N/mⁿ), `exponent` n (1 for the paper's linear
     /// spring, 1.5 for Hertz), `chi` χ = λ/k (s/m).
     HuntCrossley {
+        /// N/mⁿ, k.
         stiffness: f64,
+        /// n, dimensionless.
         exponent: f64,
+        /// s/m, χ = λ/k.
         chi: f64,
     },
 }

@@ -125,6 +125,7 @@ pub enum EventKind {
 pub struct Event {
     /// s
     pub time: f64,
+    /// What happened.
     pub kind: EventKind,
     /// m, the position (the gap for contact events, 0 on the rest stop).
     pub position: f64,

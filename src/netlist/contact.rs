@@ -86,6 +86,7 @@ pub enum ContactElement {
 }
 
 impl ContactElement {
+    /// Every element, the default first.
     pub const ALL: [ContactElement; 3] = [
         ContactElement::Pwl,
         ContactElement::EventRamp,
@@ -144,7 +145,9 @@ impl FromStr for ContactElement {
 /// A generated include file and what it needs.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ContactInclude {
+    /// The element the include uses.
     pub element: ContactElement,
+    /// The subcircuit it defines (`.subckt NAME a b`).
     pub subckt: String,
     /// The include file's text.
     pub text: String,

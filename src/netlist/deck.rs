@@ -79,6 +79,8 @@ pub struct Deck {
     /// each included file in the order it was inlined (a file included
     /// twice is listed twice).
     pub files: Vec<PathBuf>,
+    /// What the deck left out or the user may want to change, in the
+    /// order noticed.
     pub warnings: Vec<DeckWarning>,
     /// The analysis the deck runs, as it is in the deck.
     pub tran: Tran,
@@ -107,6 +109,8 @@ pub struct Tran {
     pub tstart: f64,
     /// s, when given.
     pub tmax: Option<f64>,
+    /// `uic`: start from the initial conditions, skipping the operating
+    /// point.
     pub uic: bool,
     /// 1-based line in the netlist.
     pub line: usize,
@@ -124,36 +128,55 @@ impl Tran {
 /// Something the deck changed or the user may want to change.
 #[derive(Debug, Clone, PartialEq)]
 pub enum DeckWarning {
+    /// A `.control` block was left out of the run.
     ControlRemoved {
+        /// The file that holds it.
         netlist: PathBuf,
+        /// 1-based line of the `.control`.
         first: usize,
+        /// 1-based line of the `.endc`.
         last: usize,
     },
+    /// Text follows `.end`, which ngspice ignores too.
     IgnoredAfterEnd {
+        /// The netlist file.
         netlist: PathBuf,
+        /// 1-based line of the first such text.
         line: usize,
     },
+    /// The `.tran` covers the chatter but stops soon after it.
     StopShort {
+        /// The netlist file.
         netlist: PathBuf,
+        /// 1-based line of the `.tran`.
         line: usize,
-        /// s
+        /// s, its stop time.
         tstop: f64,
-        /// s
+        /// s, its step.
         tstep: f64,
-        /// s
+        /// s, the stop time to use instead.
         wanted: f64,
     },
+    /// The first line, which ngspice takes as the title, looks like a
+    /// dot-card.
     TitleIsCard {
+        /// The netlist file.
         netlist: PathBuf,
+        /// The first line.
         text: String,
     },
+    /// `interp` was removed from an `.options` card.
     InterpRemoved {
+        /// The file that holds the card.
         netlist: PathBuf,
+        /// 1-based line of the card.
         line: usize,
     },
     /// A `*#` line, which ngspice runs as a command.
     CommandCommentRemoved {
+        /// The file that holds it.
         netlist: PathBuf,
+        /// 1-based line.
         line: usize,
     },
 }

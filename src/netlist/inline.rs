@@ -32,7 +32,9 @@ pub const MAX_INLINED_BYTES: usize = 256 * 1024 * 1024;
 /// index into the deck's list of files (0 being the user's netlist).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SourceLine {
+    /// Index into the deck's files; 0 is the user's netlist.
     pub file: usize,
+    /// 1-based line in that file.
     pub line: usize,
 }
 

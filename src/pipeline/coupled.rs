@@ -46,6 +46,7 @@ use crate::netlist::coil::coil_include;
 use crate::netlist::{
     self, ContactElement, Deck, DeckRequest, NetlistError, contact_include, instances_of,
 };
+use crate::plan::Plan;
 use crate::rawfile::{Plot, Vector};
 use crate::scenario::{Scenario, ScenarioError};
 use crate::spice::{RunRequest, Runner, SpiceError};
@@ -238,6 +239,16 @@ pub fn run_coupled(
     runner: &dyn Runner,
     options: &CouplingOptions,
 ) -> Result<Coupled, CouplingError> {
+    run_coupled_plan(&Plan::new(scenario.clone())?, runner, options)
+}
+
+/// [`run_coupled`] of a [`Plan`].
+pub fn run_coupled_plan(
+    plan: &Plan,
+    runner: &dyn Runner,
+    options: &CouplingOptions,
+) -> Result<Coupled, CouplingError> {
+    let scenario = plan.scenario();
     let origin = scenario.origin.clone();
     let section = scenario
         .coil
@@ -252,10 +263,11 @@ pub fn run_coupled(
         .ok_or_else(|| CouplingError::NoCircuit {
             path: origin.clone(),
         })?;
-    let (netlist_path, netlist_text) = scenario
+    let netlist = plan
         .netlist()
-        .expect("there is a [circuit], so netlist() is Some")?;
-    let instances = instances_of(&netlist_text, &circuit.coil_subckt);
+        .expect("there is a [circuit], so the plan read its netlist");
+    let (netlist_path, netlist_text) = (netlist.path.clone(), netlist.text.as_str());
+    let instances = instances_of(netlist_text, &circuit.coil_subckt);
     let [coil_instance] = instances.as_slice() else {
         return Err(CouplingError::CoilInstances {
             netlist: netlist_path,
@@ -264,7 +276,7 @@ pub fn run_coupled(
         });
     };
     if let Some(nc) = &circuit.nc_subckt {
-        if instances_of(&netlist_text, nc).is_empty() {
+        if instances_of(netlist_text, nc).is_empty() {
             return Err(CouplingError::NcNotInstantiated {
                 netlist: netlist_path,
                 subckt: nc.clone(),
@@ -288,10 +300,10 @@ pub fn run_coupled(
         source,
     })?;
     let stops = Stops {
-        make: scenario.surface(),
-        back: scenario.back_stop(),
+        make: plan.surface(),
+        back: plan.back_stop(),
     };
-    let settings = scenario.settings();
+    let settings = plan.settings();
     let model = ContactModel::from(&scenario.contact);
     let psi = flux_vector(coil_instance);
     let volts = voltage_vector(coil_instance);
@@ -301,7 +313,7 @@ pub fn run_coupled(
     signals.extend([psi.as_str(), volts.as_str(), current.as_str()]);
     // With [arc], the contact carries the arc in every pass.
     let arc = scenario.arc.map(|a| a.model());
-    let arc_vectors = instances_of(&netlist_text, &circuit.subckt)
+    let arc_vectors = instances_of(netlist_text, &circuit.subckt)
         .first()
         .map(|instance| ArcVectors::of(instance));
     if let (Some(_), Some(vectors)) = (&arc, &arc_vectors) {
@@ -345,7 +357,7 @@ pub fn run_coupled(
         let end = chatter.intervals.last().map_or(0.0, |iv| iv.start);
         let deck = netlist::prepare_deck_with_params(
             &DeckRequest {
-                netlist_text: &netlist_text,
+                netlist_text,
                 netlist_path: &netlist_path,
                 include_file_name: CONTACT_FILE,
                 subckt: &circuit.subckt,

@@ -31,8 +31,10 @@ use crate::arc::element::{ArcVectors, with_arc};
 use crate::arc::{ArcModel, ArcReport, GapProfile, analysis::MissingArcVector};
 use crate::chatter::{Chatter, ContactState, Interval};
 use crate::coil::Operation;
+use crate::mechanics::Surface;
 use crate::mechanics::{MechanicsError, Trajectory, contact_forces};
 use crate::netlist::{self, ContactElement, ContactInclude, Deck, DeckRequest, NetlistError};
+use crate::plan::{Netlist, Plan};
 use crate::rawfile::Plot;
 use crate::scenario::{Probe, Scenario, ScenarioError};
 use crate::spice::{Failure, RunRequest, Runner, SpiceError};
@@ -227,12 +229,23 @@ pub fn run(
     runner: &dyn Runner,
     options: &RunOptions,
 ) -> Result<RunResult, RunError> {
+    run_plan(&Plan::new(scenario.clone())?, runner, options)
+}
+
+/// [`run`] of a [`Plan`]: the scenario resolved once, its netlist read
+/// once (a sweep runs each sample's plan).
+pub fn run_plan(
+    plan: &Plan,
+    runner: &dyn Runner,
+    options: &RunOptions,
+) -> Result<RunResult, RunError> {
+    let scenario = plan.scenario();
     check_circuit(scenario)?;
     if scenario.coil.is_some() {
-        return run_coil(scenario, runner, options);
+        return run_coil(plan, runner, options);
     }
-    let mechanics = scenario.mechanics()?;
-    let (surface, settings) = (scenario.surface(), scenario.settings());
+    let mechanics = plan.mechanics()?;
+    let (surface, settings) = (plan.surface(), plan.settings());
     let trajectory = Trajectory::of_step(&mechanics, &surface, &settings).map_err(|source| {
         RunError::Mechanics {
             path: scenario.origin.clone(),
@@ -241,8 +254,8 @@ pub fn run(
     })?;
     let gap = GapProfile::from_trajectory(&trajectory);
     let chatter = trajectory.into_chatter();
-    let (waveform, model) = contact_waveform(scenario, &chatter)?;
-    run_chatter(scenario, chatter, waveform, &model, gap, runner, options)
+    let (waveform, model) = contact_waveform_of(scenario, surface, &chatter)?;
+    run_chatter(plan, chatter, waveform, &model, gap, runner, options)
 }
 
 /// [`run`] with a measured chatter sequence (e.g. from
@@ -257,6 +270,7 @@ pub fn run_measured(
     runner: &dyn Runner,
     options: &RunOptions,
 ) -> Result<RunResult, RunError> {
+    let plan = Plan::new(scenario.clone())?;
     check_circuit(scenario)?;
     if scenario.contact.holm.is_some() {
         return Err(RunError::HolmNeedsForce {
@@ -272,7 +286,7 @@ pub fn run_measured(
         }
     })?;
     let gap = record_gap(scenario, &chatter.intervals);
-    run_chatter(scenario, chatter, waveform, &model, gap, runner, options)
+    run_chatter(&plan, chatter, waveform, &model, gap, runner, options)
 }
 
 /// gap(t) of a measured record of states, which has no positions: each
@@ -303,7 +317,7 @@ fn check_circuit(scenario: &Scenario) -> Result<(), RunError> {
 /// From the contact waveform on: include, deck, both ngspice runs, probes.
 /// `model` is the ideal contact's.
 fn run_chatter(
-    scenario: &Scenario,
+    plan: &Plan,
     chatter: Chatter,
     waveform: Waveform,
     model: &ContactModel,
@@ -311,11 +325,15 @@ fn run_chatter(
     runner: &dyn Runner,
     options: &RunOptions,
 ) -> Result<RunResult, RunError> {
+    let scenario = plan.scenario();
     let origin = &scenario.origin;
-    let (netlist_path, netlist_text) =
-        scenario.netlist().ok_or_else(|| RunError::NoCircuit {
-            path: origin.clone(),
-        })??;
+    let Netlist {
+        path: netlist_path,
+        text: netlist_text,
+    } = plan.netlist().ok_or_else(|| RunError::NoCircuit {
+        path: origin.clone(),
+    })?;
+    let netlist_path = netlist_path.clone();
     let circuit = scenario
         .circuit
         .as_ref()
@@ -328,7 +346,7 @@ fn run_chatter(
         .element
         .unwrap_or_else(|| ContactElement::for_waveform(&waveform));
     let include = netlist::contact_include(&waveform, &circuit.subckt, element)?;
-    let arc = arc_setup(scenario, &netlist_text);
+    let arc = arc_setup(scenario, netlist_text);
     let include = match &arc {
         Some(a) => with_arc(include, &a.model, &gap)?,
         None => include,
@@ -341,7 +359,7 @@ fn run_chatter(
     let end = chatter_end(&chatter) + model.edge_time;
     let deck = netlist::prepare_deck_with_params(
         &DeckRequest {
-            netlist_text: &netlist_text,
+            netlist_text,
             netlist_path: &netlist_path,
             include_file_name: INCLUDE_FILE,
             subckt: &circuit.subckt,
@@ -417,7 +435,7 @@ fn run_chatter(
     warnings.extend(probes.iter().filter_map(|p| p.analysis.threshold_warning()));
     warnings.extend(arc_warnings(
         scenario,
-        &netlist_text,
+        netlist_text,
         arcs.as_ref(),
         &simulation.plot,
         &waveform,
@@ -487,13 +505,10 @@ fn probe_results(
 
 /// `run` for a coil-driven relay: the coupled run, then the probes of its
 /// last circuit run.
-fn run_coil(
-    scenario: &Scenario,
-    runner: &dyn Runner,
-    options: &RunOptions,
-) -> Result<RunResult, RunError> {
-    let coupled = run_coupled(
-        scenario,
+fn run_coil(plan: &Plan, runner: &dyn Runner, options: &RunOptions) -> Result<RunResult, RunError> {
+    let scenario = plan.scenario();
+    let coupled = coupled::run_coupled_plan(
+        plan,
         runner,
         &CouplingOptions {
             timeout: options.timeout,
@@ -516,10 +531,8 @@ fn run_coil(
         .element
         .unwrap_or_else(|| ContactElement::for_waveform(&waveform));
     let mut include = netlist::contact_include(&waveform, &circuit.subckt, element)?;
-    let netlist_text = scenario.netlist().transpose()?.map(|(_, text)| text);
-    let arc = netlist_text
-        .as_deref()
-        .and_then(|text| arc_setup(scenario, text));
+    let netlist_text = plan.netlist().map(|n| n.text.as_str());
+    let arc = netlist_text.and_then(|text| arc_setup(scenario, text));
     let gap = GapProfile::from_path(scenario.mechanics.gap, &coupled.path);
     if let Some(a) = &arc {
         include = with_arc(include, &a.model, &gap)?;
@@ -563,7 +576,7 @@ fn run_coil(
         .iter()
         .map(ToString::to_string)
         .collect();
-    if let Some(text) = &netlist_text {
+    if let Some(text) = netlist_text {
         warnings.extend(arc_warnings(
             scenario,
             text,
@@ -708,6 +721,15 @@ pub fn contact_waveform(
     scenario: &Scenario,
     chatter: &Chatter,
 ) -> Result<(Waveform, ContactModel), RunError> {
+    contact_waveform_of(scenario, scenario.surface(), chatter)
+}
+
+/// [`contact_waveform`] with the surface law `surface` (a plan's).
+fn contact_waveform_of(
+    scenario: &Scenario,
+    surface: Surface,
+    chatter: &Chatter,
+) -> Result<(Waveform, ContactModel), RunError> {
     let origin = &scenario.origin;
     let mut model = ContactModel::from(&scenario.contact);
     let waveform_error = |source| RunError::Waveform {
@@ -723,7 +745,6 @@ pub fn contact_waveform(
         return Ok((waveform, model));
     };
     let mechanics = scenario.mechanics()?;
-    let surface = scenario.surface();
     let mut failure = None;
     let waveform = Waveform::from_chatter_holm(chatter, &model, &holm, |times| {
         contact_forces(&mechanics, &surface, chatter, times).unwrap_or_else(|e| {

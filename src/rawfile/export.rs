@@ -18,13 +18,23 @@ use super::{Plot, RawFile, Vector};
 
 /// Why a plot could not be rendered.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum ExportError {
+    /// The plot asked for is not in the file.
     #[error("there is no plot {index}: the file has {count} plot(s), numbered 0 to {last}", last = .count.saturating_sub(1))]
-    NoSuchPlot { index: usize, count: usize },
+    NoSuchPlot {
+        /// The 0-based plot index asked for.
+        index: usize,
+        /// The number of plots in the file.
+        count: usize,
+    },
+    /// Writing the output failed.
     #[error("cannot write the output: {0}")]
     Write(#[from] std::io::Error),
+    /// The CSV writer failed (usually writing the output).
     #[error("cannot write the CSV output: {0}")]
     Csv(#[from] csv::Error),
+    /// The raw file cannot be read.
     #[error(transparent)]
     Raw(#[from] super::RawError),
 }

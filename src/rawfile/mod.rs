@@ -73,6 +73,7 @@ pub struct RawFile {
 /// One analysis result.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Plot {
+    /// The `Title:` line: the netlist's title.
     pub title: String,
     /// As written by the simulator (free text, local time).
     pub date: String,
@@ -86,7 +87,9 @@ pub struct Plot {
     pub dimensions: Option<String>,
     /// Header lines of a form this reader does not interpret, verbatim.
     pub other_header_lines: Vec<String>,
+    /// The `Flags:` line.
     pub flags: Flags,
+    /// The vectors, in `Variables:` order; the first is the scale.
     pub variables: Vec<Variable>,
     /// `No. Points:` as written; 0 for a killed run.
     pub declared_points: usize,
@@ -119,11 +122,14 @@ pub struct Variable {
 /// Borrowed values of one vector.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Vector<'a> {
+    /// The values of a real plot (and a complex plot's frequency scale).
     Real(&'a [f64]),
+    /// The values of a complex plot.
     Complex(&'a [Complex64]),
 }
 
 impl Vector<'_> {
+    /// The number of values.
     pub fn len(&self) -> usize {
         match self {
             Vector::Real(v) => v.len(),
@@ -131,6 +137,7 @@ impl Vector<'_> {
         }
     }
 
+    /// Whether the vector has no values.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
@@ -247,6 +254,7 @@ impl fmt::Display for RawWarning {
 pub struct Position {
     /// 1-based; `None` inside or after binary data, where lines mean nothing.
     pub line: Option<usize>,
+    /// 0-based byte offset from the start of the file.
     pub offset: usize,
 }
 
@@ -261,79 +269,142 @@ impl fmt::Display for Position {
 
 /// Why a raw file could not be read.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum RawError {
+    /// The file cannot be opened or read.
     #[error("cannot read raw file {path}: {source}")]
     Io {
+        /// The raw file.
         path: PathBuf,
+        /// Why it cannot be read.
         #[source]
         source: std::io::Error,
     },
     /// `error` in the file at `path`. Not a `source`: the message already
     /// holds it, and a cause line would repeat it.
     #[error("{path}: {error}")]
-    InFile { path: PathBuf, error: Box<RawError> },
+    InFile {
+        /// The raw file.
+        path: PathBuf,
+        /// What is wrong in it.
+        error: Box<RawError>,
+    },
+    /// The path is a directory, a device or a pipe.
     #[error(
         "{path}: not a regular file: a raw file is read from disk (a device or a pipe could \
          feed it without end)"
     )]
-    NotAFile { path: PathBuf },
+    NotAFile {
+        /// The path given.
+        path: PathBuf,
+    },
+    /// The file is larger than [`MAX_LOADED_BYTES`].
     #[error(
         "{path}: {size} bytes is more than the {limit} bytes this reader loads at once; \
          `chatterspice raw FILE --format csv` streams binary files of any size"
     )]
     TooLarge {
+        /// The raw file.
         path: PathBuf,
+        /// Its size, in bytes.
         size: u64,
+        /// The limit, in bytes.
         limit: u64,
     },
+    /// The input holds no plot (it is empty or blank).
     #[error("empty raw file: no plot header found")]
     Empty,
+    /// The file is in LTspice's dialect, which this reader refuses.
     #[error(
         "this is an LTspice raw file ({what}, at {at}); chatterspice reads ngspice raw files only: \
          re-run the netlist in ngspice, or export the waveforms from LTspice as text"
     )]
-    Ltspice { what: &'static str, at: Position },
+    Ltspice {
+        /// What gave it away, e.g. `UTF-16 text header`.
+        what: &'static str,
+        /// Where.
+        at: Position,
+    },
+    /// A line where a header line should be is none.
     #[error(
         "at {at}: expected a raw file header line (`Title:`, `Plotname:`, ...), found {text:?}"
     )]
-    UnexpectedLine { at: Position, text: String },
+    UnexpectedLine {
+        /// Where.
+        at: Position,
+        /// The line (its first 80 bytes).
+        text: String,
+    },
+    /// A header count (`No. Variables:`, `No. Points:`) is not a whole
+    /// number.
     #[error("at {at}: `{field}` needs a whole number, found {text:?}")]
     BadCount {
+        /// Where.
         at: Position,
+        /// The header field, e.g. `No. Points:`.
         field: &'static str,
+        /// What it holds.
         text: String,
     },
+    /// A plot's data starts before a header line it needs.
     #[error("at {at}: plot header has no `{field}` line before its data")]
-    MissingHeader { at: Position, field: &'static str },
+    MissingHeader {
+        /// Where.
+        at: Position,
+        /// The missing header field, e.g. `Plotname:`.
+        field: &'static str,
+    },
+    /// `No. Variables:` is 0.
     #[error("at {at}: a plot needs at least one variable (`No. Variables: 0`)")]
-    NoVariables { at: Position },
+    NoVariables {
+        /// Where.
+        at: Position,
+    },
+    /// A line of the `Variables:` list is not `index name type`.
     #[error("at {at}: variable line {text:?} {reason}")]
     BadVariable {
+        /// Where.
         at: Position,
+        /// The line.
         text: String,
+        /// What is wrong with it.
         reason: &'static str,
     },
+    /// The input ends before every declared variable is listed.
     #[error("at {at}: the file ends inside the `Variables:` list ({found} of {expected} declared)")]
     MissingVariables {
+        /// Where the `Variables:` list starts.
         at: Position,
+        /// `No. Variables:`.
         expected: usize,
+        /// Variables listed before the end.
         found: usize,
     },
+    /// The binary data's size fits the other of real and complex, not the
+    /// one `Flags:` says.
     #[error(
         "at {at}: the header's `Flags:` says {flagged}, but the data hold {bytes} bytes a \
          value for every declared point, as {found} values do: the `Flags:` line is wrong \
          (or the file was edited); fix it to `Flags: {found}`"
     )]
     FlagMismatch {
+        /// Where the data start.
         at: Position,
+        /// What `Flags:` says: `real` or `complex`.
         flagged: &'static str,
+        /// What the data fit: the other one.
         found: &'static str,
+        /// The bytes a value the data's size fits: 8 real, 16 complex.
         bytes: usize,
     },
+    /// A value of ASCII data cannot be read.
     #[error("at {at}: expected {expected}, found {text:?}")]
     BadValue {
+        /// Where.
         at: Position,
+        /// What was expected: a number, a complex value, a point index.
         expected: &'static str,
+        /// What was found (its first 40 bytes).
         text: String,
     },
 }
@@ -435,6 +506,7 @@ impl Plot {
         self.columns.iter().map(Column::len).max().unwrap_or(0)
     }
 
+    /// Whether the plot's values are complex (`Flags: complex`).
     pub fn is_complex(&self) -> bool {
         self.flags.complex
     }

@@ -26,11 +26,15 @@ use crate::rawfile::Vector;
 
 /// Why the files of a run could not be made (the run itself succeeded).
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum BundleError {
+    /// A probed signal's samples cannot be read from the raw file.
     #[error("cannot tabulate the waveforms")]
     Waveforms(#[from] AnalysisError),
+    /// The SVG plot cannot be drawn.
     #[error("cannot draw the plot")]
     Plot(#[from] svg::SvgError),
+    /// The SVG plot cannot be rendered as a PNG.
     #[error("cannot render the plot as PNG")]
     #[cfg(feature = "png")]
     Png(#[from] png::PngError),

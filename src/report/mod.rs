@@ -29,8 +29,11 @@ use crate::mechanics::Dimensionless;
 /// The formats a chatter result can be rendered in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Format {
+    /// The whole result as the JSON of docs/output.md.
     Json,
+    /// The impacts as CSV, one row each.
     Csv,
+    /// A summary and an impact table for a terminal.
     Table,
 }
 

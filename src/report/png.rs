@@ -28,11 +28,20 @@ pub const SCALE: f32 = 2.0;
 
 /// Why an SVG could not become a PNG.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum PngError {
+    /// The document is not SVG that resvg can read.
     #[error("the plot is not valid SVG: {0}")]
     Svg(#[from] usvg::Error),
+    /// The picture would be empty or wider or taller than 16 384 px.
     #[error("the plot is {width}×{height} px, too large to render")]
-    TooLarge { width: u32, height: u32 },
+    TooLarge {
+        /// px
+        width: u32,
+        /// px
+        height: u32,
+    },
+    /// The PNG encoder failed: its message.
     #[error("cannot encode the PNG: {0}")]
     Encode(String),
 }
@@ -42,7 +51,9 @@ pub enum PngError {
 pub struct Png {
     /// The PNG file's bytes.
     pub bytes: Vec<u8>,
+    /// px, the SVG's width times [`SCALE`].
     pub width: u32,
+    /// px, the SVG's height times [`SCALE`].
     pub height: u32,
     /// No font was found, so the text was left out.
     pub missing_fonts: bool,

@@ -30,17 +30,36 @@ use crate::chatter::{ContactState, Interval};
 
 /// Why a plot could not be drawn.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum SvgError {
+    /// The time window is not finite with start < end.
     #[error("plot window {start:e} s to {end:e} s: it needs finite start < end")]
-    Window { start: f64, end: f64 },
+    Window {
+        /// s
+        start: f64,
+        /// s
+        end: f64,
+    },
+    /// A series has a different number of values than of times.
     #[error("`{name}` has {values} values for {time} times; give one value per time")]
     Length {
+        /// The series' name (a probe's signal, or `contact resistance`).
         name: String,
+        /// The number of times.
         time: usize,
+        /// The number of values.
         values: usize,
     },
+    /// A series' time decreases.
     #[error("`{name}`: time goes back at sample {index}; pass the samples in time order")]
-    Unsorted { name: String, index: usize },
+    Unsorted {
+        /// The series' name.
+        name: String,
+        /// The 0-based index of the first sample earlier than the one
+        /// before it.
+        index: usize,
+    },
+    /// The plot has neither a contact trace nor a probe.
     #[error("nothing to plot: give a contact trace or at least one probe")]
     Empty,
 }
@@ -49,7 +68,9 @@ pub enum SvgError {
 /// per time.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Series<'a> {
+    /// s
     pub time: &'a [f64],
+    /// The values, in the signal's unit.
     pub value: &'a [f64],
 }
 
@@ -71,9 +92,11 @@ pub struct ProbePanel<'a> {
     pub name: String,
     /// SI unit symbol of the values (`V`, `A`), or empty.
     pub unit: String,
+    /// The samples.
     pub series: Series<'a>,
-    /// Schmitt thresholds, in `unit`.
+    /// The lower Schmitt threshold, in `unit`.
     pub low: f64,
+    /// The upper Schmitt threshold, in `unit`.
     pub high: f64,
     /// Edges to mark, in time order.
     pub edges: Vec<Edge>,
@@ -96,10 +119,13 @@ impl<'a> ProbePanel<'a> {
 /// Everything one picture shows.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SvgPlot<'a> {
+    /// The line over the picture.
     pub title: String,
     /// s, the time axis from `.0` to `.1` (see [`suggested_window`]).
     pub window: (f64, f64),
+    /// The top panel; `None` leaves it out.
     pub contact: Option<ContactTrace<'a>>,
+    /// One panel per probe, top to bottom.
     pub probes: Vec<ProbePanel<'a>>,
     /// Arcs and breakdowns to mark on the contact panel: (start, end, s;
     /// `true` for an arc, `false` for a breakdown).

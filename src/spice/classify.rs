@@ -28,6 +28,7 @@ use std::fmt;
 /// How the ngspice process ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Exit {
+    /// Exited with this status code.
     Code(i32),
     /// Killed by a signal (Unix), e.g. 11 for a segmentation fault.
     Signal(i32),
@@ -42,10 +43,14 @@ pub enum Failure {
         line: Option<usize>,
         /// The offending element line, as ngspice echoes it (lowercased).
         text: Option<String>,
+        /// What ngspice says is wrong.
         reason: String,
     },
     /// `.include`/`.lib` of a file ngspice cannot find.
-    MissingInclude { file: String },
+    MissingInclude {
+        /// The file, as ngspice names it.
+        file: String,
+    },
     /// The time step collapsed (to 1e-11·TMAX) during an analysis.
     TimestepTooSmall {
         /// `TRAN`, ...
@@ -54,27 +59,41 @@ pub enum Failure {
         time: Option<f64>,
         /// s, the step ngspice gave up at.
         timestep: Option<f64>,
+        /// The node or branch ngspice blames, when it names one.
         node: Option<String>,
     },
     /// The circuit matrix is singular: a node without a DC path, or a loop
     /// of voltage sources/inductors.
     SingularMatrix {
+        /// The analysis it happened in (`OP`, `TRAN`, ...), when known.
         analysis: Option<String>,
+        /// The node or branch ngspice blames, when it names one.
         node: Option<String>,
     },
     /// No operating point: gmin and source stepping both failed.
     NoConvergence {
+        /// The analysis that needed it (`OP`, `TRAN`, ...).
         analysis: String,
+        /// The node or branch ngspice blames, when it names one.
         node: Option<String>,
     },
     /// `run simulation(s) aborted` without a recognised cause.
     Aborted,
     /// Killed by a signal or exit code 3 (ngspice's crash exit).
-    Crashed { exit: Exit },
+    Crashed {
+        /// The signal or the exit code.
+        exit: Exit,
+    },
     /// An `Error` line no other class covers, e.g. from a `.control` block.
-    ErrorMessage { message: String },
+    ErrorMessage {
+        /// The line, as ngspice printed it.
+        message: String,
+    },
     /// Non-zero exit with no recognised message.
-    ExitStatus { code: i32 },
+    ExitStatus {
+        /// The exit status.
+        code: i32,
+    },
 }
 
 fn fmt_opt_node(node: &Option<String>) -> String {

@@ -38,6 +38,8 @@ pub use ngspice::Ngspice;
 
 /// Runs one deck.
 pub trait Runner: Send + Sync {
+    /// Runs `req` to completion: its raw file and log, or why there is
+    /// no usable result.
     fn run(&self, req: &RunRequest) -> Result<RunOutput, SpiceError>;
 }
 
@@ -61,6 +63,8 @@ impl RunRequest {
     /// a stuck sweep fails instead of hanging.
     pub const DEFAULT_TIMEOUT: Duration = Duration::from_secs(60);
 
+    /// A request for `deck` with no includes, the default timeout, and
+    /// the work directory removed afterwards.
     pub fn new(deck: impl Into<String>) -> RunRequest {
         RunRequest {
             deck: deck.into(),
@@ -74,12 +78,14 @@ impl RunRequest {
 /// A successful run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunOutput {
+    /// The raw file ngspice wrote, read.
     pub raw: RawFile,
     /// ngspice's stdout and stderr, interleaved in arrival order (progress
     /// lines dropped).
     pub log: String,
     /// e.g. `"39"`, when the program reported one.
     pub version: Option<String>,
+    /// Wall-clock time of the run.
     pub elapsed: Duration,
     /// The kept work directory, when asked for.
     pub workdir: Option<PathBuf>,
@@ -90,6 +96,7 @@ pub struct RunOutput {
 /// Where a failed run happened and what ngspice said last.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct RunContext {
+    /// The run's work directory (deck, includes, raw file).
     pub workdir: PathBuf,
     /// Whether the work directory still exists.
     pub kept: bool,
@@ -173,78 +180,117 @@ fn shorten(line: &str, max: usize) -> String {
 /// The run context is boxed so that `Result<RunOutput, SpiceError>` stays
 /// small.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum SpiceError {
+    /// The ngspice program cannot be found or does not answer `-v`.
     #[error(
         "ngspice not found: cannot run `{}` ({source}); install it with \
          `apt-get install -y ngspice`, or set CHATTERSPICE_NGSPICE to the ngspice binary",
         program.display()
     )]
     NotFound {
+        /// The program looked for.
         program: PathBuf,
+        /// Why it cannot be run.
         #[source]
         source: io::Error,
     },
+    /// The run's work directory cannot be created.
     #[error("cannot create a work directory in {}: {source}", parent.display())]
     WorkDir {
+        /// The directory it was to be created in.
         parent: PathBuf,
+        /// Why not.
         #[source]
         source: io::Error,
     },
+    /// An include's name is not a plain file name, or is the deck's or
+    /// the raw file's.
     #[error(
         "include file name {name:?} must be a plain file name (no directories, not \
          `deck.cir` or `out.raw`): it is written next to the deck in the work directory"
     )]
-    IncludeName { name: String },
+    IncludeName {
+        /// The name given.
+        name: String,
+    },
+    /// The deck or an include cannot be written to the work directory.
     #[error("cannot write {}: {source}", path.display())]
     Write {
+        /// The file.
         path: PathBuf,
+        /// Why not.
         #[source]
         source: io::Error,
     },
+    /// The ngspice process cannot be started or waited for.
     #[error("cannot run `{}`: {source}\n{context}", program.display())]
     Process {
+        /// The program.
         program: PathBuf,
+        /// Why not.
         #[source]
         source: io::Error,
+        /// The work directory.
         context: Box<RunContext>,
     },
+    /// ngspice ran and failed; its log says how.
     #[error("{failure}\n{context}")]
     Failed {
+        /// The failure, classified from the log.
         failure: Failure,
+        /// The work directory and the log's tail.
         context: Box<RunContext>,
     },
+    /// ngspice could not write its raw file (usually a full disk).
     #[error(
         "ngspice could not write its raw file in the temporary work directory {}: the file \
          system is probably full; free space there, or set TMPDIR to a directory with room\n{context}",
         dir.display()
     )]
     RawWrite {
+        /// The work directory.
         dir: PathBuf,
+        /// The work directory and the log's tail.
         context: Box<RunContext>,
     },
+    /// ngspice ran past the timeout and was killed.
     #[error(
         "ngspice was still running after the {} s timeout and was killed; raise the \
          timeout, or shorten the analysis (a smaller stop time, a larger TMAX)\n{context}",
         limit.as_secs_f64()
     )]
     Timeout {
+        /// The timeout.
         limit: Duration,
+        /// The work directory and the log's tail.
         context: Box<RunContext>,
     },
+    /// ngspice exited cleanly without writing a raw file.
     #[error(
         "ngspice finished without writing a raw file; does the deck have an analysis \
          line (.tran, .ac, .op) outside a .control block?\n{context}"
     )]
-    MissingRaw { context: Box<RunContext> },
-    #[error("the raw file ngspice wrote is unreadable: {source}\n{context}")]
-    BadRaw {
-        #[source]
-        source: RawError,
+    MissingRaw {
+        /// The work directory and the log's tail.
         context: Box<RunContext>,
     },
+    /// The raw file ngspice wrote cannot be read.
+    #[error("the raw file ngspice wrote is unreadable: {source}\n{context}")]
+    BadRaw {
+        /// Why.
+        #[source]
+        source: RawError,
+        /// The work directory and the log's tail.
+        context: Box<RunContext>,
+    },
+    /// ngspice exited cleanly but its raw file is cut short (a write
+    /// failure, not a result).
     #[error("the raw file ngspice wrote is cut short: {warning}\n{context}")]
     TruncatedRaw {
+        /// What the reader found.
         warning: RawWarning,
+        /// The work directory and the log's tail.
         context: Box<RunContext>,
     },
 }

@@ -28,8 +28,9 @@ use crate::rawfile::{RawFile, RawWarning};
 
 /// The environment variable naming the ngspice binary.
 pub const ENV_VAR: &str = "CHATTERSPICE_NGSPICE";
-/// File names inside the work directory.
+/// The deck's file name inside the work directory.
 pub const DECK_NAME: &str = "deck.cir";
+/// The raw file's name inside the work directory.
 pub const RAW_NAME: &str = "out.raw";
 
 /// ngspice, located and probed.
@@ -91,6 +92,7 @@ impl Ngspice {
         self
     }
 
+    /// The ngspice binary found.
     pub fn program(&self) -> &Path {
         &self.program
     }

@@ -28,6 +28,7 @@ use crate::chatter::Chatter;
 use crate::coil::{Closing, Operation};
 use crate::mechanics::simulate;
 use crate::pipeline::{self, RunOptions, RunResult};
+use crate::plan::Plan;
 use crate::scenario::Scenario;
 use crate::spice::Runner;
 
@@ -184,6 +185,9 @@ pub fn run_from(
     }
     progress.advance(first);
 
+    // Resolved once: each sample makes its plan from this one.
+    let base = base_plan(scenario, options)?;
+    let base = &base;
     let next = AtomicU64::new(0);
     let stop = AtomicBool::new(false);
     let jobs = options.jobs.get();
@@ -193,7 +197,7 @@ pub fn run_from(
             let tx = tx.clone();
             let (next, stop) = (&next, &stop);
             scope.spawn(move || {
-                let mut worker = Worker::new(scenario, sampler, options);
+                let mut worker = Worker::new(base, sampler, options);
                 loop {
                     let c = next.fetch_add(1, Ordering::Relaxed);
                     if c >= chunks || stop.load(Ordering::Relaxed) {
@@ -266,29 +270,66 @@ fn signals(scenario: &Scenario, options: &SweepOptions<'_>) -> Result<Vec<String
 }
 
 /// Evaluate sample `index` of `sampler`'s sweep of `scenario` on its own
-/// (the sweep's workers reuse one scenario copy instead).
+/// (the sweep's workers share one resolved plan instead).
 pub fn evaluate(
     scenario: &Scenario,
     sampler: &Sampler,
     index: u64,
     options: &SweepOptions<'_>,
 ) -> Record {
-    Worker::new(scenario, sampler, options).evaluate(index)
+    match base_plan(scenario, options) {
+        Ok(base) => Worker::new(&base, sampler, options).evaluate(index),
+        Err(e) => Record {
+            error: Some(one_line(&e)),
+            ..blank(index)
+        },
+    }
 }
 
-/// One thread's state: its own scenario, whose varied keys every sample
-/// sets anew.
+/// Sample `index`'s record before anything ran: every value absent.
+fn blank(index: u64) -> Record {
+    Record {
+        index,
+        values: Vec::new(),
+        outcome: None,
+        bounce_count: None,
+        first_impact: None,
+        settle_time: None,
+        bounce_time: None,
+        release_time: None,
+        nc_bounce_time: None,
+        arc_count: None,
+        arc_energy: None,
+        breakdowns: None,
+        probes: Vec::new(),
+        verdict: Verdict::Error,
+        failed_limits: Vec::new(),
+        error: None,
+    }
+}
+
+/// The plan every sample starts from: the netlist read once for a circuit
+/// sweep, not at all for the mechanics alone.
+fn base_plan(scenario: &Scenario, options: &SweepOptions<'_>) -> Result<Plan, SweepError> {
+    Ok(match options.mode {
+        Mode::Circuit(_) => Plan::new(scenario.clone())?,
+        Mode::Mechanics => Plan::without_circuit(scenario.clone())?,
+    })
+}
+
+/// One thread's state: the sweep's plan, from which each sample makes
+/// its own with the sample's values.
 struct Worker<'a, 'r> {
-    scenario: Scenario,
+    base: &'a Plan,
     sampler: &'a Sampler,
     options: &'a SweepOptions<'r>,
     values: Vec<f64>,
 }
 
 impl<'a, 'r> Worker<'a, 'r> {
-    fn new(scenario: &Scenario, sampler: &'a Sampler, options: &'a SweepOptions<'r>) -> Self {
+    fn new(base: &'a Plan, sampler: &'a Sampler, options: &'a SweepOptions<'r>) -> Self {
         Worker {
-            scenario: scenario.clone(),
+            base,
             sampler,
             options,
             values: vec![0.0; sampler.keys().len()],
@@ -296,24 +337,7 @@ impl<'a, 'r> Worker<'a, 'r> {
     }
 
     fn evaluate(&mut self, index: u64) -> Record {
-        let mut record = Record {
-            index,
-            values: Vec::new(),
-            outcome: None,
-            bounce_count: None,
-            first_impact: None,
-            settle_time: None,
-            bounce_time: None,
-            release_time: None,
-            nc_bounce_time: None,
-            arc_count: None,
-            arc_energy: None,
-            breakdowns: None,
-            probes: Vec::new(),
-            verdict: Verdict::Error,
-            failed_limits: Vec::new(),
-            error: None,
-        };
+        let mut record = blank(index);
         if let Err(e) = self.sampler.values(index, &mut self.values) {
             record.error = Some(one_line(&e));
             return record;
@@ -326,11 +350,14 @@ impl<'a, 'r> Worker<'a, 'r> {
             .map(String::as_str)
             .zip(self.values.iter().copied())
             .collect();
-        if let Err(e) = self.scenario.set_numbers(&pairs) {
-            record.error = Some(format!("invalid sample: {}", one_line(&e)));
-            return record;
-        }
-        let scenario = &self.scenario;
+        let plan = match self.base.with_numbers(&pairs) {
+            Ok(plan) => plan,
+            Err(e) => {
+                record.error = Some(format!("invalid sample: {}", one_line(&e)));
+                return record;
+            }
+        };
+        let scenario = plan.scenario();
         if scenario.coil.is_some() {
             // The relay moves only in its circuit: the coupled run gives
             // the chatter too.
@@ -338,7 +365,7 @@ impl<'a, 'r> Worker<'a, 'r> {
                 record.error = Some("a coil-driven relay needs the circuit".to_owned());
                 return record;
             };
-            match pipeline::run(scenario, runner, &self.options.run) {
+            match pipeline::run_plan(&plan, runner, &self.options.run) {
                 Ok(result) => {
                     record_chatter(&mut record, &result.chatter);
                     // Closing times count from the coil being energized.
@@ -361,9 +388,8 @@ impl<'a, 'r> Worker<'a, 'r> {
         let chatter = match scenario
             .mechanics()
             .map_err(|e| one_line(&e))
-            .and_then(|m| {
-                simulate(&m, &scenario.surface(), &scenario.settings()).map_err(|e| one_line(&e))
-            }) {
+            .and_then(|m| simulate(&m, &plan.surface(), &plan.settings()).map_err(|e| one_line(&e)))
+        {
             Ok(chatter) => chatter,
             Err(e) => {
                 record.error = Some(e);
@@ -375,7 +401,7 @@ impl<'a, 'r> Worker<'a, 'r> {
             Mode::Mechanics => {
                 (record.verdict, record.failed_limits) = verdict(scenario, &chatter, None);
             }
-            Mode::Circuit(runner) => match pipeline::run(scenario, runner, &self.options.run) {
+            Mode::Circuit(runner) => match pipeline::run_plan(&plan, runner, &self.options.run) {
                 Ok(result) => {
                     record_probes(&mut record, &result);
                     (record.verdict, record.failed_limits) =
