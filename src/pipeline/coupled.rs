@@ -26,12 +26,13 @@
 //! (see docs/coupling.md for the measurements and the reasons).
 
 use std::path::PathBuf;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use thiserror::Error;
 
 use crate::arc::GapProfile;
-use crate::arc::element::{ArcVectors, with_arc};
+use crate::arc::ArcVectors;
+use crate::netlist::arc::with_arc;
 use crate::chatter::{Chatter, ContactState, Interval};
 use crate::coil::accelerate::{CircuitRun, Tolerances, settle};
 #[cfg(test)]
@@ -376,29 +377,31 @@ pub fn run_coupled_plan(
             ),
         ];
         includes.extend(contact.data_files);
-        let started = Instant::now();
-        let output = runner
-            .run(&RunRequest {
-                deck: deck.text.clone(),
+        let simulation = super::circuit_pass(
+            runner,
+            super::Pass {
+                run: "coupled",
+                netlist: &netlist_path,
+                deck: &deck,
                 includes,
                 timeout: options.timeout,
                 keep_workdir: options.keep_workdir,
-            })
-            .map_err(|source| CouplingError::Spice {
+            },
+        )
+        .map_err(|e| match e {
+            super::RunError::Spice { source, .. } => CouplingError::Spice {
                 netlist: netlist_path.clone(),
                 iteration,
-                source: Box::new(source),
-            })?;
-        let ngspice_elapsed = started.elapsed().as_secs_f64();
-        let plot =
-            output
-                .raw
-                .last_transient()
-                .cloned()
-                .ok_or_else(|| CouplingError::MissingVector {
-                    iteration,
-                    vector: psi.clone(),
-                })?;
+                source,
+            },
+            _ => CouplingError::MissingVector {
+                iteration,
+                vector: psi.clone(),
+            },
+        })?;
+        let ngspice_elapsed = simulation.elapsed.as_secs_f64();
+        let version = simulation.version;
+        let plot = simulation.plot;
         let flux = series(&plot, &psi).ok_or_else(|| CouplingError::MissingVector {
             iteration,
             vector: psi.clone(),
@@ -490,7 +493,7 @@ pub fn run_coupled_plan(
                 coil_instance: coil_instance.clone(),
                 iterations,
                 deck,
-                version: output.version,
+                version,
             });
         }
     }

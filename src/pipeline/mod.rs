@@ -18,6 +18,9 @@
 //! reports to write wherever the caller wants.
 
 pub mod coupled;
+pub mod pass;
+
+pub use pass::{Pass, circuit_pass};
 
 pub use coupled::{Coupled, CouplingError, CouplingOptions, Iteration, nc_include, run_coupled};
 
@@ -27,7 +30,8 @@ use std::time::Duration;
 use thiserror::Error;
 
 use crate::analysis::{self, AnalysisError, Comparison, ProbeAnalysis};
-use crate::arc::element::{ArcVectors, with_arc};
+use crate::arc::ArcVectors;
+use crate::netlist::arc::with_arc;
 use crate::arc::{ArcModel, ArcReport, GapProfile, analysis::MissingArcVector};
 use crate::chatter::{Chatter, ContactState, Interval};
 use crate::coil::Operation;
@@ -37,7 +41,7 @@ use crate::netlist::{self, ContactElement, ContactInclude, Deck, DeckRequest, Ne
 use crate::plan::{Netlist, Plan};
 use crate::rawfile::Plot;
 use crate::scenario::{Probe, Scenario, ScenarioError};
-use crate::spice::{Failure, RunRequest, Runner, SpiceError};
+use crate::spice::{RunRequest, Runner, SpiceError};
 use crate::waveform::{ContactModel, Holm, Waveform, WaveformError};
 
 /// The file name of the contact include in the run's work directory (and
@@ -380,35 +384,33 @@ fn run_chatter(
         _ => None,
     };
 
-    let request = |include: &ContactInclude| {
+    let pass = |run: &'static str, include: &ContactInclude| {
         let mut includes = vec![(INCLUDE_FILE.to_owned(), include.text.clone())];
         includes.extend(include.data_files.iter().cloned());
-        RunRequest {
-            deck: deck.text.clone(),
+        Pass {
+            run,
+            netlist: &netlist_path,
+            deck: &deck,
             includes,
             timeout: options.timeout,
             keep_workdir: options.keep_workdir,
         }
     };
-    let bounced_request = request(&include);
-    let ideal_request = ideal_include.as_ref().map(request);
-    let (bounced, ideal) = if options.ideal_alongside {
+    let bounced_pass = pass("bounced", &include);
+    let ideal_pass = ideal_include.as_ref().map(|i| pass("ideal", i));
+    let (simulation, ideal) = if options.ideal_alongside {
         std::thread::scope(|scope| {
-            let ideal = ideal_request
-                .as_ref()
-                .map(|req| scope.spawn(move || runner.run(req)));
-            let bounced = runner.run(&bounced_request);
+            let ideal = ideal_pass.map(|p| scope.spawn(move || circuit_pass(runner, p)));
+            let bounced = circuit_pass(runner, bounced_pass);
             let ideal = ideal.map(|handle| handle.join().expect("the ideal run does not panic"));
             (bounced, ideal)
         })
     } else {
-        let bounced = runner.run(&bounced_request);
-        (bounced, ideal_request.as_ref().map(|req| runner.run(req)))
+        let bounced = circuit_pass(runner, bounced_pass);
+        (bounced, ideal_pass.map(|p| circuit_pass(runner, p)))
     };
-    let simulation = simulation_of("bounced", bounced, &netlist_path, &deck)?;
-    let ideal = ideal
-        .map(|result| simulation_of("ideal", result, &netlist_path, &deck))
-        .transpose()?;
+    let simulation = simulation?;
+    let ideal = ideal.transpose()?;
 
     let probes = probe_results(
         scenario,
@@ -792,66 +794,4 @@ pub fn ideal_waveform(
         },
     ];
     Waveform::from_intervals(&intervals, model)
-}
-
-fn simulation_of(
-    run: &'static str,
-    result: Result<crate::spice::RunOutput, SpiceError>,
-    netlist: &std::path::Path,
-    deck: &Deck,
-) -> Result<Simulation, RunError> {
-    let output = result.map_err(|source| {
-        let line = match source.failure() {
-            Some(Failure::Netlist {
-                line: Some(l),
-                text,
-                ..
-            }) => deck
-                .source_line(*l)
-                .map(|(file, line)| (file.to_path_buf(), line))
-                // Only when the deck line is the one ngspice echoed.
-                .filter(|_| {
-                    let deck_line = deck.text.lines().nth(l - 1).unwrap_or_default();
-                    text.as_ref()
-                        .is_none_or(|t| deck_line.trim().eq_ignore_ascii_case(t.trim()))
-                }),
-            _ => None,
-        };
-        RunError::Spice {
-            run,
-            netlist: netlist.to_owned(),
-            line,
-            source: Box::new(source),
-        }
-    })?;
-    let crate::spice::RunOutput {
-        raw,
-        version,
-        elapsed,
-        workdir,
-        warnings,
-        ..
-    } = output;
-    let plot_names = || {
-        raw.plots
-            .iter()
-            .map(|p| format!("`{}`", p.name))
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    let plot = raw
-        .last_transient()
-        .cloned()
-        .ok_or_else(|| RunError::NoTransient {
-            run,
-            netlist: netlist.to_owned(),
-            plots: plot_names(),
-        })?;
-    Ok(Simulation {
-        plot,
-        version,
-        elapsed,
-        warnings,
-        workdir,
-    })
 }

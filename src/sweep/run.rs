@@ -59,9 +59,11 @@ impl std::fmt::Debug for Mode<'_> {
 /// How to run a sweep.
 #[derive(Debug, Clone)]
 pub struct SweepOptions<'r> {
+    /// The mechanics alone, or the whole pipeline through a runner.
     pub mode: Mode<'r>,
     /// Threads evaluating samples (with ngspice: ngspice processes at once).
     pub jobs: NonZeroUsize,
+    /// The slice of the samples to run ([`Shard::WHOLE`] for all).
     pub shard: Shard,
     /// Each sample's pipeline options; the ideal-contact run is off by
     /// default (see the module overview).
