@@ -536,7 +536,7 @@ fn pwl(args: &PwlArgs) -> Result<()> {
         .unwrap_or_else(|| ContactElement::for_waveform(&waveform));
     let mut include = netlist::contact_include(&waveform, subckt, element)?;
     if let Some(arc) = &scenario.arc {
-        include = chatterspice::arc::element::with_arc(include, &arc.model(), &gap)?;
+        include = chatterspice::netlist::arc::with_arc(include, &arc.model(), &gap)?;
     }
     if !include.data_files.is_empty() {
         let Some(output) = &args.output else {

@@ -16,7 +16,7 @@
 use serde::Serialize;
 
 use super::ArcModel;
-use super::element::ArcVectors;
+use super::vectors::ArcVectors;
 use crate::chatter::{Chatter, ContactState};
 use crate::rawfile::{Plot, Vector};
 

@@ -14,17 +14,19 @@
 //!   numbers;
 //! - [`breakdown_voltage`] is V_bd(d) in air;
 //! - [`gap::GapProfile`] is gap(t) from the armature's own trajectory;
-//! - [`element`] adds the arc to the contact include (ngspice carries it);
+//! - [`vectors`] names what the arc element (written with the contact
+//!   include, so ngspice carries the arc) puts in the raw file;
 //! - [`analysis`] finds every arc and breakdown in the run's raw file.
 
 pub mod analysis;
-pub mod element;
 pub mod gap;
+pub mod vectors;
 
 use serde::{Deserialize, Serialize};
 
 pub use analysis::{ArcEvent, ArcReport, ArcTotals, Breakdown};
 pub use gap::GapProfile;
+pub use vectors::ArcVectors;
 
 /// A contact material with published minimum arc voltage and current.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]

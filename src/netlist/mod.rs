@@ -16,6 +16,7 @@
 //!
 //! Everything here is text in, text out, and deterministic.
 
+pub mod arc;
 pub mod coil;
 pub mod contact;
 pub mod deck;

@@ -30,9 +30,8 @@ use std::time::Duration;
 
 use thiserror::Error;
 
-use crate::arc::GapProfile;
 use crate::arc::ArcVectors;
-use crate::netlist::arc::with_arc;
+use crate::arc::GapProfile;
 use crate::chatter::{Chatter, ContactState, Interval};
 use crate::coil::accelerate::{CircuitRun, Tolerances, settle};
 #[cfg(test)]
@@ -43,6 +42,7 @@ use crate::coil::{Coil, CoilError};
 use crate::mechanics::Mechanics;
 use crate::mechanics::cycle::{Stops, Stroke};
 use crate::mechanics::{Drive, Trajectory, simulate_drive};
+use crate::netlist::arc::with_arc;
 use crate::netlist::coil::coil_include;
 use crate::netlist::{
     self, ContactElement, Deck, DeckRequest, NetlistError, contact_include, instances_of,

@@ -31,12 +31,12 @@ use thiserror::Error;
 
 use crate::analysis::{self, AnalysisError, Comparison, ProbeAnalysis};
 use crate::arc::ArcVectors;
-use crate::netlist::arc::with_arc;
 use crate::arc::{ArcModel, ArcReport, GapProfile, analysis::MissingArcVector};
 use crate::chatter::{Chatter, ContactState, Interval};
 use crate::coil::Operation;
 use crate::mechanics::Surface;
 use crate::mechanics::{MechanicsError, Trajectory, contact_forces};
+use crate::netlist::arc::with_arc;
 use crate::netlist::{self, ContactElement, ContactInclude, Deck, DeckRequest, NetlistError};
 use crate::plan::{Netlist, Plan};
 use crate::rawfile::Plot;
