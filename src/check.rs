@@ -57,10 +57,13 @@ pub struct LimitCheck {
     pub quantity: String,
     /// SI unit symbol of `limit`, `actual` and `margin`; empty for counts.
     pub unit: &'static str,
+    /// Whether `limit` is a maximum or a minimum.
     pub bound: Bound,
+    /// The limit from the scenario, in `unit`.
     pub limit: f64,
     /// `None` when the quantity does not exist (the check then fails).
     pub actual: Option<f64>,
+    /// Whether the limit held: `actual` exists and the margin is ≥ 0.
     pub passed: bool,
     /// Room left before the limit (negative: by how much it failed).
     pub margin: Option<f64>,
@@ -111,6 +114,7 @@ pub struct Verdict {
 }
 
 impl Verdict {
+    /// The verdict of `checks`: passed when none failed.
     pub fn new(checks: Vec<LimitCheck>) -> Verdict {
         let failed = checks.iter().filter(|c| !c.passed).count();
         Verdict {
@@ -172,7 +176,10 @@ pub fn quantity(value: f64, unit: &str) -> String {
 
 /// Why a check could not be made (as opposed to failing).
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum CheckError {
+    /// Nothing to check: the scenario has no `[limits]` and no probe with
+    /// a limit (for [`relay_only`], no `[limits]`).
     #[error(
         "{}: nothing to check: add a [limits] section (max_bounce_time, max_bounces, \
          max_operate_time, max_settle_time; with a coil max_release_time, \
@@ -180,15 +187,24 @@ pub enum CheckError {
          max_glitches, max_peak, max_value, min_value, max_last_edge)",
         path.display()
     )]
-    NoLimits { path: PathBuf },
+    NoLimits {
+        /// The scenario file.
+        path: PathBuf,
+    },
+    /// The scenario cannot be simulated as asked (e.g. the mechanics
+    /// alone of a coil-driven relay).
     #[error(transparent)]
     Scenario(#[from] ScenarioError),
+    /// The mechanics simulation failed.
     #[error("{}: the mechanics simulation failed", path.display())]
     Mechanics {
+        /// The scenario file.
         path: PathBuf,
+        /// Why it failed.
         #[source]
         source: MechanicsError,
     },
+    /// The run through the circuit simulator failed.
     #[error(transparent)]
     Run(#[from] Box<RunError>),
 }
@@ -441,6 +457,7 @@ pub enum Evidence {
 }
 
 impl Evidence {
+    /// The chatter sequence the verdict was reached on.
     pub fn chatter(&self) -> &Chatter {
         match self {
             Evidence::Mechanics(c) => c,

@@ -43,8 +43,11 @@ use crate::mechanics::{Drive, Mechanics, Settings, Trajectory, simulate_drive};
 /// One ngspice run of the coil: its time points, the voltage across the
 /// coil and its flux linkage there, and the armature path it followed.
 pub struct CircuitRun<'a> {
+    /// s, the run's time points.
     pub time: &'a [f64],
+    /// V, the voltage across the coil at each time point.
     pub volts: &'a [f64],
+    /// Wb (V·s), the coil's flux linkage ψ at each time point.
     pub flux: &'a [f64],
     /// (s, m): the path given to ngspice.
     pub path: &'a [(f64, f64)],

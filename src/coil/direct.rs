@@ -124,11 +124,14 @@ impl EnergyBalance {
 /// The result of [`simulate_direct`].
 #[derive(Debug, Clone)]
 pub struct CoilRun {
+    /// The contact's chatter sequence.
     pub chatter: Chatter,
+    /// The named events of the closing.
     pub events: CoilEvents,
     /// (s, A): the coil current at every accepted integration step, from
     /// t = 0 to the end of the run (the sticking decision, or `t_end`).
     pub current: Vec<(f64, f64)>,
+    /// J, where the source's energy went, from t = 0 to the end of the run.
     pub energy: EnergyBalance,
     coil: Coil,
     gap: f64,

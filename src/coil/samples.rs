@@ -84,6 +84,7 @@ pub struct Cursor<'a> {
 }
 
 impl<'a> Cursor<'a> {
+    /// A cursor over `samples`, (time, value) pairs in increasing time.
     pub fn new(samples: &'a [(f64, f64)]) -> Self {
         Cursor {
             samples,

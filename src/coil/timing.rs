@@ -103,6 +103,8 @@ pub struct Operation {
     pub coil_on: Option<f64>,
     /// s, the coil switched off after it closed.
     pub coil_off: Option<f64>,
+    /// The stroke itself: its instants (s, from the run's t = 0) and
+    /// bounce counts, flattened into the operation when serialized.
     #[serde(flatten)]
     pub stroke: Stroke,
     /// s, coil on → first make: the operate time.

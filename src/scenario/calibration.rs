@@ -39,8 +39,13 @@ pub struct DatasheetSection {
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FitSection {
+    /// `fit.free`: the number keys the fit may move (`--free` replaces the
+    /// list); each needs a positive value in the scenario, its prior.
     #[serde(default)]
     pub free: Vec<String>,
+    /// `fit.bounds`: per free key, the `[low, high]` it may move within, in
+    /// the key's unit; a key without bounds moves within a decade either
+    /// side of its prior.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub bounds: BTreeMap<String, [f64; 2]>,
 }
@@ -67,11 +72,16 @@ pub struct ProvenanceSection {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FittedParameter {
+    /// `prior`: the key's value before the fit, in its unit.
     pub prior: f64,
+    /// `value`: the fitted value, in the key's unit; the prior when the key
+    /// was held.
     pub value: f64,
     /// 1σ, same unit as the value; absent when the key was held at its
     /// prior because the evidence does not determine it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sigma: Option<f64>,
+    /// `determined`: whether the evidence determined the key (its 1σ is
+    /// smaller than its value); `false` for a key held at its prior.
     pub determined: bool,
 }

@@ -9,6 +9,7 @@ use super::*;
 pub struct CoilSection {
     /// Ω
     pub resistance: f64,
+    /// `coil.turns`: the number of turns of the winding, at least 1.
     pub turns: u32,
     /// m²
     pub pole_area: f64,

@@ -5,7 +5,9 @@ use super::*;
 /// A place in a scenario file: the file and, when known, the 1-based line.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Location {
+    /// The scenario file, or `<stdin>` for one read from standard input.
     pub path: PathBuf,
+    /// 1-based line, when the error can be traced to one.
     pub line: Option<usize>,
 }
 
@@ -21,98 +23,163 @@ impl fmt::Display for Location {
 /// Why a scenario file cannot be used. Each variant says where (`at`),
 /// which key, and what to change.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum ScenarioError {
+    /// The scenario file could not be read.
     #[error("{}: cannot read the scenario file", path.display())]
     Read {
+        /// The file as given.
         path: PathBuf,
+        /// Why it could not be read.
         #[source]
         source: std::io::Error,
     },
+    /// The text is not valid TOML, or sets a key or a table twice.
     #[error("{at}: not valid TOML (column {column}): {message}")]
     Syntax {
+        /// Where the parser stopped.
         at: Location,
+        /// 1-based column of that place, in characters.
         column: usize,
+        /// The parser's message; for a duplicate key, it names the key and the
+        /// line that set it first.
         message: String,
+        /// The parser's error.
         #[source]
         source: Box<toml::de::Error>,
     },
+    /// A key its section does not have, such as a misspelt one.
     #[error("{at}: unknown key `{key}` (misspelt?); {expected}")]
     UnknownKey {
+        /// Where the key is.
         at: Location,
+        /// The dotted key, e.g. `mechanics.mas`.
         key: String,
+        /// The keys the section has, in serde's words ("expected one of …").
         expected: String,
+        /// The deserializer's error.
         #[source]
         source: Box<toml::de::Error>,
     },
+    /// A required key or section is not given.
     #[error("{at}: `{key}` is missing: {help}")]
     MissingKey {
+        /// Where it is missing: the enclosing table, or the key that needs it.
         at: Location,
+        /// The dotted key that is missing.
         key: String,
+        /// What the key means, or how to add it.
         help: String,
+        /// The deserializer's error, when the deserializer found it missing;
+        /// `None` when validation did.
         #[source]
         source: Option<Box<toml::de::Error>>,
     },
+    /// A value of the wrong type (text for a number, …) or not one of the
+    /// values a key takes (e.g. an unknown `surface.law`).
     #[error("{at}: bad value for `{key}`: {message}")]
     BadValue {
+        /// Where the value is.
         at: Location,
+        /// The dotted key whose value it is.
         key: String,
+        /// The deserializer's message in a reader's words.
         message: String,
+        /// The deserializer's error.
         #[source]
         source: Box<toml::de::Error>,
     },
+    /// A number that is not finite, or outside the range its key allows.
     #[error("{at}: `{key}` = {value:?} {requirement}")]
     Invalid {
+        /// Where the key is.
         at: Location,
+        /// The dotted key, e.g. `mechanics.mass` or `probe[0].low`.
         key: String,
+        /// The value given (a count that must be at least 1 reports 0).
         value: f64,
+        /// What the value must be, and what the key means.
         requirement: String,
     },
+    /// A text key that must name something is blank (`probe[i].signal`,
+    /// `circuit.netlist`, `circuit.subckt`, …).
     #[error("{at}: `{key}` must not be empty: {help}")]
     Empty {
+        /// Where the key is.
         at: Location,
+        /// The dotted key.
         key: String,
+        /// What the key holds.
         help: &'static str,
     },
+    /// Two keys or sections that cannot be used together are both given.
     #[error("{at}: `{key}` and `{other}` cannot both be given: {advice}")]
     Conflict {
+        /// Where `key` is.
         at: Location,
+        /// The dotted key reported.
         key: String,
+        /// The key or section it cannot be used with.
         other: String,
+        /// Which to keep, and why.
         advice: &'static str,
     },
+    /// A key of `[surface]` or `[back_stop]` that the section's `law` does
+    /// not read.
     #[error(
         "{at}: `{key}` is not a key of surface law \"{law}\", which takes {takes}; \
          remove it or change `surface.law`"
     )]
     NotForLaw {
+        /// Where the key is.
         at: Location,
+        /// The dotted key, e.g. `surface.damping`.
         key: String,
+        /// The section's `law`.
         law: SurfaceLaw,
+        /// The keys that law reads, as the message lists them.
         takes: &'static str,
     },
+    /// The mechanics alone were asked of a coil-driven relay (a `[coil]`
+    /// and no `mechanics.force`), which moves only coupled to its driver
+    /// circuit.
     #[error(
         "{}: a coil-driven relay ([coil], docs/model.md §7) is simulated only with its driver \
          circuit, by `run` (the coil coupled to the netlist); for the mechanics alone \
          replace [coil] with `mechanics.force`, the closing force in N",
         path.display()
     )]
-    CoilDriveUnsupported { path: PathBuf },
+    CoilDriveUnsupported {
+        /// The scenario file.
+        path: PathBuf,
+    },
+    /// A key given as one of the scenario's numbers (in `[sweep]`, or to
+    /// [`Scenario::number`] or [`Scenario::set_number`]) that is not one.
     #[error("{at}: `{key}` is not a number of the scenario{within}; use one of: {known}")]
     UnknownNumber {
+        /// Where the key was named; no line for a library call.
         at: Location,
+        /// The key as given.
         key: String,
-        /// Where the key was named, e.g. " (in [sweep.vary])"; empty for a
+        /// Where the key was named, e.g. " (named in [sweep.vary])"; empty for a
         /// library call.
         within: &'static str,
         /// The keys that are numbers, comma-separated.
         known: String,
     },
+    /// A `[sweep]` key that cannot be used (a grid of more than two keys, a
+    /// varied key the scenario gives no value or 0, a grid end outside the
+    /// key's range), or a number key whose section the scenario lacks.
     #[error("{at}: `{key}`: {problem}")]
     Sweep {
+        /// Where the key is; no line for a library call.
         at: Location,
+        /// The key as shown in the message, e.g. `sweep.vary."mechanics.mass"`.
         key: String,
+        /// What is wrong, and what to change.
         problem: String,
     },
+    /// The netlist named by `circuit.netlist` could not be read.
     #[error(
         "{}: cannot read the netlist named by `circuit.netlist` in {} ({})",
         path.display(),
@@ -125,8 +192,11 @@ pub enum ScenarioError {
         }
     )]
     NetlistRead {
+        /// The netlist's path, resolved against the scenario's directory.
         path: PathBuf,
+        /// The scenario file that names it (`<stdin>` for standard input).
         scenario: PathBuf,
+        /// Why it could not be read.
         #[source]
         source: std::io::Error,
     },

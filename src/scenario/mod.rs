@@ -103,15 +103,27 @@ struct Document {
 pub struct Scenario {
     /// The file it came from (for messages, and the base of relative paths).
     pub origin: PathBuf,
+    /// `[mechanics]`: the moving contact and, without a `[coil]`, its step
+    /// force.
     pub mechanics: MechanicsSection,
+    /// `[coil]`: the magnetic drive of a coil-driven relay, instead of
+    /// `mechanics.force`.
     pub coil: Option<CoilSection>,
+    /// `[surface]`: the fixed contact's surface law as written; the
+    /// resolved law is [`Scenario::surface`].
     pub surface: SurfaceSection,
     /// `[back_stop]`: the rest stop's own surface law, where the armature
     /// lands on release (the normally-closed contact). Only with `[coil]`:
     /// a step force never releases.
     pub back_stop: Option<SurfaceSection>,
+    /// `[contact]`: the contact as a resistor (the defaults when the file
+    /// has no such section).
     pub contact: ContactSection,
+    /// `[simulation]`: when to stop (the defaults when the file has no such
+    /// section).
     pub simulation: SimulationSection,
+    /// `[circuit]`: the netlist the contact switches, `circuit.netlist`
+    /// already resolved against the scenario file's directory.
     pub circuit: Option<CircuitSection>,
     /// The `[[probe]]` tables, in file order.
     pub probes: Vec<Probe>,
@@ -288,7 +300,6 @@ impl Scenario {
     }
 }
 
-/// 1-based line and column of byte offset `at` in `text`.
 /// `path` with `.` dropped and `dir/..` folded, without touching the file
 /// system: `scenarios/../netlists/a.cir` → `netlists/a.cir`, which reads
 /// better in messages. A `..` with nothing to fold stays.

@@ -9,8 +9,10 @@ use super::*;
 pub struct Probe {
     /// An ngspice vector name, e.g. `v(in)`.
     pub signal: String,
-    /// V (A for a current): the Schmitt thresholds.
+    /// `probe[i].low`, V (A for a current): the lower Schmitt threshold,
+    /// below `high`.
     pub low: f64,
+    /// `probe[i].high`, V (A for a current): the upper Schmitt threshold.
     pub high: f64,
     /// Most Schmitt edges allowed (1 = one clean transition).
     #[serde(default)]

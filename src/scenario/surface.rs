@@ -8,8 +8,15 @@ use crate::mechanics::surface::hunt_crossley_chi;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum SurfaceLaw {
+    /// `"rigid"`: an impact of no duration that reverses the speed and
+    /// scales it by `restitution` (docs/model.md §2a).
     Rigid,
+    /// `"kelvin-voigt"`: a linear spring `stiffness` and damper `damping`
+    /// while in contact (docs/model.md §2b).
     KelvinVoigt,
+    /// `"hunt-crossley"`: the force k δⁿ (1 + χ δ̇), never negative; χ given
+    /// as `chi` or as `restitution` at `reference_velocity`
+    /// (docs/model.md §2c).
     HuntCrossley,
 }
 
@@ -63,6 +70,8 @@ impl fmt::Display for SurfaceLaw {
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SurfaceSection {
+    /// `surface.law` (or `back_stop.law`): which law, and so which of the
+    /// other keys apply.
     pub law: SurfaceLaw,
     /// N/m (Kelvin–Voigt s0) or N/mⁿ (Hunt–Crossley k).
     pub stiffness: Option<f64>,

@@ -105,8 +105,12 @@ impl<'de> Deserialize<'de> for Tolerance {
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GridAxis {
+    /// `from`: the first value, in the key's unit; > 0 with `log`.
     pub from: f64,
+    /// `to`: the last value, in the key's unit; > 0 with `log`. It may lie
+    /// below `from`.
     pub to: f64,
+    /// `steps`: how many values, at least 1 (1 gives `from` alone).
     pub steps: u32,
     /// Space the values geometrically (e.g. a stiffness over decades).
     #[serde(default)]

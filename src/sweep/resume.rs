@@ -33,6 +33,7 @@ pub struct Identity {
     pub scenario_digest: String,
     /// The random sweep's seed; `None` for a grid.
     pub seed: Option<u64>,
+    /// Samples of the whole sweep (not of the shard).
     pub samples: u64,
     /// `K/N`, or `None` for the whole sweep.
     pub shard: Option<String>,
@@ -45,6 +46,8 @@ pub struct Identity {
 /// The file beside a sweep CSV.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Meta {
+    /// Which sweep the rows belong to; its fields sit at the top level of
+    /// the JSON.
     #[serde(flatten)]
     pub identity: Identity,
     /// Whether every sample of the shard has its row.
@@ -54,6 +57,7 @@ pub struct Meta {
 }
 
 impl Meta {
+    /// Pretty JSON, `\n`-terminated.
     pub fn to_json(&self) -> String {
         let mut text = serde_json::to_string_pretty(self).expect("plain data serializes");
         text.push('\n');
@@ -65,41 +69,69 @@ impl Meta {
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum ResumeError {
+    /// The identity file cannot be read, so no sweep is known to have run
+    /// there.
     #[error(
         "{}: cannot read it, so there is no sweep to resume here (a sweep writes it beside its \
          CSV)",
         path.display()
     )]
     NoMeta {
+        /// The identity file.
         path: PathBuf,
+        /// Why it cannot be read.
         #[source]
         source: std::io::Error,
     },
+    /// The identity file is not the JSON a sweep writes.
     #[error("{}: not a sweep's identity file: {problem}", path.display())]
-    BadMeta { path: PathBuf, problem: String },
+    BadMeta {
+        /// The identity file.
+        path: PathBuf,
+        /// The JSON parser's message.
+        problem: String,
+    },
+    /// The sweep there has every row already.
     #[error("{}: the sweep there is complete: there is nothing to resume", path.display())]
-    Complete { path: PathBuf },
+    Complete {
+        /// The identity file.
+        path: PathBuf,
+    },
+    /// The rows there belong to another sweep: its scenario, seed, sample
+    /// count, shard, mode, ideal-contact setting or tool version differs.
     #[error(
         "{}: the sweep there is another one: its {field} is {theirs}, this one's is {ours}; \
          resume with the same scenario, seed and options",
         path.display()
     )]
     Different {
+        /// The identity file.
         path: PathBuf,
+        /// The first field that differs, in words (e.g. `seed`).
         field: &'static str,
+        /// Its value in the identity file.
         theirs: String,
+        /// Its value for this sweep.
         ours: String,
     },
+    /// The CSV of the interrupted sweep cannot be read.
     #[error("{}: cannot read the rows to resume from", path.display())]
     ReadCsv {
+        /// The CSV.
         path: PathBuf,
+        /// Why it cannot be read.
         #[source]
         source: std::io::Error,
     },
+    /// The CSV's header is not the one this sweep writes, or a whole row
+    /// cannot be read back or is not the sample due.
     #[error("{}: line {line}: {problem}; the rows cannot be resumed from", path.display())]
     BadRow {
+        /// The CSV.
         path: PathBuf,
+        /// 1-based line of the row (1: the header).
         line: u64,
+        /// What is wrong with it.
         problem: String,
     },
 }

@@ -32,10 +32,17 @@ const QUOTED_ERRORS: usize = 5;
 /// Per-sample numbers for the summary and the plot, in index order.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Collected {
+    /// The varied keys, in [`Sampler::keys`] order.
     pub keys: Vec<String>,
+    /// The probes' signals, in `[[probe]]` order; empty for a
+    /// mechanics-only sweep.
     pub signals: Vec<String>,
+    /// Each sample's index in the sweep.
     pub index: Vec<u64>,
+    /// Each sample's chatter outcome; `None` when it failed before the
+    /// mechanics ran.
     pub outcome: Vec<Option<Outcome>>,
+    /// Each sample's openings after the first make.
     pub bounce_count: Vec<Option<u32>>,
     /// s
     pub bounce_time: Vec<Option<f64>>,
@@ -49,6 +56,7 @@ pub struct Collected {
     pub edges: Vec<Vec<Option<u32>>>,
     /// `[probe][sample]`, max |value|.
     pub peak: Vec<Vec<Option<f64>>>,
+    /// Each sample's verdict.
     pub verdict: Vec<Verdict>,
     /// Samples that failed each limit, by limit key.
     pub failed_limits: BTreeMap<String, u64>,
@@ -226,10 +234,15 @@ impl Collected {
 pub struct Distribution {
     /// How many samples had a value.
     pub count: u64,
+    /// The smallest value, in the quantity's unit.
     pub min: f64,
+    /// The 50th percentile (nearest-rank).
     pub median: f64,
+    /// The 95th percentile (nearest-rank).
     pub p95: f64,
+    /// The largest value.
     pub max: f64,
+    /// The arithmetic mean.
     pub mean: f64,
 }
 
@@ -257,20 +270,30 @@ impl Distribution {
 /// One probe's distributions.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ProbeSummary {
+    /// The probe's ngspice vector, e.g. `v(in)`.
     pub signal: String,
+    /// Schmitt edges per sample; `None` when no sample reached ngspice's
+    /// results.
     pub edges: Option<Distribution>,
+    /// max |value| per sample, in the signal's unit (V or A).
     pub peak: Option<Distribution>,
 }
 
 /// The worst sample.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Worst {
+    /// Its index in the sweep.
     pub index: u64,
+    /// Its chatter outcome, as in `sweep.csv`; `None` when it failed
+    /// before the mechanics ran.
     pub outcome: Option<&'static str>,
+    /// Its openings after the first make.
     pub bounce_count: Option<u32>,
+    /// s, its first make → closed for good.
     pub bounce_time: Option<f64>,
     /// Per probe.
     pub edges: Vec<Option<u32>>,
+    /// `pass`, `fail` or `error`.
     pub verdict: &'static str,
     /// Its values of the varied keys.
     pub values: BTreeMap<String, f64>,
@@ -279,6 +302,7 @@ pub struct Worst {
 /// The samples that failed one limit.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct LimitFailures {
+    /// Samples that failed it.
     pub failing: u64,
     /// failing / samples.
     pub fraction: f64,
@@ -287,17 +311,22 @@ pub struct LimitFailures {
 /// A sample that failed, and why.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SampleError {
+    /// The sample's index in the sweep.
     pub index: u64,
+    /// The error and its causes, on one line.
     pub error: String,
 }
 
 /// `summary.json`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Summary {
+    /// Samples summarized (a shard's own, for a shard).
     pub samples: u64,
     /// `random` or `grid`.
     pub kind: &'static str,
+    /// The random sweep's seed; `None` for a grid.
     pub seed: Option<u64>,
+    /// The varied keys, sorted.
     pub keys: Vec<String>,
     /// Samples per chatter outcome (`none`: failed before the mechanics).
     pub outcomes: BTreeMap<&'static str, u64>,
@@ -312,6 +341,7 @@ pub struct Summary {
     pub limits: BTreeMap<String, LimitFailures>,
     /// (failing + errors) / samples.
     pub fraction_failing: f64,
+    /// Openings after the first make.
     pub bounce_count: Option<Distribution>,
     /// s
     pub bounce_time: Option<Distribution>,
@@ -321,7 +351,10 @@ pub struct Summary {
     pub release_time: Option<Distribution>,
     /// J, all arcs of a sample (with `[arc]` only).
     pub arc_energy: Option<Distribution>,
+    /// One per `[[probe]]`, in file order; empty for a mechanics-only
+    /// sweep.
     pub probes: Vec<ProbeSummary>,
+    /// The worst sample (see the module overview); `None` without samples.
     pub worst: Option<Worst>,
     /// The first few errors.
     pub first_errors: Vec<SampleError>,

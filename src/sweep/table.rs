@@ -162,39 +162,63 @@ pub fn rows(records: &[Record], keys: usize, probes: usize, columns: Columns) ->
 
 /// Why shards' CSVs could not be merged.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum MergeError {
+    /// An input could not be read as CSV.
     #[error("{}: cannot read it", path.display())]
     Read {
+        /// The input.
         path: PathBuf,
+        /// Why it could not be read.
         #[source]
         source: csv::Error,
     },
+    /// An input is empty: it has no header.
     #[error("{}: empty, not even a header; was the shard started?", path.display())]
-    NoHeader { path: PathBuf },
+    NoHeader {
+        /// The input.
+        path: PathBuf,
+    },
+    /// An input's header differs from the first input's.
     #[error(
         "{}: its header differs from {}'s; merge only the shards of one sweep \
          (same scenario, keys and mode)",
         path.display(),
         first.display()
     )]
-    Header { path: PathBuf, first: PathBuf },
+    Header {
+        /// The input.
+        path: PathBuf,
+        /// The first input, whose header the others must have.
+        first: PathBuf,
+    },
+    /// A row's first cell is not a sample index.
     #[error("{}, line {line}: `{text}` is not a sample index; is this a sweep CSV?", path.display())]
     Index {
+        /// The input.
         path: PathBuf,
+        /// 1-based line of the row.
         line: u64,
+        /// The cell.
         text: String,
     },
+    /// An input's rows are not in increasing index order.
     #[error(
         "{}, line {line}: index {index} after {previous}; a shard's rows are in index order, \
          was the file edited?",
         path.display()
     )]
     Unsorted {
+        /// The input.
         path: PathBuf,
+        /// 1-based line of the row.
         line: u64,
+        /// The row's index.
         index: u64,
+        /// The index of the row before it, not below `index`.
         previous: u64,
     },
+    /// Two inputs hold different rows for the same index.
     #[error(
         "index {index} is in {} and in {} with different values; were these shards of \
          different sweeps (seed, samples)?",
@@ -202,15 +226,26 @@ pub enum MergeError {
         second.display()
     )]
     Conflict {
+        /// The sample index.
         index: u64,
+        /// The input whose row was kept first.
         first: PathBuf,
+        /// The input with the other row.
         second: PathBuf,
     },
+    /// Indices below the largest found, or below the expected sample
+    /// count, are in no input (and missing ones were not allowed).
     #[error(
         "{count} sample(s) missing: {ranges}; rerun the shards that hold them, or pass \
          --allow-missing to write the rows there are"
     )]
-    Missing { count: u64, ranges: String },
+    Missing {
+        /// How many indices are missing.
+        count: u64,
+        /// The missing indices as ranges, e.g. `3–5, 9`.
+        ranges: String,
+    },
+    /// The merged CSV could not be written.
     #[error("cannot write the merged CSV")]
     Write(#[source] std::io::Error),
 }
@@ -425,20 +460,30 @@ pub fn merge_files(
 
 /// Why [`merge_files`] failed.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum MergeFilesError {
+    /// An input could not be opened (or is not a regular file).
     #[error("{}: cannot open it", path.display())]
     Open {
+        /// The input.
         path: PathBuf,
+        /// Why it could not be opened.
         #[source]
         source: std::io::Error,
     },
+    /// The inputs could not be merged.
     #[error(transparent)]
     Merge(#[from] MergeError),
+    /// The output could not be created or put in place (e.g. it exists
+    /// and overwriting was not asked for).
     #[error(transparent)]
     Write(#[from] crate::output::WriteError),
+    /// The merged rows could not be flushed to the temporary output file.
     #[error("{}: cannot write the merged CSV", path.display())]
     Output {
+        /// The output.
         path: PathBuf,
+        /// Why it could not be written.
         #[source]
         source: std::io::Error,
     },

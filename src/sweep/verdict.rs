@@ -16,6 +16,7 @@ use crate::scenario::Scenario;
 /// The `verdict` column of `sweep.csv`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Verdict {
+    /// The sample ran and every limit held (or it had none).
     Pass,
     /// A limit failed.
     Fail,
