@@ -545,6 +545,20 @@ pub fn measured(
 
 /// The `[limits]` of `scenario` on the mechanics alone, without ngspice;
 /// probe limits are not looked at (use [`run_with`] for those).
+///
+/// ```
+/// use chatterspice::check::relay_only;
+/// use chatterspice::scenario::{LimitsSection, Scenario};
+///
+/// // The built-in relay bounces 5 times: a limit of 4 fails, 5 holds.
+/// let mut scenario = Scenario::builtin_default();
+/// for (max, holds) in [(4, false), (5, true)] {
+///     scenario.limits = Some(LimitsSection { max_bounces: Some(max), ..Default::default() });
+///     let (verdict, _) = relay_only(&scenario)?;
+///     assert_eq!(verdict.passed, holds);
+/// }
+/// # Ok::<(), chatterspice::check::CheckError>(())
+/// ```
 pub fn relay_only(scenario: &Scenario) -> Result<(Verdict, Evidence), CheckError> {
     if scenario.limits.is_none() {
         return Err(CheckError::NoLimits {

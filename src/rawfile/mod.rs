@@ -450,6 +450,19 @@ impl RawFile {
     }
 
     /// Parses the bytes of a raw file.
+    ///
+    /// ```
+    /// use chatterspice::rawfile::RawFile;
+    ///
+    /// let text = "Title: divider\nDate: today\nPlotname: Transient Analysis\n\
+    ///             Flags: real\nNo. Variables: 2\nNo. Points: 2\nVariables:\n\
+    ///             \t0\ttime\ttime\n\t1\tv(out)\tvoltage\nValues:\n\
+    ///             0\t0.0\n\t1.5\n1\t1e-3\n\t1.65\n";
+    /// let raw = RawFile::parse(text.as_bytes())?;
+    /// let plot = raw.last_transient().expect("a transient plot");
+    /// assert_eq!(plot.real("v(out)"), Some(&[1.5, 1.65][..]));
+    /// # Ok::<(), chatterspice::rawfile::RawError>(())
+    /// ```
     pub fn parse(bytes: &[u8]) -> Result<RawFile, RawError> {
         detect_utf16(bytes)?;
         let mut cur = Cursor {

@@ -14,6 +14,7 @@
 //! [`Scenario::mechanics`], [`Scenario::surface`], [`Scenario::settings`].
 
 mod arc;
+mod builder;
 mod calibration;
 mod check;
 mod circuit;
@@ -31,6 +32,7 @@ mod sweep;
 #[cfg(test)]
 mod tests;
 
+pub use builder::ScenarioBuilder;
 pub use calibration::{DatasheetSection, FitSection, FittedParameter, ProvenanceSection};
 pub use circuit::CircuitSection;
 pub use coil::CoilSection;
