@@ -55,6 +55,8 @@ use crate::waveform::{ContactModel, Waveform, WaveformError};
 
 /// The include names in the run's work directory.
 const CONTACT_FILE: &str = "contact.inc";
+/// The coil include's file name in the run's work directory (and in
+/// `--out`), which the deck `.include`s.
 pub const COIL_FILE: &str = "coil.inc";
 
 /// How to iterate.
@@ -62,6 +64,8 @@ pub const COIL_FILE: &str = "coil.inc";
 pub struct CouplingOptions {
     /// s: converged when no impact or release time moves more than this.
     pub tolerance: f64,
+    /// The most iterations (one ngspice run each) before the run fails
+    /// as not converged.
     pub max_iterations: usize,
     /// Wall-clock limit of each ngspice run.
     pub timeout: Duration,
@@ -95,7 +99,11 @@ impl Default for CouplingOptions {
 /// One pass of the loop.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Iteration {
+    /// s, the normally-open contact's first impact in this pass's
+    /// mechanics; `None` if it never closed.
     pub first_impact: Option<f64>,
+    /// The normally-open contact's bounce count in this pass's mechanics
+    /// ([`Chatter::bounce_count`]).
     pub bounces: usize,
     /// s, the largest move of an event time from the previous iteration
     /// (infinite when the number of events changed).
@@ -124,7 +132,10 @@ pub struct Coupled {
     /// The coil instance in the netlist, e.g. `x2`: its current is
     /// `i(v.x2.vi)`, its flux linkage `v(x2.psi)`.
     pub coil_instance: String,
+    /// Every pass of the loop, in order; the last one converged.
     pub iterations: Vec<Iteration>,
+    /// The deck of the last circuit run: the user's netlist with the
+    /// contact and coil `.include`s.
     pub deck: Deck,
     /// ngspice's version, e.g. `"39"`.
     pub version: Option<String>,
@@ -160,64 +171,113 @@ pub fn flux_vector(instance: &str) -> String {
 
 /// Why a coupled run failed.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum CouplingError {
+    /// The scenario has no `[coil]`.
     #[error(
         "{}: no [coil] section: the coupled run needs the coil (resistance, turns, \
          pole_area, air_gap, iron_gap)",
         path.display()
     )]
-    NoCoil { path: PathBuf },
+    NoCoil {
+        /// The scenario file.
+        path: PathBuf,
+    },
+    /// The scenario has no `[circuit]`, so there is no driver to run.
     #[error(
         "{}: no [circuit] section: the coupled run needs the driver netlist that \
          instantiates the coil (X2 a b COIL) and the contact (X1 a b CONTACT)",
         path.display()
     )]
-    NoCircuit { path: PathBuf },
+    NoCircuit {
+        /// The scenario file.
+        path: PathBuf,
+    },
+    /// The netlist does not instantiate the coil subcircuit exactly once.
     #[error(
         "{}: the coil subcircuit `{subckt}` must be instantiated exactly once in the netlist \
          itself (found {found}), so that its current can be read back",
         netlist.display()
     )]
     CoilInstances {
+        /// The user's netlist.
         netlist: PathBuf,
+        /// The coil subcircuit's name (`circuit.coil_subckt`).
         subckt: String,
+        /// How many instances of it the netlist has.
         found: usize,
     },
+    /// `circuit.nc_subckt` names a subcircuit the netlist does not
+    /// instantiate.
     #[error(
         "{}: `circuit.nc_subckt` = `{subckt}` is not instantiated in the netlist: add \
          an X line for the normally-closed contact (X3 a b {subckt}), or remove the key",
         netlist.display()
     )]
-    NcNotInstantiated { netlist: PathBuf, subckt: String },
+    NcNotInstantiated {
+        /// The user's netlist.
+        netlist: PathBuf,
+        /// The normally-closed contact's subcircuit name
+        /// (`circuit.nc_subckt`).
+        subckt: String,
+    },
+    /// The scenario does not validate, or its netlist cannot be read
+    /// (see [`Plan::new`]).
     #[error(transparent)]
     Scenario(#[from] ScenarioError),
+    /// An include (the contact's, the normally-closed contact's or the
+    /// coil's) or the run deck could not be built.
     #[error(transparent)]
     Netlist(#[from] NetlistError),
+    /// A contact's conductance over time could not be built from its
+    /// chatter.
     #[error("{}: the contact waveform", path.display())]
     Waveform {
+        /// The scenario file.
         path: PathBuf,
+        /// Why the waveform could not be built.
         #[source]
         source: WaveformError,
     },
+    /// The coil's parameters are invalid (iteration 0), or the mechanics
+    /// under the coil's pull failed.
     #[error("{}: iteration {iteration}: the mechanics under the coil's pull", path.display())]
     Coil {
+        /// The scenario file.
         path: PathBuf,
+        /// The iteration, from 1; 0 for the check of the coil before the
+        /// first.
         iteration: usize,
+        /// Why the coil or the mechanics failed.
         #[source]
         source: CoilError,
     },
+    /// ngspice failed on one iteration's circuit run.
     #[error("ngspice failed in iteration {iteration} of the coupled run of {}", netlist.display())]
     Spice {
+        /// The user's netlist.
         netlist: PathBuf,
+        /// The iteration, from 1.
         iteration: usize,
+        /// The ngspice error.
         #[source]
         source: Box<SpiceError>,
     },
+    /// An iteration's raw file lacks a vector the coupling reads back (or
+    /// has no transient plot at all).
     #[error(
         "the raw file of iteration {iteration} has no `{vector}`: the coil's flux linkage \
          (a transient analysis is needed)"
     )]
-    MissingVector { iteration: usize, vector: String },
+    MissingVector {
+        /// The iteration, from 1.
+        iteration: usize,
+        /// The vector's name, e.g. `v(x2.psi)`, or `time` for a plot with
+        /// no real time scale.
+        vector: String,
+    },
+    /// The event times still moved by more than the tolerance after the
+    /// allowed number of iterations.
     #[error(
         "{}: the coupling did not converge in {iterations} iterations: event times still \
          moved by {change:e} s (tolerance {tolerance:e} s); allow more iterations \
@@ -226,9 +286,14 @@ pub enum CouplingError {
         netlist.display()
     )]
     NotConverged {
+        /// The user's netlist.
         netlist: PathBuf,
+        /// The number of iterations run (`max_iterations`).
         iterations: usize,
+        /// s, the last iteration's largest move of an event time
+        /// (infinite when the number of events changed).
         change: f64,
+        /// s, the tolerance it had to come within.
         tolerance: f64,
     },
 }

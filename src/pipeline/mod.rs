@@ -90,43 +90,72 @@ impl Default for RunOptions {
 
 /// Why a run failed. Each variant names the file, key or run to look at.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum RunError {
+    /// The scenario does not validate, or its netlist cannot be read
+    /// (see [`Plan::new`]).
     #[error(transparent)]
     Scenario(#[from] ScenarioError),
+    /// The mechanics (the armature's motion under the step force, or the
+    /// contact force for the Holm law) could not be simulated.
     #[error("{}: the mechanics simulation failed", path.display())]
     Mechanics {
+        /// The scenario file.
         path: PathBuf,
+        /// Why the simulation failed.
         #[source]
         source: MechanicsError,
     },
+    /// The contact conductance over time could not be built from the
+    /// chatter.
     #[error("{}: cannot build the contact waveform", path.display())]
     Waveform {
+        /// The scenario file.
         path: PathBuf,
+        /// Why the waveform could not be built.
         #[source]
         source: WaveformError,
     },
+    /// The scenario has no `[circuit]`, so there is nothing to simulate.
     #[error(
         "{}: no [circuit] section: `run` needs the netlist the contact switches; add\n  \
          [circuit]\n  netlist = \"my_circuit.cir\"   # instantiates the contact as X1 a b CONTACT",
         path.display()
     )]
-    NoCircuit { path: PathBuf },
+    NoCircuit {
+        /// The scenario file.
+        path: PathBuf,
+    },
+    /// The scenario has no `[[probe]]`, so there is nothing to measure.
     #[error(
         "{}: no [[probe]]: `run` measures the signals the probes name; add\n  \
          [[probe]]\n  signal = \"v(in)\"\n  low = 0.99\n  high = 2.31",
         path.display()
     )]
-    NoProbes { path: PathBuf },
+    NoProbes {
+        /// The scenario file.
+        path: PathBuf,
+    },
+    /// `[contact.holm]` with a measured chatter sequence, which has no
+    /// contact force for the Holm law ([`run_measured`]).
     #[error(
         "{}: [contact.holm] needs the contact force, which a measured chatter sequence \
          does not have: remove [contact.holm] (r_closed is used) or simulate the relay",
         path.display()
     )]
-    HolmNeedsForce { path: PathBuf },
+    HolmNeedsForce {
+        /// The scenario file.
+        path: PathBuf,
+    },
+    /// An include (the contact's or the coil's) or the run deck could not
+    /// be built.
     #[error(transparent)]
     Netlist(#[from] NetlistError),
+    /// For a coil-driven relay: the coupled run, or the normally-closed
+    /// contact's include, failed.
     #[error(transparent)]
     Coupling(Box<CouplingError>),
+    /// ngspice failed on one of the runs.
     #[error(
         "ngspice failed on the {run} run of {}{}",
         netlist.display(),
@@ -141,36 +170,53 @@ pub enum RunError {
         }
     )]
     Spice {
+        /// The run: `bounced`, `ideal` or `coupled`.
         run: &'static str,
+        /// The user's netlist.
         netlist: PathBuf,
         /// The file (the netlist or one it includes) and line, when
         /// ngspice named a deck line that came from one.
         line: Option<(PathBuf, usize)>,
+        /// The ngspice error.
         #[source]
         source: Box<SpiceError>,
     },
+    /// ngspice ran, but its raw file has no transient plot to analyse.
     #[error(
         "{}: the raw file of the {run} run has no transient plot (ngspice wrote: {plots}); \
          the netlist's .tran analysis did not produce one",
         netlist.display()
     )]
     NoTransient {
+        /// The run: `bounced`, `ideal` or `coupled`.
         run: &'static str,
+        /// The user's netlist.
         netlist: PathBuf,
+        /// The names of the plots the raw file has, each in backticks,
+        /// comma-separated (empty when it has none).
         plots: String,
     },
+    /// With `[arc]`: the raw file lacks a vector the arc analysis reads.
     #[error("{}: cannot analyse the arcs of the {run} run", netlist.display())]
     Arc {
+        /// The run: `bounced` or `coupled`.
         run: &'static str,
+        /// The user's netlist.
         netlist: PathBuf,
+        /// The contact instance and the vector that is missing.
         #[source]
         source: MissingArcVector,
     },
+    /// A `[[probe]]` could not be analysed in a run's transient plot.
     #[error("{}: probe `{signal}` ({run} run)", origin.display())]
     Probe {
+        /// The scenario file.
         origin: PathBuf,
+        /// The probe's ngspice vector, e.g. `v(out)`.
         signal: String,
+        /// The run: `bounced`, `ideal` or `coupled`.
         run: &'static str,
+        /// Why the analysis failed.
         #[source]
         source: Box<AnalysisError>,
     },
@@ -183,7 +229,11 @@ pub struct Simulation {
     pub plot: Plot,
     /// e.g. `"39"`.
     pub version: Option<String>,
+    /// Wall-clock time of the ngspice run (for a coil-driven relay, the
+    /// sum over the coupling's passes).
     pub elapsed: Duration,
+    /// ngspice's `Warning:` lines and the raw reader's warnings (empty for
+    /// a coil-driven relay).
     pub warnings: Vec<String>,
     /// The kept work directory, when asked for.
     pub workdir: Option<PathBuf>,
@@ -192,9 +242,15 @@ pub struct Simulation {
 /// One probe: its analysis, and what the bounce added over the ideal run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ProbeResult {
+    /// The `[[probe]]` as the scenario gives it.
     pub probe: Probe,
+    /// The probe in the bounced run (the coupled run, for a coil-driven
+    /// relay).
     pub analysis: ProbeAnalysis,
+    /// The probe in the ideal-contact run, when there was one.
     pub ideal: Option<ProbeAnalysis>,
+    /// What the bounce added (bounced − ideal), when there was an
+    /// ideal-contact run.
     pub comparison: Option<Comparison>,
 }
 
@@ -203,15 +259,21 @@ pub struct ProbeResult {
 pub struct RunResult {
     /// The user's netlist (as named by the scenario).
     pub netlist: PathBuf,
+    /// The contact's chatter sequence (for a coil-driven relay, the
+    /// normally-open contact's over the whole run).
     pub chatter: Chatter,
+    /// The contact conductance over time that the include follows.
     pub waveform: Waveform,
     /// The contact include that was run (written as [`INCLUDE_FILE`]).
     pub include: ContactInclude,
     /// The deck that was run: the user's netlist plus the `.include`.
     pub deck: Deck,
+    /// The bounced run (for a coil-driven relay, the coupling's last
+    /// circuit run).
     pub simulation: Simulation,
     /// The ideal-contact run, when there was one.
     pub ideal: Option<Simulation>,
+    /// Every `[[probe]]`, in the scenario's order.
     pub probes: Vec<ProbeResult>,
     /// Things worth a look that did not stop the run, in order.
     pub warnings: Vec<String>,
