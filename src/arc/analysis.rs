@@ -15,7 +15,7 @@
 
 use serde::Serialize;
 
-use super::ArcModel;
+use super::model::ArcModel;
 use super::vectors::ArcVectors;
 use crate::chatter::{Chatter, ContactState};
 use crate::rawfile::{Plot, Vector};
@@ -203,7 +203,7 @@ pub fn analyze(
     plot: &Plot,
     instance: &str,
     model: &ArcModel,
-    gap: &super::GapProfile,
+    gap: &super::gap::GapProfile,
     chatter: &Chatter,
     coil_offs: &[f64],
 ) -> Result<ArcReport, MissingArcVector> {
@@ -381,7 +381,7 @@ pub fn unphysical_warning(
     nodes: (Option<&str>, Option<&str>),
     conductance: impl Fn(f64) -> f64,
     chatter: &Chatter,
-    gap: &super::GapProfile,
+    gap: &super::gap::GapProfile,
 ) -> Option<String> {
     let Some(Vector::Real(time)) = plot.scale() else {
         return None;
@@ -393,10 +393,10 @@ pub fn unphysical_warning(
     };
     let (a, b) = (node(nodes.0)?, node(nodes.1)?);
     let v = |k: usize| a[k] - b[k];
-    let material = super::REFERENCE_MATERIAL;
-    let model = super::ArcSection {
+    let material = super::model::REFERENCE_MATERIAL;
+    let model = super::model::ArcSection {
         material: Some(material),
-        ..super::ArcSection::default()
+        ..super::model::ArcSection::default()
     }
     .model();
     let n = time.len().min(a.len()).min(b.len());

@@ -32,8 +32,9 @@
 //! arc); Gear's method damps it. A netlist's own later `.options method`
 //! wins.
 
+use super::contact::ContactInclude;
 use super::contact::{comment, line, pairs};
-use super::{ContactInclude, NetlistError};
+use super::error::NetlistError;
 use crate::arc::{ArcModel, GapProfile};
 use crate::waveform::format_time;
 

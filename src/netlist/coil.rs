@@ -23,9 +23,9 @@
 //! across the coil is repeated on node `vt`, `v(<instance>.vt)`, which
 //! tells when the driver switched the coil on and off.
 
-use super::NetlistError;
-use super::check_subckt_name;
+use super::contact::check_subckt_name;
 use super::contact::{comment, line, pairs};
+use super::error::NetlistError;
 use crate::coil::MU0;
 use crate::scenario::CoilSection;
 use crate::waveform::format_time;

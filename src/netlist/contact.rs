@@ -50,7 +50,7 @@
 use std::fmt;
 use std::str::FromStr;
 
-use super::NetlistError;
+use super::error::NetlistError;
 use crate::waveform::{Point, Waveform, format_time};
 
 /// Points per PWL source before the waveform is split into windows.
@@ -463,7 +463,7 @@ struct Ramps {
 /// whose transitions all last the same time, or why it is not one.
 fn two_level_ramps(points: &[Point], g_min: f64, g_max: f64) -> Result<Ramps, NetlistError> {
     let unsupported = |reason: String| NetlistError::ElementUnsupported {
-        element: ContactElement::EventRamp,
+        element: ContactElement::EventRamp.to_string(),
         reason,
     };
     if let Some(p) = points

@@ -30,11 +30,12 @@
 //! `.tran` whose stop time covers the chatter.
 
 use std::collections::HashSet;
-use std::fmt;
 use std::path::{Path, PathBuf};
 
-use super::NetlistError;
+pub use super::error::DeckWarning;
+use super::error::NetlistError;
 use super::inline::{Command, IncludeRef, Inliner, SourceLine, command_line, is_script_title};
+use super::lexical::{resolve, split_path, strip_comment};
 use super::number::parse_number;
 use crate::waveform::format_time;
 
@@ -122,122 +123,6 @@ impl Tran {
     pub fn effective_max_step(&self) -> f64 {
         self.tmax
             .unwrap_or_else(|| self.tstep.min((self.tstop - self.tstart) / 50.0))
-    }
-}
-
-/// Something the deck changed or the user may want to change.
-#[derive(Debug, Clone, PartialEq)]
-pub enum DeckWarning {
-    /// A `.control` block was left out of the run.
-    ControlRemoved {
-        /// The file that holds it.
-        netlist: PathBuf,
-        /// 1-based line of the `.control`.
-        first: usize,
-        /// 1-based line of the `.endc`.
-        last: usize,
-    },
-    /// Text follows `.end`, which ngspice ignores too.
-    IgnoredAfterEnd {
-        /// The netlist file.
-        netlist: PathBuf,
-        /// 1-based line of the first such text.
-        line: usize,
-    },
-    /// The `.tran` covers the chatter but stops soon after it.
-    StopShort {
-        /// The netlist file.
-        netlist: PathBuf,
-        /// 1-based line of the `.tran`.
-        line: usize,
-        /// s, its stop time.
-        tstop: f64,
-        /// s, its step.
-        tstep: f64,
-        /// s, the stop time to use instead.
-        wanted: f64,
-    },
-    /// The first line, which ngspice takes as the title, looks like a
-    /// dot-card.
-    TitleIsCard {
-        /// The netlist file.
-        netlist: PathBuf,
-        /// The first line.
-        text: String,
-    },
-    /// `interp` was removed from an `.options` card.
-    InterpRemoved {
-        /// The file that holds the card.
-        netlist: PathBuf,
-        /// 1-based line of the card.
-        line: usize,
-    },
-    /// A `*#` line, which ngspice runs as a command.
-    CommandCommentRemoved {
-        /// The file that holds it.
-        netlist: PathBuf,
-        /// 1-based line.
-        line: usize,
-    },
-}
-
-impl fmt::Display for DeckWarning {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            DeckWarning::InterpRemoved { netlist, line } => write!(
-                f,
-                "{}: line {line}: `interp` is left out of the run's `.options`: ngspice 39 \
-                 writes an interpolated raw file whose time stamps run slow wherever its time \
-                 step exceeds the `.tran` step (and more points than it declares), so the \
-                 analysis would be wrong; the run keeps every point ngspice computes instead",
-                netlist.display()
-            ),
-            DeckWarning::CommandCommentRemoved { netlist, line } => write!(
-                f,
-                "{}: line {line}: the `*#` line is left out of the run: ngspice runs such a \
-                 comment as a command, and chatterspice runs no commands from netlists; write \
-                 `* #` for a plain comment",
-                netlist.display()
-            ),
-            DeckWarning::ControlRemoved {
-                netlist,
-                first,
-                last,
-            } => write!(
-                f,
-                "{}: lines {first}-{last}: the `.control` block is left out of the run: \
-                 chatterspice runs the netlist's dot-analyses in batch mode and writes the raw \
-                 file itself (the block's commands would run a second analysis, write elsewhere \
-                 or quit first); move what it sets into dot-cards such as `.options`",
-                netlist.display()
-            ),
-            DeckWarning::IgnoredAfterEnd { netlist, line } => write!(
-                f,
-                "{}: line {line}: text after `.end` is ignored, as ngspice does",
-                netlist.display()
-            ),
-            DeckWarning::StopShort {
-                netlist,
-                line,
-                tstop,
-                tstep,
-                wanted,
-            } => write!(
-                f,
-                "{}: line {line}: `.tran` stops at {} s, soon after the chatter: to see the \
-                 circuit settle, use `.tran {} {}`",
-                netlist.display(),
-                format_time(*tstop),
-                format_time(*tstep),
-                format_time(*wanted)
-            ),
-            DeckWarning::TitleIsCard { netlist, text } => write!(
-                f,
-                "{}: line 1 `{text}` is read by ngspice as the title and ignored: put a title \
-                 line first",
-                netlist.display()
-            ),
-        }
     }
 }
 
@@ -889,22 +774,6 @@ fn is_blank_or_comment(line: &str) -> bool {
     t.is_empty() || t.starts_with('*')
 }
 
-/// The line without its inline comment (`;` anywhere, `$` after
-/// whitespace), and without a whole-line `*` comment.
-pub(super) fn strip_comment(line: &str) -> &str {
-    if line.trim_start().starts_with('*') {
-        return "";
-    }
-    let mut prev_space = true;
-    for (i, c) in line.char_indices() {
-        if c == ';' || (c == '$' && prev_space) {
-            return &line[..i];
-        }
-        prev_space = c.is_whitespace();
-    }
-    line
-}
-
 /// The cards among the live lines: `+` lines join the card before them,
 /// across comment and blank lines.
 fn cards(lines: &[&str], live: &[bool]) -> Vec<Card> {
@@ -1038,33 +907,6 @@ fn resolve_include(
         .filter(|_| is_lib)
         .map(str::to_owned);
     Ok(Some((resolved, section)))
-}
-
-/// A possibly quoted path and the rest of the card.
-pub(super) fn split_path(rest: &str) -> (&str, &str) {
-    for quote in ['"', '\''] {
-        if let Some(inner) = rest.strip_prefix(quote) {
-            if let Some(end) = inner.find(quote) {
-                return (&inner[..end], inner[end + 1..].trim());
-            }
-        }
-    }
-    match rest.find(char::is_whitespace) {
-        Some(i) => (&rest[..i], rest[i..].trim()),
-        None => (rest, ""),
-    }
-}
-
-pub(super) fn resolve(written: &str, base: &Path) -> PathBuf {
-    if let Some(home_rel) = written.strip_prefix("~/") {
-        if let Some(home) = std::env::var_os("HOME") {
-            return PathBuf::from(home).join(home_rel);
-        }
-    }
-    let p = base.join(written);
-    // A netlist given by a relative path has a relative directory; the
-    // deck runs elsewhere, so the current directory is joined here.
-    std::path::absolute(&p).unwrap_or(p)
 }
 
 /// Whether an included file (or one it includes) has an `X` card for

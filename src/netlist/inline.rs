@@ -20,8 +20,8 @@
 
 use std::path::{Path, PathBuf};
 
-use super::NetlistError;
-use super::deck::DeckWarning;
+use super::error::{DeckWarning, NetlistError};
+use super::lexical::{resolve, split_path, strip_comment};
 
 /// Nesting depth of includes: far beyond real projects.
 pub const MAX_DEPTH: usize = 32;
@@ -248,13 +248,13 @@ impl<'w> Inliner<'w> {
             let is_lib = keyword.starts_with(".lib");
             if is_inc || is_lib {
                 let rest = trimmed[keyword.len()..].trim();
-                let rest = super::deck::strip_comment(rest).trim();
-                let (written, after) = super::deck::split_path(rest);
+                let rest = strip_comment(rest).trim();
+                let (written, after) = split_path(rest);
                 if written.is_empty() {
                     self.push(raw.to_owned(), origin);
                     continue;
                 }
-                let resolved = super::deck::resolve(written, &base);
+                let resolved = resolve(written, &base);
                 let section = after.split_whitespace().next();
                 if is_lib && section.is_none() && !resolved.is_file() {
                     // `.lib NAME`: a section header of this file.

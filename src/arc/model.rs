@@ -1,0 +1,236 @@
+//! The arc's physics: contact materials and their minimum arc voltage
+//! and current, the arc model, and the breakdown voltage of the gap.
+
+use serde::{Deserialize, Serialize};
+
+/// A contact material with published minimum arc voltage and current.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Material {
+    /// Silver.
+    Ag,
+    /// Silver–nickel.
+    AgNi,
+    /// Silver–tin oxide.
+    AgSnO2,
+    /// Gold.
+    Au,
+    /// Copper.
+    Cu,
+    /// Palladium.
+    Pd,
+    /// Tungsten.
+    W,
+}
+
+impl Material {
+    /// Every material, in the order above.
+    pub const ALL: [Material; 7] = [
+        Material::Ag,
+        Material::AgNi,
+        Material::AgSnO2,
+        Material::Au,
+        Material::Cu,
+        Material::Pd,
+        Material::W,
+    ];
+
+    /// The name used in scenario files, e.g. `AgSnO2`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Material::Ag => "Ag",
+            Material::AgNi => "AgNi",
+            Material::AgSnO2 => "AgSnO2",
+            Material::Au => "Au",
+            Material::Cu => "Cu",
+            Material::Pd => "Pd",
+            Material::W => "W",
+        }
+    }
+
+    /// V, the minimum arc voltage (docs/arcs.md, materials table). The
+    /// silver composites take silver's value: their arc roots stand on
+    /// the silver matrix.
+    pub fn v_min(self) -> f64 {
+        match self {
+            Material::Ag | Material::AgNi | Material::AgSnO2 => 12.0,
+            Material::Au | Material::Pd | Material::W => 15.0,
+            Material::Cu => 13.0,
+        }
+    }
+
+    /// A, the minimum arc current (docs/arcs.md, materials table).
+    pub fn i_min(self) -> f64 {
+        match self {
+            Material::Ag | Material::AgNi | Material::AgSnO2 => 0.40,
+            Material::Au => 0.38,
+            Material::Cu => 0.43,
+            Material::Pd => 0.50,
+            Material::W => 1.0,
+        }
+    }
+}
+
+/// V/m, the default column gradient E: short low-current arcs in air
+/// have gradients of a few kV/m (docs/arcs.md).
+pub const DEFAULT_FIELD: f64 = 2.0e3;
+
+/// m/s, how fast the gap opens and closes where no trajectory is known
+/// (a measured record of states): a typical contact separation speed.
+pub const DEFAULT_OPENING_SPEED: f64 = 0.3;
+
+/// The material whose V_min and I_min judge a run without `[arc]` (the
+/// commonest power-contact family).
+pub const REFERENCE_MATERIAL: Material = Material::Ag;
+
+/// `[arc]`: the contact arcs (docs/arcs.md).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ArcSection {
+    /// Sets `v_min` and `i_min` (each may still be given to override).
+    /// Neither material nor the two numbers: silver.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material: Option<Material>,
+    /// V, the minimum arc voltage (electrode drops).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub v_min: Option<f64>,
+    /// A, the minimum arc current: below it the arc goes out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub i_min: Option<f64>,
+    /// V/m, the column gradient E: V_arc = V_min + E·gap.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub field: Option<f64>,
+    /// m/s, the gap's opening speed for a measured record of states,
+    /// which has no trajectory; a simulated relay uses its own.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub opening_speed: Option<f64>,
+}
+
+impl ArcSection {
+    /// The section with every number given: the material's (or the
+    /// defaults) where the file left one out. Its [`ArcSection::model`] is
+    /// the same.
+    pub fn resolved(&self) -> ArcSection {
+        let m = self.model();
+        ArcSection {
+            material: self.material,
+            v_min: Some(m.v_min),
+            i_min: Some(m.i_min),
+            field: Some(m.field),
+            opening_speed: Some(m.opening_speed),
+        }
+    }
+
+    /// The numbers the run uses.
+    pub fn model(&self) -> ArcModel {
+        let material = self.material.unwrap_or(REFERENCE_MATERIAL);
+        ArcModel {
+            v_min: self.v_min.unwrap_or(material.v_min()),
+            i_min: self.i_min.unwrap_or(material.i_min()),
+            field: self.field.unwrap_or(DEFAULT_FIELD),
+            opening_speed: self.opening_speed.unwrap_or(DEFAULT_OPENING_SPEED),
+        }
+    }
+}
+
+/// The resolved arc numbers, SI units.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ArcModel {
+    /// V
+    pub v_min: f64,
+    /// A
+    pub i_min: f64,
+    /// V/m
+    pub field: f64,
+    /// m/s
+    pub opening_speed: f64,
+}
+
+impl ArcModel {
+    /// V, the burning voltage at gap `gap` (m).
+    pub fn arc_voltage(&self, gap: f64) -> f64 {
+        self.v_min + self.field * gap.max(0.0)
+    }
+
+    /// V, the most an open gap `gap` (m) holds before it conducts: the
+    /// breakdown voltage, never below V_min (less cannot sustain a
+    /// discharge at all).
+    pub fn hold_voltage(&self, gap: f64) -> f64 {
+        breakdown_voltage(gap).max(self.v_min)
+    }
+}
+
+/// V/m, the breakdown field of sub-micrometre gaps in air, where field
+/// emission from the cathode starts the discharge (Peschot et al. 2014:
+/// a nearly constant 350 V/µm below 1 µm).
+pub const FIELD_EMISSION_FIELD: f64 = 350e6;
+
+/// V, the Paschen minimum of air (≈ 327 V near 7–8 µm at 1 atm).
+pub const PASCHEN_MINIMUM: f64 = 327.0;
+
+/// bar, standard atmosphere.
+const ATMOSPHERE_BAR: f64 = 1.01325;
+
+/// V, the breakdown voltage of a gap of `gap` m in air at 1 atm and room
+/// temperature, between flat electrodes:
+///
+/// - below ~1 µm, field emission: V = 350 V/µm · d;
+/// - from there to ~17 µm the Paschen minimum, 327 V;
+/// - above, the uniform-field law of air,
+///   V = 24.36·(pd) + 6.72·√(pd) kV with pd in bar·cm (4.6 kV at 1 mm,
+///   31 kV at 1 cm).
+///
+/// `gap ≤ 0` gives 0.
+pub fn breakdown_voltage(gap: f64) -> f64 {
+    if gap.is_nan() || gap <= 0.0 {
+        return 0.0;
+    }
+    let pd = ATMOSPHERE_BAR * gap * 100.0; // bar·cm
+    let uniform = 1e3 * (24.36 * pd + 6.72 * pd.sqrt());
+    (FIELD_EMISSION_FIELD * gap).min(uniform.max(PASCHEN_MINIMUM))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn breakdown_follows_its_three_regimes() {
+        // Field emission: linear through the origin.
+        assert!((breakdown_voltage(0.5e-6) - 175.0).abs() < 1e-9);
+        // The Paschen minimum plateau.
+        assert_eq!(breakdown_voltage(5e-6), PASCHEN_MINIMUM);
+        assert_eq!(breakdown_voltage(10e-6), PASCHEN_MINIMUM);
+        // Uniform-field air: 1 mm ≈ 4.6 kV, 1 cm ≈ 31 kV.
+        assert!((breakdown_voltage(1e-3) / 4.61e3 - 1.0).abs() < 0.01);
+        assert!((breakdown_voltage(1e-2) / 31.4e3 - 1.0).abs() < 0.01);
+        assert_eq!(breakdown_voltage(0.0), 0.0);
+        assert_eq!(breakdown_voltage(-1.0), 0.0);
+        // Continuous and non-decreasing.
+        let mut last = breakdown_voltage(1e-8);
+        for k in 1..2000 {
+            let d = 1e-8 * 1.01f64.powi(k);
+            let v = breakdown_voltage(d);
+            assert!(v >= last, "at {d}");
+            assert!(v - last < 0.05 * v.max(1.0) + 1.0, "jump at {d}");
+            last = v;
+        }
+    }
+
+    #[test]
+    fn materials_and_overrides() {
+        let silver = ArcSection::default().model();
+        assert_eq!((silver.v_min, silver.i_min), (12.0, 0.40));
+        let w = ArcSection {
+            material: Some(Material::W),
+            i_min: Some(2.0),
+            ..ArcSection::default()
+        }
+        .model();
+        assert_eq!((w.v_min, w.i_min), (15.0, 2.0));
+        assert_eq!(w.arc_voltage(1e-3), 15.0 + DEFAULT_FIELD * 1e-3);
+        assert_eq!(w.hold_voltage(0.0), 15.0);
+        for m in Material::ALL {
+            assert!(m.v_min() >= 12.0 && m.i_min() >= 0.38, "{}", m.as_str());
+        }
+    }
+}
