@@ -442,9 +442,9 @@ pub fn run_coupled_plan(
             ),
         ];
         includes.extend(contact.data_files);
-        let simulation = super::circuit_pass(
+        let simulation = super::pass::circuit_pass(
             runner,
-            super::Pass {
+            super::pass::Pass {
                 run: "coupled",
                 netlist: &netlist_path,
                 deck: &deck,
@@ -454,7 +454,7 @@ pub fn run_coupled_plan(
             },
         )
         .map_err(|e| match e {
-            super::RunError::Spice { source, .. } => CouplingError::Spice {
+            super::pass::PassError::Spice { source, .. } => CouplingError::Spice {
                 netlist: netlist_path.clone(),
                 iteration,
                 source,

@@ -20,7 +20,7 @@
 pub mod coupled;
 pub mod pass;
 
-pub use pass::{Pass, circuit_pass};
+pub use pass::{Pass, PassError, Simulation, circuit_pass};
 
 pub use coupled::{Coupled, CouplingError, CouplingOptions, Iteration, nc_include, run_coupled};
 
@@ -41,7 +41,7 @@ use crate::netlist::{self, ContactElement, ContactInclude, Deck, DeckRequest, Ne
 use crate::plan::{Netlist, Plan};
 use crate::rawfile::Plot;
 use crate::scenario::{Probe, Scenario, ScenarioError};
-use crate::spice::{RunRequest, Runner, SpiceError};
+use crate::spice::{RunRequest, Runner};
 use crate::waveform::{ContactModel, Holm, Waveform, WaveformError};
 
 /// The file name of the contact include in the run's work directory (and
@@ -92,6 +92,17 @@ impl Default for RunOptions {
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum RunError {
+    /// A circuit pass failed (ngspice, or its raw file).
+    #[error(transparent)]
+    Pass(#[from] PassError),
+    /// An include (the contact's or the coil's) or the run deck could not
+    /// be built.
+    #[error(transparent)]
+    Netlist(#[from] NetlistError),
+    /// For a coil-driven relay: the coupled run, or the normally-closed
+    /// contact's include, failed.
+    #[error(transparent)]
+    Coupling(Box<CouplingError>),
     /// The scenario does not validate, or its netlist cannot be read
     /// (see [`Plan::new`]).
     #[error(transparent)]
@@ -147,55 +158,6 @@ pub enum RunError {
         /// The scenario file.
         path: PathBuf,
     },
-    /// An include (the contact's or the coil's) or the run deck could not
-    /// be built.
-    #[error(transparent)]
-    Netlist(#[from] NetlistError),
-    /// For a coil-driven relay: the coupled run, or the normally-closed
-    /// contact's include, failed.
-    #[error(transparent)]
-    Coupling(Box<CouplingError>),
-    /// ngspice failed on one of the runs.
-    #[error(
-        "ngspice failed on the {run} run of {}{}",
-        netlist.display(),
-        match line {
-            None => String::new(),
-            Some((file, l)) if file == netlist => format!(
-                ": the error is on line {l} of that file (ngspice counts the lines of the \
-                 deck it ran, which has the contact `.include` added and included files \
-                 written in)"
-            ),
-            Some((file, l)) => format!(": the error is on line {l} of {}, which it includes", file.display()),
-        }
-    )]
-    Spice {
-        /// The run: `bounced`, `ideal` or `coupled`.
-        run: &'static str,
-        /// The user's netlist.
-        netlist: PathBuf,
-        /// The file (the netlist or one it includes) and line, when
-        /// ngspice named a deck line that came from one.
-        line: Option<(PathBuf, usize)>,
-        /// The ngspice error.
-        #[source]
-        source: Box<SpiceError>,
-    },
-    /// ngspice ran, but its raw file has no transient plot to analyse.
-    #[error(
-        "{}: the raw file of the {run} run has no transient plot (ngspice wrote: {plots}); \
-         the netlist's .tran analysis did not produce one",
-        netlist.display()
-    )]
-    NoTransient {
-        /// The run: `bounced`, `ideal` or `coupled`.
-        run: &'static str,
-        /// The user's netlist.
-        netlist: PathBuf,
-        /// The names of the plots the raw file has, each in backticks,
-        /// comma-separated (empty when it has none).
-        plots: String,
-    },
     /// With `[arc]`: the raw file lacks a vector the arc analysis reads.
     #[error("{}: cannot analyse the arcs of the {run} run", netlist.display())]
     Arc {
@@ -220,23 +182,6 @@ pub enum RunError {
         #[source]
         source: Box<AnalysisError>,
     },
-}
-
-/// One ngspice run as the reports need it.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Simulation {
-    /// The transient plot.
-    pub plot: Plot,
-    /// e.g. `"39"`.
-    pub version: Option<String>,
-    /// Wall-clock time of the ngspice run (for a coil-driven relay, the
-    /// sum over the coupling's passes).
-    pub elapsed: Duration,
-    /// ngspice's `Warning:` lines and the raw reader's warnings (empty for
-    /// a coil-driven relay).
-    pub warnings: Vec<String>,
-    /// The kept work directory, when asked for.
-    pub workdir: Option<PathBuf>,
 }
 
 /// One probe: its analysis, and what the bounce added over the ideal run.

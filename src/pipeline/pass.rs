@@ -5,12 +5,78 @@
 //! wherever it happens: named at the line of the user's file (or of a file
 //! it includes) that ngspice rejected.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use super::{RunError, Simulation};
+use thiserror::Error;
+
 use crate::netlist::Deck;
+use crate::rawfile::Plot;
 use crate::spice::{Failure, RunRequest, Runner, SpiceError};
+
+/// One ngspice run as the reports need it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Simulation {
+    /// The transient plot.
+    pub plot: Plot,
+    /// e.g. `"39"`.
+    pub version: Option<String>,
+    /// Wall-clock time of the ngspice run (for a coil-driven relay, the
+    /// sum over the coupling's passes).
+    pub elapsed: Duration,
+    /// ngspice's `Warning:` lines and the raw reader's warnings (empty for
+    /// a coil-driven relay).
+    pub warnings: Vec<String>,
+    /// The kept work directory, when asked for.
+    pub workdir: Option<PathBuf>,
+}
+
+/// Why a circuit pass gave no plot.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum PassError {
+    /// ngspice failed on one of the runs.
+    #[error(
+        "ngspice failed on the {run} run of {}{}",
+        netlist.display(),
+        match line {
+            None => String::new(),
+            Some((file, l)) if file == netlist => format!(
+                ": the error is on line {l} of that file (ngspice counts the lines of the \
+                 deck it ran, which has the contact `.include` added and included files \
+                 written in)"
+            ),
+            Some((file, l)) => format!(": the error is on line {l} of {}, which it includes", file.display()),
+        }
+    )]
+    Spice {
+        /// The run: `bounced`, `ideal` or `coupled`.
+        run: &'static str,
+        /// The user's netlist.
+        netlist: PathBuf,
+        /// The file (the netlist or one it includes) and line, when
+        /// ngspice named a deck line that came from one.
+        line: Option<(PathBuf, usize)>,
+        /// The ngspice error.
+        #[source]
+        source: Box<SpiceError>,
+    },
+    /// ngspice ran, but its raw file has no transient plot to analyse.
+    #[error(
+        "{}: the raw file of the {run} run has no transient plot (ngspice wrote: {plots}); \
+         the netlist's .tran analysis did not produce one",
+        netlist.display()
+    )]
+    NoTransient {
+        /// The run: `bounced`, `ideal` or `coupled`.
+        run: &'static str,
+        /// The user's netlist.
+        netlist: PathBuf,
+        /// The names of the plots the raw file has, each in backticks,
+        /// comma-separated (empty when it has none).
+        plots: String,
+    },
+}
 
 /// What one pass runs.
 #[derive(Debug, Clone)]
@@ -31,7 +97,7 @@ pub struct Pass<'a> {
 
 /// Runs `pass` with `runner`: the deck and its includes in a work
 /// directory, the simulator, the raw file's last transient plot.
-pub fn circuit_pass(runner: &dyn Runner, pass: Pass<'_>) -> Result<Simulation, RunError> {
+pub fn circuit_pass(runner: &dyn Runner, pass: Pass<'_>) -> Result<Simulation, PassError> {
     let result = runner.run(&RunRequest {
         deck: pass.deck.text.clone(),
         includes: pass.includes,
@@ -46,7 +112,7 @@ fn simulation_of(
     result: Result<crate::spice::RunOutput, SpiceError>,
     netlist: &Path,
     deck: &Deck,
-) -> Result<Simulation, RunError> {
+) -> Result<Simulation, PassError> {
     let output = result.map_err(|source| {
         let line = match source.failure() {
             Some(Failure::Netlist {
@@ -64,7 +130,7 @@ fn simulation_of(
                 }),
             _ => None,
         };
-        RunError::Spice {
+        PassError::Spice {
             run,
             netlist: netlist.to_owned(),
             line,
@@ -89,7 +155,7 @@ fn simulation_of(
     let plot = raw
         .last_transient()
         .cloned()
-        .ok_or_else(|| RunError::NoTransient {
+        .ok_or_else(|| PassError::NoTransient {
             run,
             netlist: netlist.to_owned(),
             plots: plot_names(),

@@ -12,7 +12,7 @@
 
 use std::fmt::Write as _;
 
-use super::SweepError;
+use super::error::SweepError;
 use super::sample::Sampler;
 use super::summary::Collected;
 use crate::report::svg::escape;

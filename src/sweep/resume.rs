@@ -20,8 +20,8 @@ use csv::{ByteRecord, ReaderBuilder};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+use super::record::{ProbeRecord, Record, Shard};
 use super::verdict::Verdict;
-use super::{ProbeRecord, Record, Shard};
 use crate::chatter::Outcome;
 
 /// Which sweep a CSV holds rows of.

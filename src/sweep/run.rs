@@ -32,11 +32,12 @@ use crate::plan::Plan;
 use crate::scenario::Scenario;
 use crate::spice::Runner;
 
+use super::error::SweepError;
+use super::record::{ProbeRecord, Record, Shard};
 use super::sample::Sampler;
 use super::summary::Collected;
 use super::table;
 use super::verdict::{Verdict, verdict};
-use super::{ProbeRecord, Record, Shard, SweepError};
 
 /// What each sample runs.
 #[derive(Clone, Copy)]

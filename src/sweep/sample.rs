@@ -32,7 +32,7 @@ use rand_chacha::rand_core::{Rng, SeedableRng};
 
 use crate::scenario::{GridAxis, Scenario, Tolerance};
 
-use super::SweepError;
+use super::error::SweepError;
 
 /// Random samples when neither the scenario nor the caller says.
 pub const DEFAULT_SAMPLES: u64 = 100;
@@ -108,6 +108,7 @@ impl Sampler {
                     path: path(),
                     count,
                     what: "the product of the `[sweep.grid]` steps",
+                    limit: MAX_SAMPLES,
                 });
             }
             return Ok(Sampler {
@@ -125,6 +126,7 @@ impl Sampler {
                 path: path(),
                 count: samples,
                 what: "`sweep.samples` (or --samples)",
+                limit: MAX_SAMPLES,
             });
         }
         let seed = seed.or(sweep.seed).unwrap_or(DEFAULT_SEED);

@@ -18,9 +18,10 @@ use serde::Serialize;
 use crate::chatter::Outcome;
 use crate::report::units::prefix;
 
+use super::error::SweepError;
+use super::record::Record;
 use super::sample::Sampler;
 use super::verdict::Verdict;
-use super::{Record, SweepError};
 
 /// How bad a sample is, compared field by field: (could not run, failed a
 /// limit, did not end closed, edges, bounce time).

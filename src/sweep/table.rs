@@ -27,7 +27,7 @@ use std::path::{Path, PathBuf};
 use csv::{ByteRecord, ReaderBuilder, Writer};
 use thiserror::Error;
 
-use super::Record;
+use super::record::Record;
 
 /// The columns before the probes', after the varied keys.
 pub const OUTCOME_COLUMNS: [&str; 5] = [
