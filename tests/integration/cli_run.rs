@@ -6,7 +6,7 @@
 //! Tests that need ngspice skip with a note when it is missing, and fail
 //! when `REQUIRE_NGSPICE=1` (CI sets it).
 
-use crate::common;
+use crate::common::{self, scenario_with_netlist, script};
 
 use std::path::Path;
 
@@ -21,21 +21,6 @@ fn chatterspice() -> Command {
 fn stdout_of(args: &[&str]) -> String {
     let out = chatterspice().args(args).assert().success();
     String::from_utf8(out.get_output().stdout.clone()).unwrap()
-}
-
-/// A scenario in `dir` using the default relay, with `circuit` as its
-/// `[circuit]` netlist text (written to `circuit.cir`) and one probe.
-fn scenario_with_netlist(dir: &Path, netlist: &str) -> std::path::PathBuf {
-    std::fs::write(dir.join("circuit.cir"), netlist).unwrap();
-    let relay = chatterspice::scenario::DEFAULT_SCENARIO_TOML;
-    let cut = relay.find("[circuit]").unwrap();
-    let text = format!(
-        "{}[circuit]\nnetlist = \"circuit.cir\"\n\n[[probe]]\nsignal = \"v(sw)\"\nlow = 0.99\nhigh = 2.31\n",
-        &relay[..cut]
-    );
-    let path = dir.join("relay.toml");
-    std::fs::write(&path, text).unwrap();
-    path
 }
 
 const PULLUP: &str =
@@ -509,14 +494,6 @@ fn force_never_overwrites_an_input() {
         std::fs::read(dir.path().join("netlist.cir")).unwrap(),
         netlist
     );
-}
-
-fn script(dir: &std::path::Path, name: &str, body: &str) -> std::path::PathBuf {
-    use std::os::unix::fs::PermissionsExt;
-    let path = dir.join(name);
-    std::fs::write(&path, format!("#!/bin/sh\n{body}")).unwrap();
-    std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).unwrap();
-    path
 }
 
 /// `--timeout` covers the version check, and a wrapper that does not

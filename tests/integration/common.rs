@@ -44,3 +44,29 @@ macro_rules! ngspice_or_skip {
         }
     };
 }
+
+/// A scenario in `dir` (created if needed) using the default relay, with
+/// `netlist` as its `[circuit]` netlist text (written to `circuit.cir`)
+/// and one probe, `v(sw)`.
+pub fn scenario_with_netlist(dir: &std::path::Path, netlist: &str) -> std::path::PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    std::fs::write(dir.join("circuit.cir"), netlist).unwrap();
+    let relay = chatterspice::scenario::DEFAULT_SCENARIO_TOML;
+    let cut = relay.find("[circuit]").unwrap();
+    let text = format!(
+        "{}[circuit]\nnetlist = \"circuit.cir\"\n\n[[probe]]\nsignal = \"v(sw)\"\nlow = 0.99\nhigh = 2.31\n",
+        &relay[..cut]
+    );
+    let path = dir.join("relay.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// An executable shell script `dir/name` running `body`.
+pub fn script(dir: &std::path::Path, name: &str, body: &str) -> std::path::PathBuf {
+    use std::os::unix::fs::PermissionsExt;
+    let path = dir.join(name);
+    std::fs::write(&path, format!("#!/bin/sh\n{body}")).unwrap();
+    std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).unwrap();
+    path
+}

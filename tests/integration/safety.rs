@@ -7,24 +7,10 @@ use std::path::{Path, PathBuf};
 use assert_cmd::Command;
 use predicates::prelude::*;
 
+use crate::common::{scenario_with_netlist, script};
+
 fn chatterspice() -> Command {
     Command::cargo_bin("chatterspice").unwrap()
-}
-
-/// A scenario in `dir` using the default relay, with `netlist` as its
-/// `[circuit]` netlist (written to `circuit.cir`) and one probe.
-fn scenario_with_netlist(dir: &Path, netlist: &str) -> PathBuf {
-    std::fs::create_dir_all(dir).unwrap();
-    std::fs::write(dir.join("circuit.cir"), netlist).unwrap();
-    let relay = chatterspice::scenario::DEFAULT_SCENARIO_TOML;
-    let cut = relay.find("[circuit]").unwrap();
-    let text = format!(
-        "{}[circuit]\nnetlist = \"circuit.cir\"\n\n[[probe]]\nsignal = \"v(sw)\"\nlow = 0.99\nhigh = 2.31\n",
-        &relay[..cut]
-    );
-    let path = dir.join("relay.toml");
-    std::fs::write(&path, text).unwrap();
-    path
 }
 
 /// `shell touch <marker>` as ngspice would run it.
@@ -161,14 +147,6 @@ fn an_include_cycle_is_refused() {
         stderr.contains("b.inc: line 2") && stderr.contains("circle"),
         "{stderr}"
     );
-}
-
-fn script(dir: &Path, name: &str, body: &str) -> PathBuf {
-    use std::os::unix::fs::PermissionsExt;
-    let path = dir.join(name);
-    std::fs::write(&path, format!("#!/bin/sh\n{body}")).unwrap();
-    std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).unwrap();
-    path
 }
 
 /// A stand-in for ngspice: answers the version check, then runs `body`.
