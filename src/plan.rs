@@ -95,6 +95,18 @@ impl Plan {
         })
     }
 
+    /// Sets the numbers `values` in this plan, validated and resolved
+    /// again as [`Plan::with_numbers`] does; on an error the plan is left
+    /// as it was. For a loop that sets the same keys on every pass (a
+    /// sweep's worker), where a new plan per pass would copy the whole
+    /// scenario each time.
+    pub fn renumber(&mut self, values: &[(&str, f64)]) -> Result<(), ScenarioError> {
+        self.scenario.set_numbers(values)?;
+        self.surface = self.scenario.surface();
+        self.back_stop = self.scenario.back_stop();
+        Ok(())
+    }
+
     /// The scenario this plan was resolved from.
     pub fn scenario(&self) -> &Scenario {
         &self.scenario
