@@ -35,7 +35,7 @@ use std::path::{Path, PathBuf};
 pub use super::error::DeckWarning;
 use super::error::NetlistError;
 use super::inline::{Command, IncludeRef, Inliner, SourceLine, command_line, is_script_title};
-use super::lexical::{resolve, split_path, strip_comment};
+use super::lexical::{physical_lines, resolve, split_path, strip_comment};
 use super::number::parse_number;
 use crate::waveform::format_time;
 
@@ -747,18 +747,6 @@ pub fn save_names(signal: &str) -> Result<Vec<String>, NetlistError> {
         ("i", 1) => Ok(vec![format!("i({})", args[0])]),
         _ => Err(bad()),
     }
-}
-
-/// Lines without their `\r`; a final newline does not make an extra line.
-fn physical_lines(text: &str) -> Vec<&str> {
-    let mut lines: Vec<&str> = text
-        .split('\n')
-        .map(|l| l.strip_suffix('\r').unwrap_or(l))
-        .collect();
-    if lines.len() > 1 && lines[lines.len() - 1].is_empty() {
-        lines.pop();
-    }
-    lines
 }
 
 fn first_word(line: &str) -> String {

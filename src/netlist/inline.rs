@@ -21,7 +21,7 @@
 use std::path::{Path, PathBuf};
 
 use super::error::{DeckWarning, NetlistError};
-use super::lexical::{resolve, split_path, strip_comment};
+use super::lexical::{physical_lines, resolve, split_path, strip_comment};
 
 /// Nesting depth of includes: far beyond real projects.
 pub const MAX_DEPTH: usize = 32;
@@ -181,7 +181,7 @@ impl<'w> Inliner<'w> {
         let mut inside = include.section.is_none();
         let mut found = include.section.is_none();
         let mut control: Option<usize> = None;
-        for (index, raw) in physical_lines(text).enumerate() {
+        for (index, raw) in physical_lines(text).into_iter().enumerate() {
             let line = index + 1;
             let origin = Some(SourceLine { file, line });
             if let Some(section) = include.section {
@@ -295,11 +295,6 @@ impl<'w> Inliner<'w> {
         }
         Ok(())
     }
-}
-
-fn physical_lines(text: &str) -> impl Iterator<Item = &str> {
-    let text = text.strip_suffix('\n').unwrap_or(text);
-    text.split('\n').map(|l| l.strip_suffix('\r').unwrap_or(l))
 }
 
 /// The path as a cycle check compares it: canonical when it exists.

@@ -46,3 +46,15 @@ pub(super) fn resolve(written: &str, base: &Path) -> PathBuf {
     // deck runs elsewhere, so the current directory is joined here.
     std::path::absolute(&p).unwrap_or(p)
 }
+
+/// Lines without their `\r`; a final newline does not make an extra line.
+pub(super) fn physical_lines(text: &str) -> Vec<&str> {
+    let mut lines: Vec<&str> = text
+        .split('\n')
+        .map(|l| l.strip_suffix('\r').unwrap_or(l))
+        .collect();
+    if lines.len() > 1 && lines[lines.len() - 1].is_empty() {
+        lines.pop();
+    }
+    lines
+}

@@ -169,6 +169,10 @@ pub fn run_from(
     done: Vec<Record>,
 ) -> Result<Collected, SweepError> {
     let signals = signals(scenario, options)?;
+    // Resolved once, the netlist read once (a netlist that cannot be read
+    // would fail every sample): each worker's plan starts from this one.
+    let base = base_plan(scenario, options)?;
+    let base = &base;
     let columns = columns(scenario, options);
     let probes = signals.len();
     if done.is_empty() {
@@ -188,9 +192,6 @@ pub fn run_from(
     }
     progress.advance(first);
 
-    // Resolved once: each sample makes its plan from this one.
-    let base = base_plan(scenario, options)?;
-    let base = &base;
     let next = AtomicU64::new(0);
     let stop = AtomicBool::new(false);
     let jobs = options.jobs.get();
@@ -263,10 +264,6 @@ fn signals(scenario: &Scenario, options: &SweepOptions<'_>) -> Result<Vec<String
                     path: scenario.origin.clone(),
                 });
             }
-            // A netlist that cannot be read would fail every sample.
-            if let Some(Err(e)) = scenario.netlist() {
-                return Err(e.into());
-            }
             scenario.probes.iter().map(|p| p.signal.clone()).collect()
         }
     })
@@ -320,8 +317,8 @@ fn base_plan(scenario: &Scenario, options: &SweepOptions<'_>) -> Result<Plan, Sw
     })
 }
 
-/// One thread's state: the sweep's plan, from which each sample makes
-/// its own with the sample's values.
+/// One thread's state: a copy of the sweep's plan, given each sample's
+/// values in turn.
 struct Worker<'a, 'r> {
     /// The sweep's plan, copied once per worker: every sample sets the same
     /// keys, so after [`Plan::renumber`] it is the sweep's plan with this
