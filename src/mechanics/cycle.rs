@@ -930,7 +930,7 @@ fn lift_offs(log: &[(f64, Event)]) -> Vec<f64> {
 }
 
 /// The NO contact's chatter, summarised by its first stroke.
-fn summary(
+pub(crate) fn summary(
     intervals: Vec<Interval>,
     impacts: Vec<Impact>,
     first: Option<&Stroke>,
@@ -959,7 +959,7 @@ fn summary(
 }
 
 /// Cut the run into strokes at the lift-offs.
-fn strokes(lift_offs: &[f64], make: &[Impact], back: &[Impact]) -> Vec<Stroke> {
+pub(crate) fn strokes(lift_offs: &[f64], make: &[Impact], back: &[Impact]) -> Vec<Stroke> {
     let mut out = Vec::with_capacity(lift_offs.len());
     for (k, &lift_off) in lift_offs.iter().enumerate() {
         let until = lift_offs.get(k + 1).copied().unwrap_or(f64::INFINITY);

@@ -228,6 +228,16 @@ pub struct Dense<const N: usize> {
 }
 
 impl<const N: usize> Dense<N> {
+    /// A state held constant at `y` over [t0, t1].
+    pub(crate) fn constant(t0: f64, t1: f64, y: SVector<f64, N>) -> Self {
+        let zero = SVector::<f64, N>::zeros();
+        Dense {
+            t0,
+            t1,
+            c: [y, zero, zero, zero, zero, zero, zero, zero],
+        }
+    }
+
     /// The interpolated state at `t` ∈ [t0, t1].
     #[inline]
     pub fn at(&self, t: f64) -> SVector<f64, N> {
@@ -343,6 +353,11 @@ where
     /// The current state.
     pub fn y(&self) -> SVector<f64, N> {
         self.y
+    }
+
+    /// The step size the controller would try next.
+    pub fn next_step(&self) -> f64 {
+        self.h
     }
 
     /// Advance one accepted step, never past `t_stop`.

@@ -102,7 +102,7 @@ fn validate(
 /// A drive given as a function. Its state `e` is the impulse `∫F dt`:
 /// integrating it makes the step-size control follow the force while the
 /// armature is held and nothing else moves.
-struct Forced<F> {
+pub(crate) struct Forced<F> {
     force: F,
     impulse_scale: f64,
     time_scale: f64,
@@ -117,7 +117,7 @@ const GL3: [(f64, f64); 3] = [
 ];
 
 impl<F: Fn(f64, f64) -> f64> Forced<F> {
-    fn new(mechanics: &Mechanics, force: F) -> Self {
+    pub(crate) fn new(mechanics: &Mechanics, force: F) -> Self {
         let scale = [
             mechanics.preload,
             mechanics.stiffness * mechanics.gap,

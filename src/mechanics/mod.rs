@@ -47,6 +47,7 @@ pub mod linear;
 pub mod root;
 pub mod surface;
 pub mod trajectory;
+pub mod two_stage;
 
 pub use engine::{
     ImpactResponse, ResponseEnd, critical_impact_speed, impact_response, simulate, validate,

@@ -1,0 +1,272 @@
+//! When a closing is over: an energy bound.
+//!
+//! With the drive frozen at its present value (a constant force, or the
+//! coil's pull at its present flux, which does not depend on where the
+//! armature is) the relay is a mechanical system with the potential
+//!
+//! ```text
+//! V(x_a, x_b) = ½ s x_a² + p x_a − W(x_a) + ½ s_b (x_a − x_b)²
+//!             + E_c(x_b − g) + E_pole(x_a − g − o) + E_rest(−x_a)
+//! ```
+//!
+//! (`W` the drive's work from 0, `E_*` the energies the surfaces store),
+//! and every damper and every surface dissipates: the total energy
+//! `E = ½ m v_a² + ½ m_b v_b² + V` never grows. V is convex in
+//! `(x_a, x_b)` (convex springs and surface energies, a linear `W`).
+//!
+//! - A contact released by position opens only through `x_b = g`, where
+//!   `E ≥ V ≥ min V(·, g)`: if `E` is already below that minimum, it
+//!   never opens again: `stuck`.
+//! - Released by force, a Kelvin–Voigt contact opens where
+//!   `s0 δ + r0 δ̇ ≤ 0`, i.e. with `½ m_b δ̇² ≥ ½ m_b (s0 δ / r0)²`; the
+//!   bound is the minimum over `δ ≥ 0` of `min V(·, g + δ)` plus that
+//!   kinetic energy. A Hunt–Crossley contact opens by force only at
+//!   `δ̇ ≤ −1/χ`: the bound is the global minimum of V plus `½ m_b/χ²`,
+//!   or the position bound, whichever is lower.
+//! - An open contact that was touched is reached again only through
+//!   `x_b = g`: below the same position bound it `ends_open`.
+//!
+//! Minima of a convex function of one variable are found by golden
+//! section; of two, by golden section nested in golden section.
+
+use super::super::Surface;
+use super::super::driven::Drive;
+use super::super::surface::surface_energy;
+use super::Release;
+use super::engine::{Model, Modes, Y};
+
+/// Golden-section iterations: the bracket shrinks by 0.618^80 ≈ 2e-17.
+const ITERATIONS: usize = 80;
+
+/// The energy bound's state: when it was last checked.
+pub(crate) struct Bound {
+    steps: usize,
+}
+
+impl Bound {
+    pub(crate) fn new<D: Drive>(_model: &Model<'_, D>) -> Bound {
+        Bound { steps: 0 }
+    }
+
+    /// Whether to check at this step: every fourth accepted step.
+    pub(crate) fn due(&mut self, _t: f64) -> bool {
+        self.steps += 1;
+        self.steps % 4 == 0
+    }
+
+    /// Whether the closed contact can never release again.
+    pub(crate) fn cannot_release<D: Drive>(
+        &mut self,
+        model: &Model<'_, D>,
+        t: f64,
+        y: &Y,
+        _modes: Modes,
+    ) -> bool {
+        let frozen = Frozen::at(model, t, y);
+        let e = frozen.energy(y);
+        let bound = frozen.release_bound(e);
+        e < bound - frozen.margin(e, bound)
+    }
+
+    /// Whether the open contact can never be reached again.
+    pub(crate) fn cannot_reach<D: Drive>(
+        &mut self,
+        model: &Model<'_, D>,
+        t: f64,
+        y: &Y,
+        _modes: Modes,
+    ) -> bool {
+        if y[2] > 0.0 {
+            return false;
+        }
+        let frozen = Frozen::at(model, t, y);
+        let e = frozen.energy(y);
+        let bound = frozen.at_contact(0.0);
+        e < bound - frozen.margin(e, bound)
+    }
+}
+
+/// The model with its drive frozen at (t, e).
+struct Frozen<'m, 'a, D> {
+    model: &'m Model<'a, D>,
+    t: f64,
+    e: f64,
+    /// m, the range of armature positions to search.
+    lo: f64,
+    hi: f64,
+}
+
+impl<'m, 'a, D: Drive> Frozen<'m, 'a, D> {
+    fn at(model: &'m Model<'a, D>, t: f64, y: &Y) -> Self {
+        let m = model.m;
+        let g = m.gap;
+        let o = model.build.pole_face.map_or(0.0, |p| p.overtravel);
+        let push = model.drive.force(t, g + y[0], y[4]).abs() + m.preload;
+        let reach = 4.0 * (g + o + push / m.stiffness) + (g + y[0]).abs();
+        let lo = match (model.rest, &model.back) {
+            (true, None | Some(Surface::Rigid { .. })) => 0.0,
+            _ => -reach,
+        };
+        let mut hi = reach;
+        if let Some(p) = &model.build.pole_face
+            && matches!(p.surface, Surface::Rigid { .. })
+        {
+            hi = g + p.overtravel;
+        }
+        hi = hi.min(model.drive.pole() * (1.0 - 1e-9));
+        Frozen {
+            model,
+            t,
+            e: y[4],
+            lo,
+            hi,
+        }
+    }
+
+    /// J, the potential at armature `xa`, contact point `xb`.
+    fn potential(&self, xa: f64, xb: f64) -> f64 {
+        let model = self.model;
+        let m = model.m;
+        let g = m.gap;
+        let mut v = 0.5 * m.stiffness * xa * xa + m.preload * xa
+            - model.drive.frozen_work(self.t, self.e, 0.0, xa);
+        match &model.build.blade {
+            Some(b) => {
+                v += 0.5 * b.stiffness * (xa - xb) * (xa - xb);
+                v += surface_energy(&model.contact, xb - g);
+            }
+            None => v += surface_energy(&model.contact, xa - g),
+        }
+        if let Some(p) = &model.build.pole_face {
+            v += surface_energy(&p.surface, xa - g - p.overtravel);
+        }
+        if let (true, Some(b)) = (model.rest, &model.back) {
+            v += surface_energy(b, -xa);
+        }
+        v
+    }
+
+    /// J, the total energy of state `y`.
+    fn energy(&self, y: &Y) -> f64 {
+        let model = self.model;
+        let g = model.m.gap;
+        let kinetic = 0.5 * model.m.mass * y[1] * y[1]
+            + model
+                .build
+                .blade
+                .map_or(0.0, |b| 0.5 * b.mass * y[3] * y[3]);
+        let xb = if model.build.blade.is_some() {
+            g + y[2]
+        } else {
+            g + y[0]
+        };
+        kinetic + self.potential(g + y[0], xb)
+    }
+
+    /// J, the least potential with the contact point at `g + delta`.
+    fn at_contact(&self, delta: f64) -> f64 {
+        let xb = self.model.m.gap + delta;
+        if self.model.build.blade.is_none() {
+            return self.potential(xb, xb);
+        }
+        golden(|xa| self.potential(xa, xb), self.lo, self.hi).1
+    }
+
+    /// J, the least energy at which the contact can release.
+    fn release_bound(&self, energy: f64) -> f64 {
+        let model = self.model;
+        let position = self.at_contact(0.0);
+        if model.build.release == Release::Position {
+            return position;
+        }
+        let contact_mass = model.build.blade.map_or(model.m.mass, |b| b.mass);
+        match model.contact {
+            Surface::KelvinVoigt { stiffness, damping } if damping > 0.0 => {
+                // The kinetic energy the release needs at penetration δ.
+                let need = |d: f64| 0.5 * contact_mass * (stiffness * d / damping).powi(2);
+                let global = self.global();
+                let room = (energy - global).max(0.0);
+                let top = damping / stiffness * (2.0 * room / contact_mass).sqrt();
+                if top <= 0.0 {
+                    return position;
+                }
+                golden(|d| self.at_contact(d) + need(d), 0.0, top)
+                    .1
+                    .min(position)
+            }
+            Surface::HuntCrossley { chi, .. } if chi > 0.0 => {
+                position.min(self.global() + 0.5 * contact_mass / (chi * chi))
+            }
+            _ => position,
+        }
+    }
+
+    /// J, the least potential anywhere.
+    fn global(&self) -> f64 {
+        let model = self.model;
+        if model.build.blade.is_none() {
+            return golden(|x| self.potential(x, x), self.lo, self.hi).1;
+        }
+        let inner = |xa: f64| {
+            golden(
+                |xb| self.potential(xa, xb),
+                self.lo,
+                self.hi.max(xa) + model.m.gap,
+            )
+            .1
+        };
+        golden(inner, self.lo, self.hi).1
+    }
+
+    /// J, a margin against rounding in the comparison.
+    fn margin(&self, energy: f64, bound: f64) -> f64 {
+        let m = self.model.m;
+        1e-9 * (energy.abs() + bound.abs() + m.stiffness * m.gap * m.gap)
+    }
+}
+
+/// (x, f(x)) at the minimum of a convex `f` on `[lo, hi]`.
+fn golden(f: impl Fn(f64) -> f64, lo: f64, hi: f64) -> (f64, f64) {
+    const R: f64 = 0.618_033_988_749_894_9;
+    let (mut a, mut b) = (lo, hi);
+    let mut c = b - R * (b - a);
+    let mut d = a + R * (b - a);
+    let (mut fc, mut fd) = (f(c), f(d));
+    for _ in 0..ITERATIONS {
+        if fc < fd {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - R * (b - a);
+            fc = f(c);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + R * (b - a);
+            fd = f(d);
+        }
+        if b - a <= 1e-15 * (a.abs() + b.abs()) {
+            break;
+        }
+    }
+    let (fa, fb) = (f(lo), f(hi));
+    [(lo, fa), (hi, fb), (c, fc), (d, fd)]
+        .into_iter()
+        .fold((c, fc), |best, p| if p.1 < best.1 { p } else { best })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::golden;
+
+    #[test]
+    fn golden_section_finds_a_parabola_s_minimum() {
+        let (x, fx) = golden(|x| (x - 0.3) * (x - 0.3) + 2.0, -1.0, 4.0);
+        assert!((x - 0.3).abs() < 1e-7, "{x}");
+        assert!((fx - 2.0).abs() < 1e-13);
+        // At a bound when the minimum lies outside.
+        let (x, _) = golden(|x| (x - 9.0) * (x - 9.0), -1.0, 4.0);
+        assert_eq!(x, 4.0);
+    }
+}
