@@ -21,7 +21,7 @@ mod raw;
 use chatterspice::arc::GapProfile;
 use chatterspice::chatter::Chatter;
 use chatterspice::check;
-use chatterspice::mechanics::{Dimensionless, Trajectory};
+use chatterspice::mechanics::Dimensionless;
 use chatterspice::netlist::{self, ContactElement};
 use chatterspice::pipeline::CouplingOptions;
 use chatterspice::pipeline::{self, RunOptions};
@@ -348,14 +348,36 @@ fn bounce(args: &BounceArgs) -> Result<()> {
     let scenario = load_scenario(args.scenario.as_deref())?;
     let mechanics = scenario.mechanics()?;
     let surface = scenario.surface();
-    let chatter = simulate(&mechanics, &surface, &scenario.settings()).with_context(|| {
+    let build = scenario.two_stage();
+    let failed = || {
         format!(
             "{}: the mechanics simulation failed",
             scenario.origin.display()
         )
-    })?;
+    };
     let dimensionless = Dimensionless::of(&mechanics, &surface);
-    let text = report::render(args.format.into(), &chatter, Some(&dimensionless));
+    let text = if build.is_one_mass() {
+        let chatter = simulate(&mechanics, &surface, &scenario.settings()).with_context(failed)?;
+        report::render(args.format.into(), &chatter, Some(&dimensionless))
+    } else {
+        let trajectory = chatterspice::mechanics::two_stage::step_closing(
+            &mechanics,
+            &build,
+            &surface,
+            &scenario.settings(),
+        )
+        .with_context(failed)?;
+        let pole_face = build
+            .pole_face
+            .is_some()
+            .then(|| trajectory.pole_face_impacts());
+        report::render_two_stage(
+            args.format.into(),
+            trajectory.chatter(),
+            Some(&dimensionless),
+            pole_face,
+        )
+    };
     emit(&text, args.output.as_deref(), args.force)
 }
 
@@ -515,13 +537,18 @@ fn pwl(args: &PwlArgs) -> Result<()> {
                 scenario.surface(),
                 scenario.settings(),
             );
-            let trajectory =
-                Trajectory::of_step(&mechanics, &surface, &settings).with_context(|| {
-                    format!(
-                        "{}: the mechanics simulation failed",
-                        scenario.origin.display()
-                    )
-                })?;
+            let trajectory = chatterspice::mechanics::two_stage::step_closing(
+                &mechanics,
+                &scenario.two_stage(),
+                &surface,
+                &settings,
+            )
+            .with_context(|| {
+                format!(
+                    "{}: the mechanics simulation failed",
+                    scenario.origin.display()
+                )
+            })?;
             let gap = GapProfile::from_trajectory(&trajectory);
             let chatter = trajectory.into_chatter();
             (pipeline::contact_waveform(&scenario, &chatter)?.0, gap)

@@ -25,6 +25,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use crate::mechanics::two_stage::TwoStage;
 use crate::mechanics::{Mechanics, Settings, Surface};
 use crate::scenario::{Scenario, ScenarioError};
 
@@ -44,6 +45,7 @@ pub struct Plan {
     scenario: Scenario,
     surface: Surface,
     back_stop: Option<Surface>,
+    two_stage: TwoStage,
     netlist: Option<Arc<Netlist>>,
 }
 
@@ -60,6 +62,7 @@ impl Plan {
             None => None,
         };
         Ok(Plan {
+            two_stage: scenario.two_stage(),
             scenario,
             surface,
             back_stop,
@@ -73,6 +76,7 @@ impl Plan {
     pub fn without_circuit(scenario: Scenario) -> Result<Plan, ScenarioError> {
         let (surface, back_stop) = scenario.revalidate(true)?;
         Ok(Plan {
+            two_stage: scenario.two_stage(),
             scenario,
             surface,
             back_stop,
@@ -88,6 +92,7 @@ impl Plan {
         scenario.set_numbers(values)?;
         let (surface, back_stop) = (scenario.surface(), scenario.back_stop());
         Ok(Plan {
+            two_stage: scenario.two_stage(),
             scenario,
             surface,
             back_stop,
@@ -104,6 +109,7 @@ impl Plan {
         self.scenario.set_numbers(values)?;
         self.surface = self.scenario.surface();
         self.back_stop = self.scenario.back_stop();
+        self.two_stage = self.scenario.two_stage();
         Ok(())
     }
 
@@ -121,6 +127,12 @@ impl Plan {
     /// armature lands inelastically.
     pub fn back_stop(&self) -> Option<Surface> {
         self.back_stop
+    }
+
+    /// The relay as built (`[blade]`, `[pole_face]`, the release rules),
+    /// resolved.
+    pub fn two_stage(&self) -> TwoStage {
+        self.two_stage
     }
 
     /// The engine settings (`[simulation]`).

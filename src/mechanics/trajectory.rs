@@ -29,6 +29,8 @@ use super::hunt_crossley::{HcContact, HcStep};
 use super::integrate::Step;
 use super::linear::LinearPiece;
 use super::surface::surface_force;
+use super::two_stage::TwoStageRun;
+use super::two_stage::engine::Piece as StagedPiece;
 use super::{DriveError, Mechanics, MechanicsError, Settings, Surface};
 use crate::chatter::{Chatter, ContactState, Impact};
 
@@ -118,6 +120,10 @@ pub enum EventKind {
     Landing,
     /// It rebounds off the rest stop.
     Rebound,
+    /// The armature hits the pole face (a relay with a contact blade).
+    PoleFace,
+    /// The armature leaves the pole face.
+    PoleFaceRelease,
 }
 
 /// One event of a trajectory.
@@ -169,6 +175,9 @@ enum Motion {
     /// One step of a Hunt–Crossley contact under the step drive, touched
     /// at `touch` (s).
     Contact { step: HcStep, touch: f64 },
+    /// One step of the two-stage engine: the state is
+    /// `(u_a, v_a, u_b, v_b, e)`; the contact point is the blade's.
+    Staged(Box<StagedPiece>),
 }
 
 /// A stretch of the trajectory between two instants.
@@ -267,6 +276,8 @@ impl Segment {
             Motion::Linear(piece) => piece.state(self.t1 - self.t0).0,
             Motion::Integrated { y1, .. } => g + y1[0],
             Motion::Contact { step, touch } => g + step.at(self.t1 - touch).0,
+            // The armature, whose position sets the coil's inductance.
+            Motion::Staged(piece) => g + piece.y1[0],
         };
         (self.t1, x)
     }
@@ -285,6 +296,7 @@ pub struct Trajectory {
     make: Chatter,
     back: Option<Chatter>,
     strokes: Vec<Stroke>,
+    pole_face: Vec<Impact>,
     t_end: f64,
 }
 
@@ -312,7 +324,33 @@ impl Trajectory {
                 let (delta, rate) = step.at(t - touch);
                 (self.gap + delta, rate)
             }
+            Motion::Staged(piece) => {
+                let y = piece.at(t);
+                (self.gap + y[2], y[3])
+            }
         }
+    }
+
+    /// (m, m/s): the armature's position and velocity at `t` (s). The
+    /// same as [`Trajectory::state`] for the one-mass model; with a
+    /// contact blade, the armature that carries it.
+    pub fn armature(&self, t: f64) -> (f64, f64) {
+        let Some(seg) = self.segment(t) else {
+            return (0.0, 0.0);
+        };
+        match &seg.motion {
+            Motion::Staged(piece) => {
+                let y = piece.at(t.clamp(seg.t0, seg.t1));
+                (self.gap + y[0], y[1])
+            }
+            _ => self.state(t),
+        }
+    }
+
+    /// The armature's impacts on the pole face (a relay with a pole face;
+    /// empty otherwise).
+    pub fn pole_face_impacts(&self) -> &[Impact] {
+        &self.pole_face
     }
 
     /// m, the position at `t` (0 on the rest stop, the gap at the
@@ -502,12 +540,89 @@ impl Trajectory {
             make: cycle.make,
             back: Some(cycle.back),
             strokes: cycle.strokes,
+            pole_face: Vec::new(),
             t_end: settings.t_end,
         }
     }
 }
 
 impl Trajectory {
+    /// The trajectory of a two-stage run ([`super::two_stage`]): the
+    /// contact point is the blade's; [`Trajectory::armature`] and
+    /// [`Trajectory::path`] follow the armature.
+    pub fn of_two_stage(
+        m: &Mechanics,
+        stops: &Stops,
+        settings: &Settings,
+        run: TwoStageRun,
+    ) -> Trajectory {
+        let g = m.gap;
+        let mut events = contact_events(&run.contact, g);
+        for p in &run.pole_face {
+            events.push(Event {
+                time: p.impact_time,
+                kind: EventKind::PoleFace,
+                position: g + run.state(p.impact_time, 0.0).0,
+                velocity: p.impact_velocity,
+            });
+            if let (Some(t), Some(v)) = (p.release_time, p.release_velocity) {
+                events.push(Event {
+                    time: t,
+                    kind: EventKind::PoleFaceRelease,
+                    position: g + run.state(t, 0.0).0,
+                    velocity: v,
+                });
+            }
+        }
+        for &t in run.strokes.iter().map(|s| &s.lift_off) {
+            events.push(Event {
+                time: t,
+                kind: EventKind::LiftOff,
+                position: 0.0,
+                velocity: 0.0,
+            });
+        }
+        for b in &run.back.impacts {
+            events.push(Event {
+                time: b.impact_time,
+                kind: EventKind::Landing,
+                position: 0.0,
+                velocity: -b.impact_velocity,
+            });
+        }
+        if let Some(t) = run.contact.settle_time {
+            events.push(settled(t, g));
+        }
+        sort(&mut events);
+        let segments = run
+            .pieces
+            .into_iter()
+            .map(|piece| Segment {
+                t0: piece.dense.t0,
+                t1: piece.t1,
+                side: if piece.contact_closed() {
+                    Side::Make
+                } else {
+                    Side::Open
+                },
+                motion: Motion::Staged(Box::new(piece)),
+            })
+            .collect();
+        let driven = !run.strokes.is_empty() || !run.back.impacts.is_empty();
+        Trajectory {
+            gap: g,
+            make_surface: stops.make,
+            back_surface: stops.back,
+            segments,
+            events,
+            make: run.contact,
+            back: driven.then_some(run.back),
+            strokes: run.strokes,
+            pole_face: run.pole_face,
+            t_end: settings.t_end,
+        }
+    }
+
     /// The step-force closing of `m` onto `surface`: the exact engine's
     /// record ([`super::simulate`]), with the motion between its events
     /// rebuilt from the exact event states.
@@ -594,6 +709,7 @@ fn step_trajectory(
         make: chatter,
         back: None,
         strokes: Vec::new(),
+        pole_face: Vec::new(),
         t_end,
     })
 }
@@ -700,6 +816,8 @@ fn sort(events: &mut [Event]) {
         EventKind::Touch => 2,
         EventKind::Settled => 3,
         EventKind::Release => 4,
+        EventKind::PoleFace => 5,
+        EventKind::PoleFaceRelease => 6,
     };
     events.sort_by(|a, b| {
         a.time

@@ -35,7 +35,7 @@ use crate::arc::{ArcModel, ArcReport, GapProfile, analysis::MissingArcVector};
 use crate::chatter::{Chatter, ContactState, Interval};
 use crate::coil::Operation;
 use crate::mechanics::Surface;
-use crate::mechanics::{MechanicsError, Trajectory, contact_forces};
+use crate::mechanics::{MechanicsError, contact_forces};
 use crate::netlist::arc::with_arc;
 use crate::netlist::{self, ContactElement, ContactInclude, Deck, DeckRequest, NetlistError};
 use crate::plan::{Netlist, Plan};
@@ -116,6 +116,16 @@ pub enum RunError {
         /// Why the simulation failed.
         #[source]
         source: MechanicsError,
+    },
+    /// The two-stage relay's motion (`[blade]`, `[pole_face]`, a contact
+    /// released by force) could not be simulated.
+    #[error("{}: the mechanics simulation failed", path.display())]
+    Motion {
+        /// The scenario file.
+        path: PathBuf,
+        /// Why the simulation failed.
+        #[source]
+        source: crate::mechanics::DriveError,
     },
     /// The contact conductance over time could not be built from the
     /// chatter.
@@ -257,11 +267,15 @@ pub fn run_plan(
     }
     let mechanics = plan.mechanics()?;
     let (surface, settings) = (plan.surface(), plan.settings());
-    let trajectory = Trajectory::of_step(&mechanics, &surface, &settings).map_err(|source| {
-        RunError::Mechanics {
-            path: scenario.origin.clone(),
-            source,
-        }
+    let trajectory = crate::mechanics::two_stage::step_closing(
+        &mechanics,
+        &plan.two_stage(),
+        &surface,
+        &settings,
+    )
+    .map_err(|source| RunError::Motion {
+        path: scenario.origin.clone(),
+        source,
     })?;
     let gap = GapProfile::from_trajectory(&trajectory);
     let chatter = trajectory.into_chatter();

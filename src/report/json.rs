@@ -26,6 +26,22 @@ pub struct BounceJson<'a> {
     chatter: &'a Chatter,
     #[serde(skip_serializing_if = "Option::is_none")]
     dimensionless: Option<DimensionlessJson>,
+    /// A relay with a pole face: the armature's impacts on it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pole_face_impacts: Option<Vec<PoleFaceJson>>,
+}
+
+/// One impact of the armature on the pole face.
+#[derive(Debug, Serialize)]
+struct PoleFaceJson {
+    /// s
+    time: f64,
+    /// m/s, the armature's speed at the impact (> 0).
+    velocity: f64,
+    /// s, when it leaves the pole face again; `null` if it stays.
+    release_time: Option<f64>,
+    /// m/s, its velocity then (< 0); `null` with `release_time`.
+    release_velocity: Option<f64>,
 }
 
 impl<'a> BounceJson<'a> {
@@ -35,7 +51,24 @@ impl<'a> BounceJson<'a> {
         BounceJson {
             chatter,
             dimensionless: dimensionless.map(DimensionlessJson::from),
+            pole_face_impacts: None,
         }
+    }
+
+    /// The same object with the pole face's impacts.
+    pub fn with_pole_face(mut self, impacts: &[crate::chatter::Impact]) -> Self {
+        self.pole_face_impacts = Some(
+            impacts
+                .iter()
+                .map(|i| PoleFaceJson {
+                    time: i.impact_time,
+                    velocity: i.impact_velocity,
+                    release_time: i.release_time,
+                    release_velocity: i.release_velocity,
+                })
+                .collect(),
+        );
+        self
     }
 }
 
@@ -75,6 +108,21 @@ pub fn render(chatter: &Chatter, dimensionless: Option<&Dimensionless>) -> Strin
         // Only maps with non-string keys or a failing writer can fail, and
         // these types have neither.
         .expect("a chatter result always serializes");
+    text.push('\n');
+    text
+}
+
+/// [`render`] with the pole face's impacts, when given.
+pub fn render_with_pole_face(
+    chatter: &Chatter,
+    dimensionless: Option<&Dimensionless>,
+    pole_face: Option<&[crate::chatter::Impact]>,
+) -> String {
+    let mut json = BounceJson::new(chatter, dimensionless);
+    if let Some(impacts) = pole_face {
+        json = json.with_pole_face(impacts);
+    }
+    let mut text = serde_json::to_string_pretty(&json).expect("a chatter result always serializes");
     text.push('\n');
     text
 }

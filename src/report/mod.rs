@@ -47,6 +47,27 @@ pub fn render(format: Format, chatter: &Chatter, dimensionless: Option<&Dimensio
     }
 }
 
+/// [`render`] for a two-stage relay: the pole face's impacts (when it
+/// has one) are added to the JSON (`pole_face_impacts`) and the table.
+pub fn render_two_stage(
+    format: Format,
+    chatter: &Chatter,
+    dimensionless: Option<&Dimensionless>,
+    pole_face: Option<&[crate::chatter::Impact]>,
+) -> String {
+    match format {
+        Format::Json => json::render_with_pole_face(chatter, dimensionless, pole_face),
+        Format::Csv => csv::render(chatter),
+        Format::Table => {
+            let mut text = table::render(chatter);
+            if let Some(impacts) = pole_face {
+                text.push_str(&table::pole_face(impacts));
+            }
+            text
+        }
+    }
+}
+
 pub use crate::output::{WriteError, is_input, protect_input, write_bundle, write_new_file};
 
 /// Hand-built results for the renderers' tests: the engine is tested on

@@ -73,6 +73,31 @@ pub fn render(chatter: &Chatter) -> String {
     out
 }
 
+/// The armature's impacts on the pole face, as a table under the
+/// contact's (a relay with a pole face).
+pub fn pole_face(impacts: &[crate::chatter::Impact]) -> String {
+    let mut out = String::from("\npole face (the armature)\n");
+    if impacts.is_empty() {
+        out.push_str("  not reached\n");
+        return out;
+    }
+    let mut rows = vec![
+        ["#", "impact", "v impact", "release", "v release"].map(String::from),
+        ["", "ms", "mm/s", "ms", "mm/s"].map(String::from),
+    ];
+    for (n, i) in impacts.iter().enumerate() {
+        rows.push([
+            (n + 1).to_string(),
+            fixed(Some(i.impact_time * 1e3), 4),
+            sig(Some(i.impact_velocity * 1e3), ""),
+            fixed(i.release_time.map(|t| t * 1e3), 4),
+            sig(i.release_velocity.map(|v| v * 1e3), ""),
+        ]);
+    }
+    out.push_str(&align(&rows, 0));
+    out
+}
+
 /// The `run` result for a person: the relay in one line, the circuit run,
 /// a table of the probes (each followed by the ideal contact's row), and a
 /// sentence per probe saying what the bounce added. Current probes get a

@@ -143,6 +143,7 @@ fn section_of(surface: Surface) -> SurfaceSection {
         exponent: None,
         chi: None,
         reference_velocity: None,
+        release: None,
     };
     match surface {
         Surface::Rigid { restitution } => SurfaceSection {

@@ -101,6 +101,12 @@ impl Check<'_> {
         self.drive(&d.mechanics, d.coil.as_ref())?;
         let surface = self.surface("surface", &d.surface)?;
         let back_stop = self.back_stop(d.back_stop.as_ref(), d.coil.is_some())?;
+        self.two_stage(
+            d.blade.as_ref(),
+            d.pole_face.as_ref(),
+            &d.surface,
+            d.mechanics.gap,
+        )?;
         self.contact(&d.contact)?;
         self.simulation(&d.simulation)?;
         if let Some(circuit) = &d.circuit {

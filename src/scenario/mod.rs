@@ -31,6 +31,7 @@ mod surface;
 mod sweep;
 #[cfg(test)]
 mod tests;
+mod two_stage;
 
 pub use builder::ScenarioBuilder;
 pub use calibration::{DatasheetSection, FitSection, FittedParameter, ProvenanceSection};
@@ -45,6 +46,7 @@ pub use probes::Probe;
 pub use simulation::SimulationSection;
 pub use surface::{SurfaceLaw, SurfaceSection};
 pub use sweep::{GridAxis, SweepSection, Tolerance};
+pub use two_stage::{BladeSection, PoleFaceSection, ReleaseRule};
 
 use check::Check;
 use keys::*;
@@ -85,6 +87,8 @@ struct Document {
     coil: Option<CoilSection>,
     surface: SurfaceSection,
     back_stop: Option<SurfaceSection>,
+    blade: Option<BladeSection>,
+    pole_face: Option<PoleFaceSection>,
     #[serde(default)]
     contact: ContactSection,
     #[serde(default)]
@@ -118,6 +122,12 @@ pub struct Scenario {
     /// lands on release (the normally-closed contact). Only with `[coil]`:
     /// a step force never releases.
     pub back_stop: Option<SurfaceSection>,
+    /// `[blade]`: the moving contact on its leaf spring, carried by the
+    /// armature (a two-stage relay).
+    pub blade: Option<BladeSection>,
+    /// `[pole_face]`: the armature's stop past the contact (needs
+    /// `[blade]`).
+    pub pole_face: Option<PoleFaceSection>,
     /// `[contact]`: the contact as a resistor (the defaults when the file
     /// has no such section).
     pub contact: ContactSection,
@@ -209,6 +219,8 @@ impl Scenario {
             coil: document.coil,
             surface: document.surface,
             back_stop: document.back_stop,
+            blade: document.blade,
+            pole_face: document.pole_face,
             contact: document.contact,
             simulation: document.simulation,
             circuit,
@@ -283,6 +295,27 @@ impl Scenario {
     /// to χ.
     pub fn surface(&self) -> Surface {
         self.resolved_surface
+    }
+
+    /// The relay as built: `[blade]`, `[pole_face]` and the release rules
+    /// (validated with the rest of the file). Without them, the one-mass
+    /// model ([`crate::mechanics::two_stage::TwoStage::is_one_mass`]).
+    pub fn two_stage(&self) -> crate::mechanics::two_stage::TwoStage {
+        use crate::mechanics::two_stage::{Blade, PoleFace, TwoStage};
+        let pole_face = self.pole_face.as_ref().map(|p| PoleFace {
+            overtravel: p.overtravel,
+            surface: surface::resolve(&p.surface()),
+            release: p.release.unwrap_or_default().into(),
+        });
+        TwoStage {
+            blade: self.blade.as_ref().map(|b| Blade {
+                mass: b.mass,
+                stiffness: b.stiffness,
+                damping: b.damping,
+            }),
+            pole_face,
+            release: self.surface.release.unwrap_or_default().into(),
+        }
     }
 
     /// The back stop's law (`[back_stop]`), resolved like

@@ -30,6 +30,16 @@ pub const NUMBER_KEYS: &[&str] = &[
     "back_stop.exponent",
     "back_stop.chi",
     "back_stop.reference_velocity",
+    "blade.mass",
+    "blade.stiffness",
+    "blade.damping",
+    "pole_face.overtravel",
+    "pole_face.stiffness",
+    "pole_face.damping",
+    "pole_face.restitution",
+    "pole_face.exponent",
+    "pole_face.chi",
+    "pole_face.reference_velocity",
     "contact.r_closed",
     "contact.r_open",
     "contact.edge_time",
@@ -107,6 +117,32 @@ macro_rules! number_field {
                         _ => $($r)* b.reference_velocity,
                     }),
                     None => Field::NoSection("[back_stop]"),
+                }
+            }
+            "blade.mass" | "blade.stiffness" | "blade.damping" => match $($r)* s.blade {
+                Some(b) => Field::Plain(match $key {
+                    "blade.mass" => $($r)* b.mass,
+                    "blade.stiffness" => $($r)* b.stiffness,
+                    _ => $($r)* b.damping,
+                }),
+                None => Field::NoSection("[blade]"),
+            },
+            "pole_face.overtravel" => match $($r)* s.pole_face {
+                Some(p) => Field::Plain($($r)* p.overtravel),
+                None => Field::NoSection("[pole_face]"),
+            },
+            "pole_face.stiffness" | "pole_face.damping" | "pole_face.restitution"
+            | "pole_face.exponent" | "pole_face.chi" | "pole_face.reference_velocity" => {
+                match $($r)* s.pole_face {
+                    Some(p) => Field::Optional(match $key {
+                        "pole_face.stiffness" => $($r)* p.stiffness,
+                        "pole_face.damping" => $($r)* p.damping,
+                        "pole_face.restitution" => $($r)* p.restitution,
+                        "pole_face.exponent" => $($r)* p.exponent,
+                        "pole_face.chi" => $($r)* p.chi,
+                        _ => $($r)* p.reference_velocity,
+                    }),
+                    None => Field::NoSection("[pole_face]"),
                 }
             }
             "contact.r_closed" => Field::Plain($($r)* s.contact.r_closed),
@@ -331,6 +367,12 @@ impl Scenario {
         check.drive(&self.mechanics, self.coil.as_ref())?;
         let surface = check.surface("surface", &self.surface)?;
         let back_stop = check.back_stop(self.back_stop.as_ref(), self.coil.is_some())?;
+        check.two_stage(
+            self.blade.as_ref(),
+            self.pole_face.as_ref(),
+            &self.surface,
+            self.mechanics.gap,
+        )?;
         check.contact(&self.contact)?;
         check.simulation(&self.simulation)?;
         if let Some(arc) = &self.arc {

@@ -46,7 +46,7 @@ impl SurfaceLaw {
     }
 
     /// The same keys, as a reader should see them in an error.
-    fn keys_described(self) -> &'static str {
+    pub(super) fn keys_described(self) -> &'static str {
         match self {
             SurfaceLaw::Rigid => "`restitution`",
             SurfaceLaw::KelvinVoigt => "`stiffness` and `damping`",
@@ -85,6 +85,9 @@ pub struct SurfaceSection {
     pub chi: Option<f64>,
     /// m/s, the impact speed at which the Hunt–Crossley `restitution` holds.
     pub reference_velocity: Option<f64>,
+    /// How a deformable surface lets go (`"position"`, the paper's rule
+    /// and the default, or `"force"`).
+    pub release: Option<ReleaseRule>,
 }
 
 impl Check<'_> {
@@ -295,5 +298,29 @@ impl Check<'_> {
             exponent,
             chi,
         })
+    }
+}
+
+/// The law of a section that validation has accepted (a Hunt–Crossley
+/// restitution converted to χ). Only for checked sections: an unchecked
+/// one gets the nearest law it describes.
+pub(super) fn resolve(s: &SurfaceSection) -> Surface {
+    match s.law {
+        SurfaceLaw::Rigid => Surface::Rigid {
+            restitution: s.restitution.unwrap_or(0.0),
+        },
+        SurfaceLaw::KelvinVoigt => Surface::KelvinVoigt {
+            stiffness: s.stiffness.unwrap_or(0.0),
+            damping: s.damping.unwrap_or(0.0),
+        },
+        SurfaceLaw::HuntCrossley => Surface::HuntCrossley {
+            stiffness: s.stiffness.unwrap_or(0.0),
+            exponent: s.exponent.unwrap_or(1.0),
+            chi: match (s.chi, s.restitution, s.reference_velocity) {
+                (Some(chi), _, _) => chi,
+                (None, Some(e), Some(v)) => hunt_crossley_chi(e, v).unwrap_or(0.0),
+                _ => 0.0,
+            },
+        },
     }
 }

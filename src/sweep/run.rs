@@ -390,8 +390,21 @@ impl<'a, 'r> Worker<'a, 'r> {
         let chatter = match scenario
             .mechanics()
             .map_err(|e| one_line(&e))
-            .and_then(|m| simulate(&m, &plan.surface(), &plan.settings()).map_err(|e| one_line(&e)))
-        {
+            .and_then(|m| {
+                let build = plan.two_stage();
+                if build.is_one_mass() {
+                    simulate(&m, &plan.surface(), &plan.settings()).map_err(|e| one_line(&e))
+                } else {
+                    crate::mechanics::two_stage::step_closing(
+                        &m,
+                        &build,
+                        &plan.surface(),
+                        &plan.settings(),
+                    )
+                    .map(|t| t.into_chatter())
+                    .map_err(|e| one_line(&e))
+                }
+            }) {
             Ok(chatter) => chatter,
             Err(e) => {
                 record.error = Some(e);

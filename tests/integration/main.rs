@@ -39,4 +39,5 @@ mod spice_runner;
 mod sweep;
 mod timing;
 mod trajectory;
+mod two_stage;
 mod waveform;

@@ -86,7 +86,6 @@ impl Piece {
     }
 
     /// Whether the contact is closed over this piece.
-    #[allow(dead_code)]
     pub(crate) fn contact_closed(&self) -> bool {
         self.modes.contact != Stop::Open
     }
@@ -835,7 +834,12 @@ impl Tracker {
             let y = dense.at(t);
             match modes.contact {
                 Stop::Engaged => {
-                    let f = law(&model.contact, y[2], y[3]);
+                    let mut f = law(&model.contact, y[2], y[3]);
+                    if model.build.release == Release::Force {
+                        // F_c = max(0, ·): zero, not a rounding below it,
+                        // where the contact lets go.
+                        f = f.max(0.0);
+                    }
                     if let Some(last) = rec.contact.last_mut() {
                         last.peak_force = Some(last.peak_force.map_or(f, |p: f64| p.max(f)));
                         last.min_force = Some(last.min_force.map_or(f, |p: f64| p.min(f)));

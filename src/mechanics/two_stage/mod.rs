@@ -256,3 +256,55 @@ pub(crate) fn validate_all(
 
 #[cfg(test)]
 mod tests;
+
+/// The closing of `m` under its step force onto `surface`, built as
+/// `build`: the exact one-mass engine when `build` is the one-mass model
+/// (the same numbers to the last digit), else the two-stage engine.
+pub fn step_closing(
+    m: &Mechanics,
+    build: &TwoStage,
+    surface: &Surface,
+    settings: &super::Settings,
+) -> Result<super::Trajectory, DriveError> {
+    if build.is_one_mass() {
+        return Ok(super::Trajectory::of_step(m, surface, settings)?);
+    }
+    let stops = super::cycle::Stops {
+        make: *surface,
+        back: None,
+    };
+    let run = simulate_two_stage(
+        m,
+        build,
+        &stops,
+        settings,
+        super::Drive::Step,
+        Horizon::Closing,
+    )?;
+    Ok(super::Trajectory::of_two_stage(m, &stops, settings, run))
+}
+
+/// The whole run of `m` under a force `F(t, x)` (N toward closing at the
+/// armature's position `x`), built as `build`: the one-mass cycle engine
+/// when `build` is the one-mass model, else the two-stage engine to
+/// `settings.t_end`.
+pub fn driven_run(
+    m: &Mechanics,
+    build: &TwoStage,
+    stops: &super::cycle::Stops,
+    settings: &super::Settings,
+    force: &dyn Fn(f64, f64) -> f64,
+) -> Result<super::Trajectory, DriveError> {
+    if build.is_one_mass() {
+        return super::simulate_drive(m, stops, settings, super::Drive::Force(force));
+    }
+    let run = simulate_two_stage(
+        m,
+        build,
+        stops,
+        settings,
+        super::Drive::Force(force),
+        Horizon::Cycle,
+    )?;
+    Ok(super::Trajectory::of_two_stage(m, stops, settings, run))
+}
