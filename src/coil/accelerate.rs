@@ -38,7 +38,8 @@
 
 use super::{Coil, CoilError};
 use crate::mechanics::cycle::Stops;
-use crate::mechanics::{Drive, Mechanics, Settings, Trajectory, simulate_drive};
+use crate::mechanics::two_stage::{TwoStage, driven_run};
+use crate::mechanics::{Mechanics, Settings, Trajectory};
 
 /// One ngspice run of the coil: its time points, the voltage across the
 /// coil and its flux linkage there, and the armature path it followed.
@@ -82,6 +83,7 @@ pub fn settle(
     run: &CircuitRun,
     start: Trajectory,
     mechanics: &Mechanics,
+    build: &TwoStage,
     stops: &Stops,
     settings: &Settings,
     tolerances: Tolerances,
@@ -104,7 +106,7 @@ pub fn settle(
             .collect();
         let flux_at = super::samples::Cursor::new(&estimate);
         let pull = |t: f64, _x: f64| coil.force_from_flux(flux_at.at(t));
-        let next = simulate_drive(mechanics, stops, settings, Drive::Force(&pull))?;
+        let next = driven_run(mechanics, build, stops, settings, &pull)?;
         let moved = super::samples::event_change(current.chatter(), next.chatter()).max(
             super::samples::event_change(
                 super::samples::back_of(&current),

@@ -40,8 +40,9 @@ use crate::coil::samples::{Cursor, back_of, event_change, thin};
 use crate::coil::timing::{Operation, Switching, operations};
 use crate::coil::{Coil, CoilError};
 use crate::mechanics::Mechanics;
+use crate::mechanics::Trajectory;
 use crate::mechanics::cycle::{Stops, Stroke};
-use crate::mechanics::{Drive, Trajectory, simulate_drive};
+use crate::mechanics::two_stage::driven_run;
 use crate::netlist::arc::with_arc;
 use crate::netlist::coil::coil_include;
 use crate::netlist::{
@@ -370,6 +371,7 @@ pub fn run_coupled_plan(
         back: plan.back_stop(),
     };
     let settings = plan.settings();
+    let build = plan.two_stage();
     let model = ContactModel::from(&scenario.contact);
     let psi = flux_vector(coil_instance);
     let volts = voltage_vector(coil_instance);
@@ -473,13 +475,13 @@ pub fn run_coupled_plan(
         })?;
         let flux_at = Cursor::new(&flux);
         let pull = |t: f64, _x: f64| coil.force_from_flux(flux_at.at(t));
-        let cycle = simulate_drive(&mechanics, &stops, &settings, Drive::Force(&pull)).map_err(
-            |source| CouplingError::Coil {
+        let cycle = driven_run(&mechanics, &build, &stops, &settings, &pull).map_err(|source| {
+            CouplingError::Coil {
                 path: origin.clone(),
                 iteration,
                 source,
-            },
-        )?;
+            }
+        })?;
         let change =
             event_change(&chatter, cycle.chatter()).max(event_change(&back, back_of(&cycle)));
         iterations.push(Iteration {
@@ -519,6 +521,7 @@ pub fn run_coupled_plan(
                 &run,
                 cycle,
                 &mechanics,
+                &build,
                 &stops,
                 &settings,
                 Tolerances {
