@@ -27,9 +27,9 @@
 //!
 //! **Drop-out** (must-release) is the current at which the pull at the
 //! closed position only just holds the load there,
-//! `½ i² L'(x_c) = load(x_c)`: the pull falls as the armature leaves
-//! (the gap widens) while the load falls no faster than the spring, so
-//! once the armature leaves it returns all the way.
+//! `½ i² L'(x_c) = load(x_c)`, with `x_c` the end of the travel (the
+//! pole face, or the contact position without one): below it the
+//! armature leaves the closed position.
 
 use super::Coil;
 use crate::mechanics::Mechanics;
