@@ -138,14 +138,15 @@ mod spring_start {
     #[test]
     fn figures_no_load_line_meets_give_no_start() {
         let c = coil();
-        // A pick-up below the drop-out's pull at rest: no spring ≥ 0 and
-        // preload ≥ 0 meets both.
+        // This magnet's pick-up is 1.50 to 3.25 times its drop-out (from a
+        // preload-less spring to a spring-less preload): a pick-up below
+        // the drop-out is met by no spring ≥ 0 and preload ≥ 0.
         let given = Currents {
             pick_up: Some(0.5 / 70.0),
             drop_out: Some(0.89285 / 70.0),
         };
         assert!(solve_spring(&c, &truth(), given, true, true).is_none());
-        // A pick-up above what a spring-less load line needs.
+        // Nor one above what a spring-less load line needs.
         let given = Currents {
             pick_up: Some(4.0 / 70.0),
             ..given
