@@ -24,14 +24,20 @@
 //!
 //! **A datasheet** gives figures in IEC 61810 meanings, computed here as a
 //! datasheet measures them: an ideal DC step on the coil, no driver
-//! circuit. With the single-gap magnet `L(x) = μ0N²A/(g_a − x + l_eq)`:
-//! at pick-up the pull at rest equals the preload, `½ i² L'(0) = p` with
-//! `i = V_pu/R_c`; at drop-out the pull at the closed position equals the
-//! spring, `½ i² L'(g) = s·g + p`. The operate and bounce times come from
+//! circuit. With the single-gap magnet `L(x) = μ0N²A/(g_a − x + l_eq)`
+//! and the armature's load line `p + s·x` ([`crate::coil::pick_up`]):
+//! pick-up is the smallest current `i = V_pu/R_c` whose pull `½ i² L'(x)`
+//! beats the load at every position of the travel. That is the pull at
+//! rest against the preload only while `s·a ≤ 2p` (`a = g_a + l_eq`); a
+//! stiffer spring makes the armature lift off and stall part-way, at
+//! `x* = (s·a − 2p)/(3s)`, and that point sets the pick-up. At drop-out
+//! the pull at the closed position equals the load there,
+//! `½ i² L'(g) = s·g + p`. The operate and bounce times come from
 //! the direct coil engine ([`crate::coil::simulate_direct`]). A release
 //! time is shown but not fitted: a relay's release is paced by the decay
 //! of its flux (eddy currents, the coil's own circuit), which this magnet
-//! with an ideal switch does not have.
+//! with an ideal switch does not have. The report says where the fitted
+//! relay's pick-up binds (at rest, or part-way at which position).
 //!
 //! # The solver
 //!
@@ -70,9 +76,14 @@ use thiserror::Error;
 
 use super::sections::{DatasheetSection, FittedParameter, ProvenanceSection};
 use crate::chatter::{ContactState, Interval};
+use crate::coil::pick_up::{LoadLine, PickUp, drop_out, pick_up};
 use crate::coil::{Coil, Source, simulate_direct};
 use crate::mechanics::{Mechanics, simulate};
 use crate::scenario::{Scenario, ScenarioError};
+
+#[path = "fit_start.rs"]
+mod start;
+use start::closed_form_start;
 
 /// s: residuals of event times are divided by this before they are
 /// squared, so that they weigh like relative datasheet misfits.
@@ -325,6 +336,11 @@ pub struct FigureRow {
     pub residual: Option<f64>,
     /// This figure limits the fit: the largest relative misfit.
     pub binds: bool,
+    /// m, for `pick_up_voltage`: where along the travel the model's pull
+    /// only just beats the load (0 at rest); for `drop_out_voltage`: the
+    /// closed position the pull must hold. Absent for the times.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub position: Option<f64>,
 }
 
 /// The result of [`fit`].
@@ -348,7 +364,12 @@ pub struct FitReport {
     pub evaluations: usize,
     /// s, wall clock.
     pub elapsed: f64,
-    /// What the fit decided on its own (held keys, a dropped edge).
+    /// Where the fitted relay's pick-up binds, in words (`at rest (x = 0)`
+    /// or `part-way, at x = … mm of the … mm travel`); `None` unless the
+    /// datasheet gives a pick-up voltage.
+    pub pick_up_binds: Option<String>,
+    /// What the fit decided on its own (held keys, a dropped edge), and
+    /// where the pick-up binds.
     pub notes: Vec<String>,
     /// The scenario with the fitted values and its `[provenance]`.
     #[serde(skip)]
@@ -366,6 +387,7 @@ impl FitReport {
             fitted_to: self.fitted_to.clone(),
             rms_residual: self.rms_residual,
             time_offset: self.time_offset,
+            pick_up_binds: self.pick_up_binds.clone(),
             parameters: self
                 .parameters
                 .iter()
@@ -468,6 +490,7 @@ pub fn datasheet_figures(s: &Scenario, d: &DatasheetSection) -> Vec<(&'static st
     };
     let coil = Coil::from(section);
     let m = mechanics_of(s);
+    let line = LoadLine::of_mechanics(&m);
     let wants = |f: Option<f64>| f.is_some();
     let closing = match d.coil_voltage {
         Some(v) if wants(d.operate_time) || wants(d.bounce_time) => simulate_direct(
@@ -488,13 +511,8 @@ pub fn datasheet_figures(s: &Scenario, d: &DatasheetSection) -> Vec<(&'static st
     let mut out = Vec::new();
     for (name, _) in figures(d) {
         let value = match name {
-            "pick_up_voltage" => {
-                Some(coil.resistance * (2.0 * m.preload / coil.d_inductance(0.0)).sqrt())
-            }
-            "drop_out_voltage" => Some(
-                coil.resistance
-                    * (2.0 * (m.stiffness * m.gap + m.preload) / coil.d_inductance(m.gap)).sqrt(),
-            ),
+            "pick_up_voltage" => Some(pick_up(&coil, &line).voltage),
+            "drop_out_voltage" => Some(drop_out(&coil, &line).voltage),
             "operate_time" => operate,
             "bounce_time" => operate.zip(settle).map(|(a, b)| b - a),
             // Not modelled: a relay's release time is set by the decay of
@@ -506,6 +524,14 @@ pub fn datasheet_figures(s: &Scenario, d: &DatasheetSection) -> Vec<(&'static st
         out.push((name, value));
     }
     out
+}
+
+/// The pick-up of scenario `s` over its whole load line, with that line;
+/// `None` without a coil.
+pub fn pick_up_of(s: &Scenario) -> Option<(PickUp, LoadLine)> {
+    let coil = Coil::from(s.coil.as_ref()?);
+    let line = LoadLine::of_mechanics(&mechanics_of(s));
+    Some((pick_up(&coil, &line), line))
 }
 
 /// The fitting problem: the prior scenario, the free keys in log form,
@@ -702,37 +728,6 @@ impl Problem<'_> {
         }
         (u, cost)
     }
-}
-
-/// The prior, with the preload and the spring stiffness (when free)
-/// solved in closed form from the pick-up and drop-out voltages:
-/// `p = ½ (V_pu/R)² L'(0)` and `s = (½ (V_do/R)² L'(g) − p)/g`. The
-/// solver starts there: those two figures pin them exactly, and the rest
-/// of the fit (the times) starts from a point that already meets them.
-fn closed_form_start(problem: &Problem, u_prior: &[f64]) -> Vec<f64> {
-    let mut u = u_prior.to_vec();
-    let (Some(d), Some(s)) = (&problem.datasheet, problem.scenario_at(u_prior)) else {
-        return u;
-    };
-    let Some(c) = &s.coil else {
-        return u;
-    };
-    let coil = Coil::from(c);
-    let key = |name: &str| problem.keys.iter().position(|k| k == name);
-    let mut preload = s.mechanics.preload;
-    if let (Some(v), Some(k)) = (d.pick_up_voltage, key("mechanics.preload")) {
-        preload = 0.5 * (v / coil.resistance).powi(2) * coil.d_inductance(0.0);
-        u[k] = preload.ln();
-    }
-    if let (Some(v), Some(k)) = (d.drop_out_voltage, key("mechanics.stiffness")) {
-        let g = s.mechanics.gap;
-        let spring = (0.5 * (v / coil.resistance).powi(2) * coil.d_inductance(g) - preload) / g;
-        if spring > 0.0 {
-            u[k] = spring.ln();
-        }
-    }
-    problem.clamp(&mut u);
-    u
 }
 
 /// Halton point `i` (from 1) in base `b`: a deterministic, even spread.
@@ -1117,7 +1112,9 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
         });
     }
     let mut datasheet_rows = Vec::new();
+    let mut pick_up_binds = None;
     if let (Some(d), Some(e)) = (&problem.datasheet, &evaluation) {
+        let pick = pick_up_of(&fitted);
         for ((figure, target), (_, model)) in figures(d).into_iter().zip(&e.figures) {
             datasheet_rows.push(FigureRow {
                 figure,
@@ -1125,7 +1122,26 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
                 model: *model,
                 residual: model.map(|m| (m - target) / target),
                 binds: false,
+                position: pick.and_then(|(pu, line)| match figure {
+                    "pick_up_voltage" => Some(pu.binding_position),
+                    "drop_out_voltage" => Some(line.closed_position()),
+                    _ => None,
+                }),
             });
+        }
+        if let (Some(_), Some(c), Some((pu, line))) = (d.pick_up_voltage, &fitted.coil, pick) {
+            let text = pu.binding_text(&line);
+            notes.push(if pu.at_rest() {
+                format!("the pick-up binds {text}: the pull at rest against the preload")
+            } else {
+                let coil = Coil::from(c);
+                let lift = coil.resistance * (2.0 * line.preload / coil.d_inductance(0.0)).sqrt();
+                format!(
+                    "the pick-up binds {text}: the armature lifts off at {lift:.4} V but stalls there below {:.4} V",
+                    pu.voltage
+                )
+            });
+            pick_up_binds = Some(text);
         }
         let worst = datasheet_rows
             .iter()
@@ -1168,6 +1184,7 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
         rms_residual,
         evaluations: problem.evaluations.get(),
         elapsed: started.elapsed().as_secs_f64(),
+        pick_up_binds,
         notes,
         fitted: scenario.clone(),
         fitted_to: fitted_to.join(" + "),

@@ -7,7 +7,9 @@
 //! mass, travel or magnet geometry. Those are generic assumptions of each
 //! part's prior (`parts/priors/`), and the fit moves the preload, the
 //! spring stiffness and (when an operate time is printed) the mass until
-//! the figures are met. The parts are regenerated with
+//! the figures are met. The pick-up is computed over the armature's whole
+//! load line ([`crate::coil::pick_up`]), and each part's `[provenance]`
+//! says where it binds. The parts are regenerated with
 //! `scripts/fit-parts`.
 
 use std::path::Path;
@@ -15,7 +17,7 @@ use std::path::Path;
 use serde::Serialize;
 use thiserror::Error;
 
-use super::fit::datasheet_figures;
+use super::fit::{datasheet_figures, pick_up_of};
 use crate::scenario::{Scenario, ScenarioError};
 
 /// No bundled part of that name.
@@ -156,6 +158,9 @@ pub struct Listing {
     pub source: &'static str,
     /// As [`Part::remark`].
     pub remark: &'static str,
+    /// Where the part's pick-up binds along the armature's travel (at rest,
+    /// or part-way at which position), computed from its scenario.
+    pub pick_up_binds: Option<String>,
 }
 
 const FIGURES: [&str; 7] = [
@@ -214,6 +219,7 @@ pub fn listing(part: &Part) -> Listing {
         contact_rating: part.contact_rating,
         source: part.source,
         remark: part.remark,
+        pick_up_binds: pick_up_of(&scenario).map(|(pu, line)| pu.binding_text(&line)),
     }
 }
 
@@ -241,6 +247,9 @@ pub fn table() -> String {
                 Figure::NotGiven(t) => (*t).to_owned(),
             };
             let _ = writeln!(out, "  {name:<17} {text}");
+        }
+        if let Some(binds) = &l.pick_up_binds {
+            let _ = writeln!(out, "  pick-up binds     {binds}");
         }
         let _ = writeln!(out, "  contacts          {}", l.contact_rating);
         let _ = writeln!(out, "  source            {}", l.source);

@@ -38,11 +38,13 @@
 //!   ngspice passes; the passes themselves (the waveform relaxation that
 //!   feeds the mechanics `F_m(i(t), x)`) are run by the pipeline, which
 //!   owns the circuit simulator.
+//! - [`pick_up`]: pick-up and drop-out against the armature's load line.
 //! - [`samples`]: the sampled records those passes exchange.
 //! - [`timing`]: each operation's times as datasheets define them.
 
 pub mod accelerate;
 pub mod direct;
+pub mod pick_up;
 pub mod samples;
 pub mod timing;
 

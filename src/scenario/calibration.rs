@@ -62,6 +62,11 @@ pub struct ProvenanceSection {
     /// s, where the record's time zero fell in model time (capture fits).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub time_offset: Option<f64>,
+    /// Where the fitted relay's pick-up binds along the armature's travel
+    /// (`at rest (x = 0)`, or `part-way, at x = … mm of the … mm travel`),
+    /// when the fit was given a pick-up voltage.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pick_up_binds: Option<String>,
     /// Per free key: its prior, fitted value, 1σ and whether the evidence
     /// determined it.
     #[serde(default)]

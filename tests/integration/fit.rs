@@ -212,7 +212,7 @@ t_end = 0.008
 
 [datasheet]
 coil_voltage = 5.0
-pick_up_voltage = 1.35296
+pick_up_voltage = 1.54603
 drop_out_voltage = 0.89285
 operate_time = 3.8137e-3
 bounce_time = 2.0589e-3
@@ -243,6 +243,41 @@ fn a_datasheet_fit_of_the_reference_relay_recovers_preload_and_spring() {
         assert!(((model - row.target) / row.target).abs() < tol, "{row:?}");
     }
     assert_eq!(report.datasheet.iter().filter(|r| r.binds).count(), 1);
+    // The pick-up is set part-way along the travel, where the spring has
+    // outgrown the pull, and the report says so.
+    let pick = report
+        .datasheet
+        .iter()
+        .find(|r| r.figure == "pick_up_voltage")
+        .unwrap();
+    let x = pick.position.expect("a binding position");
+    assert!((x - 0.4e-3 / 3.0).abs() < 2e-6, "{pick:?}");
+    let binds = report.pick_up_binds.as_deref().expect("where it binds");
+    assert!(binds.starts_with("part-way, at x = 0.13"), "{binds}");
+    assert!(
+        report
+            .notes
+            .iter()
+            .any(|n| n.contains("the pick-up binds part-way")),
+        "{:?}",
+        report.notes
+    );
+}
+
+#[test]
+fn a_datasheet_fit_from_below_the_truth_recovers_preload_and_spring() {
+    // The prior low in both keys (the rest rule would have put the preload
+    // at 0.131 N, above the truth): the fit must climb to both.
+    let prior = scenario(&off(
+        REFERENCE,
+        &[
+            ("preload = 0.1", "preload = 0.06"),
+            ("stiffness = 800.0", "stiffness = 520.0"),
+        ],
+    ));
+    let report = fit(&prior, &FitRequest::default()).expect("fit runs");
+    assert_recovered(&report, "mechanics.preload", 0.1, 0.01);
+    assert_recovered(&report, "mechanics.stiffness", 800.0, 0.01);
 }
 
 #[test]
@@ -264,6 +299,8 @@ fn the_fitted_scenario_reads_back_with_its_provenance() {
     let fitted = &p.parameters["mechanics.preload"];
     assert_eq!(fitted.value, back.mechanics.preload);
     assert!((fitted.value - 0.1).abs() < 1e-3, "{fitted:?}");
+    let binds = p.pick_up_binds.as_deref().expect("where the pick-up binds");
+    assert!(binds.contains("part-way"), "{binds}");
     let _ = events_of(&[]);
 }
 

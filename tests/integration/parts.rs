@@ -3,7 +3,7 @@
 //! scenario that loads back.
 
 use assert_cmd::Command;
-use chatterspice::calibrate::fit::datasheet_figures;
+use chatterspice::calibrate::fit::{datasheet_figures, pick_up_of};
 use chatterspice::calibrate::parts;
 use chatterspice::scenario::Scenario;
 
@@ -38,6 +38,17 @@ fn there_are_six_parts_and_each_meets_its_datasheet() {
             checked += 1;
         }
         assert!(checked >= 2, "{}: nothing checked", part.name);
+        // The provenance says where the pick-up binds, as the scenario's
+        // own load line has it.
+        let (pu, line) = pick_up_of(&scenario).expect("a coil");
+        assert_eq!(
+            provenance.pick_up_binds.as_deref(),
+            Some(pu.binding_text(&line).as_str()),
+            "{}",
+            part.name
+        );
+        let listed = parts::listing(part);
+        assert_eq!(listed.pick_up_binds, provenance.pick_up_binds);
         // The fit moved the free keys away from the priors it started from.
         for (key, p) in &provenance.parameters {
             assert_eq!(
