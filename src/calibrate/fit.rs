@@ -76,8 +76,9 @@ use thiserror::Error;
 
 use super::sections::{DatasheetSection, FittedParameter, ProvenanceSection};
 use crate::chatter::{ContactState, Interval};
+use crate::coil::direct::direct_closing;
 use crate::coil::pick_up::{LoadLine, PickUp, drop_out, pick_up};
-use crate::coil::{Coil, Source, simulate_direct};
+use crate::coil::{Coil, Source};
 use crate::mechanics::{Mechanics, simulate};
 use crate::scenario::{Scenario, ScenarioError};
 
@@ -460,23 +461,32 @@ fn mechanics_of(s: &Scenario) -> Mechanics {
 pub fn model_events(s: &Scenario, voltage: Option<f64>) -> Result<Vec<Event>, String> {
     let chatter = match (&s.coil, voltage) {
         (Some(c), Some(v)) => {
-            simulate_direct(
+            direct_closing(
                 &Coil::from(c),
                 &Source {
                     voltage: v,
                     series_resistance: 0.0,
                 },
                 &mechanics_of(s),
+                &s.two_stage(),
                 &s.surface(),
                 &s.settings(),
             )
             .map_err(|e| e.to_string())?
-            .chatter
+            .0
         }
         (Some(_), None) => return Err("a coil-driven relay needs [datasheet] coil_voltage".into()),
-        (None, _) => {
+        (None, _) if s.two_stage().is_one_mass() => {
             simulate(&mechanics_of(s), &s.surface(), &s.settings()).map_err(|e| e.to_string())?
         }
+        (None, _) => crate::mechanics::two_stage::step_closing(
+            &mechanics_of(s),
+            &s.two_stage(),
+            &s.surface(),
+            &s.settings(),
+        )
+        .map_err(|e| e.to_string())?
+        .into_chatter(),
     };
     Ok(events_of(&chatter.intervals))
 }
@@ -490,24 +500,27 @@ pub fn datasheet_figures(s: &Scenario, d: &DatasheetSection) -> Vec<(&'static st
     };
     let coil = Coil::from(section);
     let m = mechanics_of(s);
-    let line = LoadLine::of_mechanics(&m);
+    let build = s.two_stage();
+    let line = LoadLine::of_relay(&m, &build);
     let wants = |f: Option<f64>| f.is_some();
     let closing = match d.coil_voltage {
-        Some(v) if wants(d.operate_time) || wants(d.bounce_time) => simulate_direct(
+        Some(v) if wants(d.operate_time) || wants(d.bounce_time) => direct_closing(
             &coil,
             &Source {
                 voltage: v,
                 series_resistance: 0.0,
             },
             &m,
+            &build,
             &s.surface(),
             &s.settings(),
         )
-        .ok(),
+        .ok()
+        .map(|(chatter, _)| chatter),
         _ => None,
     };
-    let operate = closing.as_ref().and_then(|r| r.events.first_make);
-    let settle = closing.as_ref().and_then(|r| r.events.settle_time);
+    let operate = closing.as_ref().and_then(|c| c.first_impact);
+    let settle = closing.as_ref().and_then(|c| c.settle_time);
     let mut out = Vec::new();
     for (name, _) in figures(d) {
         let value = match name {
@@ -530,7 +543,7 @@ pub fn datasheet_figures(s: &Scenario, d: &DatasheetSection) -> Vec<(&'static st
 /// `None` without a coil.
 pub fn pick_up_of(s: &Scenario) -> Option<(PickUp, LoadLine)> {
     let coil = Coil::from(s.coil.as_ref()?);
-    let line = LoadLine::of_mechanics(&mechanics_of(s));
+    let line = LoadLine::of_relay(&mechanics_of(s), &s.two_stage());
     Some((pick_up(&coil, &line), line))
 }
 

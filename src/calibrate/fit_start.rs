@@ -21,7 +21,7 @@ pub(super) fn closed_form_start(problem: &Problem, u_prior: &[f64]) -> Vec<f64> 
     let coil = Coil::from(c);
     let key = |name: &str| problem.keys.iter().position(|k| k == name);
     let (kp, ks) = (key("mechanics.preload"), key("mechanics.stiffness"));
-    let line = LoadLine::of_mechanics(&mechanics_of(&s));
+    let line = LoadLine::of_relay(&mechanics_of(&s), &s.two_stage());
     let solved = solve_spring(
         &coil,
         &line,

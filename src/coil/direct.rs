@@ -223,6 +223,59 @@ pub fn simulate_direct(
     })
 }
 
+/// The closing of the relay as built (`build`: blade, pole face,
+/// release rules) when `coil` is switched onto `source` at t = 0, as
+/// [`simulate_direct`] does for the one-mass model (and for it, exactly
+/// that): the contact's chatter, with the two-stage record when there is
+/// one.
+pub fn direct_closing(
+    coil: &Coil,
+    source: &Source,
+    mechanics: &Mechanics,
+    build: &crate::mechanics::two_stage::TwoStage,
+    surface: &Surface,
+    settings: &Settings,
+) -> Result<(Chatter, Option<crate::mechanics::two_stage::TwoStageRun>), CoilError> {
+    use crate::mechanics::two_stage::engine::{Model, run};
+    if build.is_one_mass() {
+        return Ok((
+            simulate_direct(coil, source, mechanics, surface, settings)?.chatter,
+            None,
+        ));
+    }
+    let m = Mechanics {
+        force: 0.0,
+        initial_position: 0.0,
+        initial_velocity: 0.0,
+        ..*mechanics
+    };
+    crate::mechanics::two_stage::validate_all(&m, build, surface, settings)?;
+    coil.validate(m.gap)?;
+    if !source.voltage.is_finite() {
+        return Err(CoilError::InvalidParameter {
+            name: "source.voltage",
+            value: source.voltage,
+            requirement: "a finite step voltage in V",
+        });
+    }
+    let drive = CoilDrive::new(coil, source, m.gap);
+    let model = Model {
+        m: &m,
+        build,
+        contact: *surface,
+        back: None,
+        rest: true,
+        drive: &drive,
+    };
+    let out = run(
+        &model,
+        settings,
+        0.0,
+        crate::mechanics::two_stage::Horizon::Closing,
+    )?;
+    Ok((out.contact.clone(), Some(out)))
+}
+
 /// The coil on its ideal source, in the flux.
 struct CoilDrive {
     coil: Coil,

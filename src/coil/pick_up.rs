@@ -100,6 +100,19 @@ impl LoadLine {
         }
     }
 
+    /// The load line of a relay as built: its armature's mechanics and,
+    /// with a contact blade, the blade's stiffness from the make on (to
+    /// the pole face, when there is one).
+    pub fn of_relay(m: &Mechanics, build: &crate::mechanics::two_stage::TwoStage) -> LoadLine {
+        LoadLine {
+            blade: build.blade.map(|b| BladeLoad {
+                stiffness: b.stiffness,
+                overtravel: build.pole_face.map(|p| p.overtravel),
+            }),
+            ..LoadLine::of_mechanics(m)
+        }
+    }
+
     /// N, the load at position `x` (m): `p + s·x`, plus `s_b·(x − g)` past
     /// the contact position when a blade with a pole face is deflected.
     pub fn load(&self, x: f64) -> f64 {

@@ -453,3 +453,99 @@ fn a_record_that_missed_one_bounce_still_fits() {
         report.notes
     );
 }
+
+/// The reference relay with a contact blade stiff enough that its step in
+/// the load line, not the return spring, sets the pick-up.
+const BLADED: &str = r#"
+[mechanics]
+mass = 2.0e-4
+stiffness = 800.0
+damping = 0.04
+preload = 0.1
+gap = 4.5e-4
+
+[blade]
+mass = 3.0e-5
+stiffness = 60000.0
+damping = 0.01
+
+[pole_face]
+overtravel = 1.0e-4
+law = "kelvin-voigt"
+stiffness = 1.0e6
+damping = 5.0
+
+[coil]
+resistance = 70.0
+turns = 3000
+pole_area = 2.0e-5
+air_gap = 6.0e-4
+iron_gap = 5.0e-5
+
+[surface]
+law = "kelvin-voigt"
+stiffness = 8.0e4
+damping = 0.37536
+
+[simulation]
+t_end = 0.008
+
+[fit]
+free = ["mechanics.preload", "mechanics.stiffness"]
+"#;
+
+/// V, the pick-up and drop-out of `BLADED` with preload `p` and spring
+/// `s`, by brute force: the largest holding voltage over a fine grid of
+/// the travel (to the pole face), and the one at the pole face.
+fn bladed_voltages(p: f64, s: f64) -> (f64, f64, f64) {
+    let mu0 = 1.256_637_062_12e-6;
+    let k = mu0 * 3000.0 * 3000.0 * 2.0e-5;
+    let (a, g, o, sb, r) = (6.5e-4, 4.5e-4, 1.0e-4, 60000.0, 70.0);
+    let load = |x: f64| p + s * x + if x > g { sb * (x - g) } else { 0.0 };
+    let volts = |x: f64| r * (2.0 * load(x) * (a - x) * (a - x) / k).sqrt();
+    let n = 200_000;
+    let (mut best, mut at) = (0.0, 0.0);
+    for i in 0..=n {
+        let x = (g + o) * i as f64 / n as f64;
+        if volts(x) > best {
+            (best, at) = (volts(x), x);
+        }
+    }
+    (best, volts(g + o), at)
+}
+
+#[test]
+fn a_datasheet_fit_recovers_the_preload_where_the_blade_binds_the_load_line() {
+    let (pick_up, drop_out, at) = bladed_voltages(0.1, 800.0);
+    // The blade's step binds: the largest holding voltage lies past the make.
+    assert!(at > 4.5e-4, "binding at {at:e} m");
+    let truth = format!(
+        "{BLADED}\n[datasheet]\ncoil_voltage = 5.0\npick_up_voltage = {pick_up:e}\n\
+         drop_out_voltage = {drop_out:e}\n"
+    );
+    let prior = scenario(&off(
+        &truth,
+        &[
+            ("preload = 0.1", "preload = 0.16"),
+            ("stiffness = 800.0", "stiffness = 500.0"),
+        ],
+    ));
+    let report = fit(&prior, &FitRequest::default()).expect("fit runs");
+    assert_recovered(&report, "mechanics.preload", 0.1, 0.01);
+    assert_recovered(&report, "mechanics.stiffness", 800.0, 0.01);
+    // The rule that ignores the blade would need another preload: the
+    // at-rest and spring-only pick-ups of the truth both differ.
+    let (spring_only, _, _) = {
+        let mu0 = 1.256_637_062_12e-6;
+        let k = mu0 * 3000.0 * 3000.0 * 2.0e-5;
+        let v = |x: f64| 70.0 * (2.0 * (0.1 + 800.0 * x) * (6.5e-4 - x).powi(2) / k).sqrt();
+        let best = (0..=1000)
+            .map(|i| v(4.5e-4 * i as f64 / 1000.0))
+            .fold(0.0, f64::max);
+        (best, 0.0, 0.0)
+    };
+    assert!(
+        (pick_up - spring_only) / pick_up > 0.01,
+        "{pick_up} vs {spring_only}"
+    );
+}

@@ -31,7 +31,7 @@
 //! (`ends_open`).
 
 pub(crate) mod energy;
-pub(crate) mod engine;
+pub mod engine;
 
 use super::cycle::Stroke;
 use super::{DriveError, Mechanics, MechanicsError, Surface};
