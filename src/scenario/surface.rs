@@ -108,6 +108,15 @@ impl Check<'_> {
                          driver) or remove [back_stop]",
             });
         }
+        if s.release.is_some() {
+            return Err(ScenarioError::Conflict {
+                at: self.at("back_stop.release"),
+                key: "back_stop.release".to_owned(),
+                other: "back_stop.law".to_owned(),
+                advice: "the rest stop lets go of the armature by position (back at the stop, \
+                         moving away); remove the key",
+            });
+        }
         self.surface("back_stop", s).map(Some)
     }
 
