@@ -12,6 +12,7 @@ use std::hint::black_box;
 use chatterspice::coil::simulate_forced;
 use chatterspice::mechanics::cycle::Stops;
 use chatterspice::mechanics::surface::hunt_crossley_chi;
+use chatterspice::mechanics::two_stage::{Blade, Horizon, Release, TwoStage, simulate_two_stage};
 use chatterspice::mechanics::{Drive, simulate_drive};
 use chatterspice::{Mechanics, Settings, Surface, simulate};
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -74,6 +75,42 @@ fn bench(c: &mut Criterion) {
     assert_eq!((r.impacts.len(), r.outcome.as_str()), (11, "stuck"));
     c.bench_function("hunt_crossley_sequence", |b| {
         b.iter(|| simulate(black_box(&m), black_box(&s), black_box(&st)).unwrap())
+    });
+
+    // The reference armature carrying a blade of a fifth of its mass, as
+    // stiff as the contact (s_b = 100 s, r_b = 1): also 18 contacts, by
+    // the two-stage engine.
+    let (m, s, st) = reference();
+    let stops = Stops {
+        make: s,
+        back: None,
+    };
+    let relay = TwoStage {
+        blade: Some(Blade {
+            mass: 0.2,
+            stiffness: 100.0,
+            damping: 1.0,
+        }),
+        pole_face: None,
+        release: Release::Position,
+    };
+    let run = simulate_two_stage(&m, &relay, &stops, &st, Drive::Step, Horizon::Closing).unwrap();
+    assert_eq!(
+        (run.contact.impacts.len(), run.contact.outcome.as_str()),
+        (18, "stuck")
+    );
+    c.bench_function("two_stage_18_contacts", |b| {
+        b.iter(|| {
+            simulate_two_stage(
+                black_box(&m),
+                &relay,
+                &stops,
+                &st,
+                Drive::Step,
+                Horizon::Closing,
+            )
+            .unwrap()
+        })
     });
 
     let (m, s, st) = reference();
