@@ -363,6 +363,9 @@ fn csv_prints_an_f32_as_the_shortest_text_of_its_exact_double() {
         "{}",
         rows[2]
     );
+    // The same with a UTF-8 header (which the streaming CSV writer, for
+    // ngspice's files, leaves to the reader too).
+    assert_eq!(raw_stdout(&[&path("tran_utf8.raw")]), csv);
     // Every cell reads back to the reader's value.
     let raw = read("tran.raw");
     let vout = real(&raw.plots[0], "V(out)");
@@ -586,13 +589,18 @@ fn an_all_zero_point_after_the_declared_ones_is_left_with_a_warning() {
 }
 
 #[test]
-fn two_plots_in_one_file_are_both_read() {
-    let mut bytes = std::fs::read(data("op.raw")).unwrap();
-    bytes.extend(std::fs::read(data("tran.raw")).unwrap());
+fn plots_one_after_the_other_in_one_file_are_all_read() {
+    let mut bytes = Vec::new();
+    for f in ["op.raw", "tran_ascii.raw", "tran.raw", "ac_ascii_utf8.raw"] {
+        bytes.extend(std::fs::read(data(f)).unwrap());
+    }
     let raw = RawFile::parse(&bytes).unwrap();
-    assert_eq!(raw.plots.len(), 2);
+    assert!(raw.warnings.is_empty(), "{:?}", raw.warnings);
+    assert_eq!(raw.plots.len(), 4);
     assert_eq!(raw.plots[0].name, "Operating Point");
-    check_tran(&raw.plots[1], &TRAN_NAMES, exact, single);
+    check_tran(&raw.plots[1], &TRAN_NAMES, ascii, ascii);
+    check_tran(&raw.plots[2], &TRAN_NAMES, exact, single);
+    check_ac(&raw.plots[3], &ac_rows(12, 1000.0), ascii);
 }
 
 const FILES: [&str; 13] = [
