@@ -124,10 +124,20 @@ struct PlotSummary<'a> {
     title: &'a str,
     date: &'a str,
     commands: &'a [String],
+    dialect: &'static str,
+    encoding: &'static str,
+    step: Option<StepSummary>,
     flags: FlagsSummary<'a>,
     points: usize,
     declared_points: usize,
     variables: Vec<VariableSummary<'a>>,
+}
+
+#[derive(Serialize)]
+struct StepSummary {
+    index: usize,
+    count: usize,
+    first_point: usize,
 }
 
 #[derive(Serialize)]
@@ -148,8 +158,11 @@ struct VariableSummary<'a> {
     attributes: &'a [String],
 }
 
-/// A pretty-printed JSON summary of every plot: name, flags, variables and
-/// point counts, plus the reader's warnings. Ends with a newline.
+/// A pretty-printed JSON summary of every plot: name, dialect (`ngspice`,
+/// `ltspice`), encoding (`utf-8`, `utf-16le`), step (`null`, or `index`,
+/// `count` and `first_point` for one step of a stepped plot), flags,
+/// variables and point counts, plus the reader's warnings. Ends with a
+/// newline.
 pub fn summary_json(raw: &RawFile) -> String {
     let plots = raw
         .plots
@@ -161,6 +174,13 @@ pub fn summary_json(raw: &RawFile) -> String {
             title: &p.title,
             date: &p.date,
             commands: &p.commands,
+            dialect: p.dialect.as_str(),
+            encoding: p.encoding.as_str(),
+            step: p.step.map(|s| StepSummary {
+                index: s.index,
+                count: s.count,
+                first_point: s.first_point,
+            }),
             flags: FlagsSummary {
                 complex: p.flags.complex,
                 padded: p.flags.padded,

@@ -59,27 +59,6 @@ impl<'a> Cursor<'a> {
     }
 }
 
-pub(super) fn detect_utf16(bytes: &[u8]) -> Result<(), RawError> {
-    let at = Position {
-        line: Some(1),
-        offset: 0,
-    };
-    if bytes.starts_with(&[0xff, 0xfe]) || bytes.starts_with(&[0xfe, 0xff]) {
-        return Err(RawError::Ltspice {
-            what: "UTF-16 byte order mark",
-            at,
-        });
-    }
-    // LTspice writes its header as UTF-16LE without a BOM: "T\0i\0t\0...".
-    if bytes.len() >= 4 && bytes[0] != 0 && bytes[1] == 0 && bytes[3] == 0 {
-        return Err(RawError::Ltspice {
-            what: "UTF-16 text header",
-            at,
-        });
-    }
-    Ok(())
-}
-
 // ---------------------------------------------------------------------------
 // Header
 
@@ -142,7 +121,9 @@ pub(super) fn parse_header(
     let mut other = Vec::new();
     let mut dimensions = None;
     let mut variables: Option<Vec<Variable>> = None;
-    let mut ltspice = false;
+    // Header lines only LTspice writes.
+    let mut ltspice_lines = false;
+    let mut command_names_ltspice = false;
 
     loop {
         let at = cur.at();
@@ -170,7 +151,7 @@ pub(super) fn parse_header(
         } else if let Some(v) = field(line, "Dimensions:") {
             dimensions = Some(text(v));
         } else if let Some(v) = field(line, "Command:") {
-            ltspice |= v.windows(7).any(|w| w.eq_ignore_ascii_case(b"ltspice"));
+            command_names_ltspice |= v.windows(7).any(|w| w.eq_ignore_ascii_case(b"ltspice"));
             commands.push(text(v));
         } else if let Some(v) = field(line, "Option:") {
             options.push(text(v));
@@ -196,30 +177,14 @@ pub(super) fn parse_header(
                 padded: true,
                 other: Vec::new(),
             });
-            if ltspice
-                || flags
-                    .other
-                    .iter()
-                    .any(|f| f.eq_ignore_ascii_case("fastaccess"))
-            {
-                let double = flags.other.iter().any(|f| f.eq_ignore_ascii_case("double"));
-                if data == DataKind::Binary && !(double || flags.complex) {
-                    return Err(RawError::Ltspice {
-                        what: "binary data with 32-bit float values",
-                        at,
-                    });
-                }
-                if flags
-                    .other
-                    .iter()
-                    .any(|f| f.eq_ignore_ascii_case("fastaccess"))
-                {
-                    return Err(RawError::Ltspice {
-                        what: "FastAccess (vector-major) layout",
-                        at,
-                    });
-                }
-            }
+            let ltspice_flags = ["forward", "stepped", "fastaccess", "double"]
+                .iter()
+                .any(|f| flags.has(f));
+            let dialect = if command_names_ltspice || ltspice_lines || ltspice_flags {
+                Dialect::Ltspice
+            } else {
+                Dialect::Ngspice
+            };
             let npoints = npoints.ok_or(RawError::MissingHeader {
                 at,
                 field: "No. Points:",
@@ -250,6 +215,9 @@ pub(super) fn parse_header(
                     flags,
                     variables,
                     declared_points: npoints,
+                    dialect,
+                    encoding: Encoding::Utf8,
+                    step: None,
                     columns: Vec::new(),
                 },
                 nvars,
@@ -257,6 +225,8 @@ pub(super) fn parse_header(
                 data,
             });
         } else if looks_like_header_line(line) {
+            ltspice_lines |=
+                field(line, "Offset:").is_some() || field(line, "Backannotation:").is_some();
             other.push(text(line));
         } else {
             return Err(RawError::UnexpectedLine {

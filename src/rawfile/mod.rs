@@ -1,4 +1,5 @@
-//! The SPICE raw file reader: what ngspice hands back after a run.
+//! The SPICE raw file reader: what ngspice (or LTspice) hands back after a
+//! run.
 //!
 //! A raw file is one or more *plots* (one per analysis: `.op`, `.tran`,
 //! `.ac`, ...) concatenated with no separator. Each plot is a text header
@@ -28,18 +29,46 @@
 //!   where the simulator's step exceeds the `.tran` step, which no reader
 //!   can undo: `run` leaves `interp` out of the deck;
 //! - ngspice 39 leaves garbage in the imaginary part of the AC frequency
-//!   axis, so a complex plot's `frequency` scale is stored as real;
-//! - LTspice's dialect (UTF-16 header, `f32` values, `FastAccess` layout) is
-//!   detected and refused with a message saying so, rather than misread.
+//!   axis, so a complex plot's `frequency` scale is stored as real.
+//!
+//! LTspice writes the same structure in a dialect of its own ([`Dialect`]),
+//! read into the same types:
+//! - the header in UTF-16 little-endian, with no byte order mark (one is
+//!   skipped if there); for ASCII data the values too. Names (plots,
+//!   vectors, the title) are kept exactly, beyond ASCII included
+//!   (`Noise Spectral Density - (V/Hz½ or A/Hz½)`). A UTF-8 header is read
+//!   as LTspice's when a `Command:` line names LTspice, or an `Offset:` or
+//!   `Backannotation:` line, or a flag only LTspice writes, says so;
+//! - binary values: the first vector (time, frequency, the swept source,
+//!   an operating point's first value) an `f64`, every other an `f32`
+//!   (stored as the `f64` it converts to exactly), unless `Flags:` says
+//!   `double` (all `f64`); complex plots store every value, the frequency
+//!   included, as an `(re, im)` pair of `f64`. Points follow one another,
+//!   or with `Flags: ... fastaccess` each vector's values are contiguous;
+//! - time stamps with their sign bit set (LTspice's waveform compression
+//!   leaves some negative) are read as their absolute value;
+//! - `.step` runs (`Flags: ... stepped`) are one plot holding every step:
+//!   the reader splits it into one [`Plot`] per step, with [`Plot::step`]
+//!   saying which (see [`Step`] for how steps are told apart);
+//! - `Offset:`, `Backannotation:`, `Output:` and other `Key: value` lines
+//!   are kept verbatim in [`Plot::other_header_lines`];
+//! - bytes after the declared points that are not another plot's header
+//!   (LTspice has been seen to leave an all-zero point there) are left
+//!   unread, with a [`RawWarning::TrailingData`]; a file cut short keeps
+//!   its whole points with a [`RawWarning::Truncated`], but FastAccess
+//!   data cut short are an error ([`RawError::ShortFastAccess`]).
 //!
 //! Malformed input is an error naming the line (text) or byte offset
-//! (binary); the reader never panics and never allocates more than the
-//! input can fill, whatever the header claims. Values are stored once, one
-//! `Vec` per vector, so memory is the size of the data.
+//! (binary; offsets count the file's bytes, in UTF-16 text too); the
+//! reader never panics and never allocates more than the input can fill,
+//! whatever the header claims. Values are stored once, one `Vec` per
+//! vector, so memory is the size of the data (LTspice's `f32` values take
+//! twice their size as `f64`).
 
 mod data;
 pub mod export;
 mod header;
+mod ltspice;
 mod stream;
 #[cfg(test)]
 mod tests;
@@ -91,9 +120,83 @@ pub struct Plot {
     pub flags: Flags,
     /// The vectors, in `Variables:` order; the first is the scale.
     pub variables: Vec<Variable>,
-    /// `No. Points:` as written; 0 for a killed run.
+    /// `No. Points:` as written; 0 for a killed run. For one step of a
+    /// stepped plot, the count of the whole plot (every step).
     pub declared_points: usize,
+    /// Whose layout the values were read in: ngspice's or LTspice's.
+    pub dialect: Dialect,
+    /// How the header's text was encoded.
+    pub encoding: Encoding,
+    /// For one step of an LTspice `.step` run (`Flags: ... stepped`): which
+    /// step. `None` for a plot that is not stepped.
+    pub step: Option<Step>,
     columns: Vec<Column>,
+}
+
+/// The layout of a plot's values, told from its header.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Dialect {
+    /// ngspice's (the SPICE3 layout): every binary value an `f64` (a pair
+    /// of them when complex), one point after the other.
+    #[default]
+    Ngspice,
+    /// LTspice's: in binary, the scale an `f64` and the other vectors `f32`
+    /// unless `Flags:` says `double` (complex plots: every value, the
+    /// frequency included, a pair of `f64`); point after point, or vector
+    /// after vector with `fastaccess`. Told by a UTF-16 header, a
+    /// `Command:` line naming LTspice, an `Offset:` or `Backannotation:`
+    /// line, or a flag only LTspice writes (`forward`, `stepped`,
+    /// `fastaccess`, `double`).
+    Ltspice,
+}
+
+impl Dialect {
+    /// `"ngspice"` or `"ltspice"`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Dialect::Ngspice => "ngspice",
+            Dialect::Ltspice => "ltspice",
+        }
+    }
+}
+
+/// The encoding of a plot's header (and, for ASCII data, of its values).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Encoding {
+    /// UTF-8 (or plain ASCII): what ngspice writes.
+    #[default]
+    Utf8,
+    /// UTF-16 little-endian, with or without a byte order mark: what
+    /// LTspice writes. Binary data after `Binary:` are bytes as usual.
+    Utf16Le,
+}
+
+impl Encoding {
+    /// `"utf-8"` or `"utf-16le"`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Encoding::Utf8 => "utf-8",
+            Encoding::Utf16Le => "utf-16le",
+        }
+    }
+}
+
+/// One step of a stepped plot. LTspice writes every step of a `.step` run
+/// into one plot, one after the other; the reader splits it into one
+/// [`Plot`] per step. Without LTspice's `.log` file the steps are told
+/// apart by the scale: a step starts wherever the scale (time, frequency,
+/// the swept source) comes back to its first value. A plot without a
+/// scale (`Operating Point`, `Transfer Function`, `Integrated Noise`) has
+/// one point a step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Step {
+    /// 0-based, in file order.
+    pub index: usize,
+    /// How many steps the stepped plot holds.
+    pub count: usize,
+    /// Where in the stepped plot (all steps together, 0-based) this step's
+    /// first point is.
+    pub first_point: usize,
 }
 
 /// The `Flags:` line.
@@ -104,8 +207,17 @@ pub struct Flags {
     /// False with `unpadded`: vectors shorter than the plot have no values
     /// written past their end.
     pub padded: bool,
-    /// Flags this reader does not interpret (LTspice's `forward`, `log`...).
+    /// The other flags, as written: LTspice's `forward`, `log`, `linear`,
+    /// `stepped`, `fastaccess`, `double` (see [`Flags::has`]).
     pub other: Vec<String>,
+}
+
+impl Flags {
+    /// Whether `flag` is among [`Flags::other`], ignoring ASCII case
+    /// (`flags.has("stepped")`).
+    pub fn has(&self, flag: &str) -> bool {
+        self.other.iter().any(|f| f.eq_ignore_ascii_case(flag))
+    }
 }
 
 /// One vector's declaration in the `Variables:` section.
@@ -201,6 +313,19 @@ pub enum RawWarning {
         /// Whole points read, more than declared.
         read: usize,
     },
+    /// Bytes after an LTspice plot's declared points that are neither
+    /// another plot's header nor the end of the file (LTspice has been
+    /// seen to leave an all-zero point there). They are not read.
+    TrailingData {
+        /// Index of the plot in the file (the last step of a stepped one).
+        plot: usize,
+        /// `No. Points:` as written.
+        declared: usize,
+        /// Byte offset where the unread bytes start.
+        offset: usize,
+        /// How many bytes are not read.
+        bytes: usize,
+    },
 }
 
 impl fmt::Display for RawWarning {
@@ -216,7 +341,7 @@ impl fmt::Display for RawWarning {
                     write!(
                         f,
                         "plot {plot}: header says 0 points (the run was killed before \
-                         ngspice finished the file); read {read} whole points, data cut at byte {offset}"
+                         the simulator finished the file); read {read} whole points, data cut at byte {offset}"
                     )
                 } else {
                     write!(
@@ -245,7 +370,41 @@ impl fmt::Display for RawWarning {
                 "plot {plot}: header says {declared} points but the data holds {read} whole points \
                  (ngspice writes more than it declares with `.options interp`); all {read} are read"
             ),
+            RawWarning::TrailingData {
+                plot,
+                declared,
+                offset,
+                bytes,
+            } => write!(
+                f,
+                "plot {plot}: {bytes} byte(s) from byte {offset}, after the {declared} points the \
+                 header declares, are not a plot header; they were not read"
+            ),
         }
+    }
+}
+
+impl RawWarning {
+    /// The warning about plot `plot` instead.
+    fn in_plot(mut self, index: usize) -> RawWarning {
+        match &mut self {
+            RawWarning::Truncated { plot, .. }
+            | RawWarning::Restarted { plot, .. }
+            | RawWarning::ExtraPoints { plot, .. }
+            | RawWarning::TrailingData { plot, .. } => *plot = index,
+        }
+        self
+    }
+
+    /// The warning with its byte offset (if any) mapped by `f`.
+    fn map_offset(mut self, f: impl Fn(usize) -> usize) -> RawWarning {
+        match &mut self {
+            RawWarning::Truncated { offset, .. } | RawWarning::TrailingData { offset, .. } => {
+                *offset = f(*offset)
+            }
+            RawWarning::Restarted { .. } | RawWarning::ExtraPoints { .. } => {}
+        }
+        self
     }
 }
 
@@ -314,13 +473,12 @@ pub enum RawError {
     /// The input holds no plot (it is empty or blank).
     #[error("empty raw file: no plot header found")]
     Empty,
-    /// The file is in LTspice's dialect, which this reader refuses.
-    #[error(
-        "this is an LTspice raw file ({what}, at {at}); chatterspice reads ngspice raw files only: \
-         re-run the netlist in ngspice, or export the waveforms from LTspice as text"
-    )]
+    /// A raw file in a form this reader does not read: a UTF-16
+    /// big-endian header (LTspice's own files, UTF-16 little-endian, are
+    /// read).
+    #[error("at {at}: {what}: this reader reads UTF-8 and UTF-16 little-endian raw files")]
     Ltspice {
-        /// What gave it away, e.g. `UTF-16 text header`.
+        /// What gave it away, e.g. `UTF-16 big-endian byte order mark`.
         what: &'static str,
         /// Where.
         at: Position,
@@ -397,6 +555,24 @@ pub enum RawError {
         /// The bytes a value the data's size fits: 8 real, 16 complex.
         bytes: usize,
     },
+    /// LTspice FastAccess data (vector after vector) end before every
+    /// declared point of every vector: the vectors cannot be told apart.
+    #[error(
+        "at {at}: the FastAccess data of {vectors} vectors of {points} points need {expected} \
+         bytes, but the file holds {found} (it was cut short, or `No. Points:` is wrong)"
+    )]
+    ShortFastAccess {
+        /// Where the data start.
+        at: Position,
+        /// `No. Variables:`.
+        vectors: usize,
+        /// `No. Points:`.
+        points: usize,
+        /// Bytes the header's counts need.
+        expected: u64,
+        /// Bytes there are.
+        found: usize,
+    },
     /// A value of ASCII data cannot be read.
     #[error("at {at}: expected {expected}, found {text:?}")]
     BadValue {
@@ -407,6 +583,31 @@ pub enum RawError {
         /// What was found (its first 40 bytes).
         text: String,
     },
+}
+
+impl RawError {
+    /// The error with its position (if any) mapped by `f`: from text
+    /// decoded from UTF-16 back to the input.
+    fn map_position(mut self, f: impl Fn(Position) -> Position) -> RawError {
+        match &mut self {
+            RawError::Ltspice { at, .. }
+            | RawError::UnexpectedLine { at, .. }
+            | RawError::BadCount { at, .. }
+            | RawError::MissingHeader { at, .. }
+            | RawError::NoVariables { at }
+            | RawError::BadVariable { at, .. }
+            | RawError::MissingVariables { at, .. }
+            | RawError::FlagMismatch { at, .. }
+            | RawError::ShortFastAccess { at, .. }
+            | RawError::BadValue { at, .. } => *at = f(*at),
+            RawError::Io { .. }
+            | RawError::InFile { .. }
+            | RawError::NotAFile { .. }
+            | RawError::TooLarge { .. }
+            | RawError::Empty => {}
+        }
+        self
+    }
 }
 
 /// The metadata of `path`, which must be a regular file: a device or a
@@ -464,7 +665,6 @@ impl RawFile {
     /// # Ok::<(), chatterspice::rawfile::RawError>(())
     /// ```
     pub fn parse(bytes: &[u8]) -> Result<RawFile, RawError> {
-        detect_utf16(bytes)?;
         let mut cur = Cursor {
             bytes,
             pos: 0,
@@ -475,18 +675,35 @@ impl RawFile {
         let mut title = String::new();
         let mut date = String::new();
         loop {
-            cur.skip_blank_lines();
+            ltspice::skip_blank(&mut cur);
             if cur.at_end() {
                 break;
             }
-            let header = parse_header(&mut cur, &mut title, &mut date)?;
             let index = plots.len();
-            let (plot, warning) = match header.data {
-                DataKind::Binary => read_binary(&mut cur, header, index)?,
-                DataKind::Ascii => read_ascii(&mut cur, header, index)?,
+            let (mut plot, warning) = match ltspice::utf16_start(cur.rest(), cur.at())? {
+                Some(bom) => ltspice::read_utf16_plot(&mut cur, bom, &mut title, &mut date, index)?,
+                None => {
+                    let header = parse_header(&mut cur, &mut title, &mut date)?;
+                    match (header.data, header.plot.dialect) {
+                        (DataKind::Binary, Dialect::Ngspice) => {
+                            read_binary(&mut cur, header, index)?
+                        }
+                        (DataKind::Binary, Dialect::Ltspice) => {
+                            ltspice::read_binary(&mut cur, header, index)?
+                        }
+                        (DataKind::Ascii, _) => read_ascii(&mut cur, header, index)?,
+                    }
+                }
             };
-            plots.push(plot);
-            warnings.extend(warning);
+            if plot.dialect == Dialect::Ltspice {
+                ltspice::unsign_time(&mut plot);
+            }
+            let steps = ltspice::split_steps(plot);
+            // A stepped plot's warnings are about where its data end: in
+            // its last step.
+            let last = index + steps.len().saturating_sub(1);
+            warnings.extend(warning.into_iter().map(|w| w.in_plot(last)));
+            plots.extend(steps);
         }
         if plots.is_empty() {
             return Err(RawError::Empty);

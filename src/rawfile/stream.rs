@@ -6,8 +6,9 @@
 //! padded plots whose data end where `No. Points:` says (at the end of the
 //! file or at the next plot's header), or a killed run's last plot cut
 //! anywhere. Anything else (ASCII, unpadded vectors, the irregular data of
-//! `.options interp`) returns `None`, and the caller reads the file whole
-//! with [`super::RawFile::read`], which copes with all of them.
+//! `.options interp`, LTspice's files) returns `None`, and the caller
+//! reads the file whole with [`super::RawFile::read`], which copes with
+//! all of them.
 //!
 //! Numbers are written by [`zmij`]: the shortest digits that read back to
 //! the identical `f64` (`1.5`, `0.001`, `1e-7`, `3.3000000000000003`).
@@ -18,7 +19,7 @@ use std::path::Path;
 
 use super::export::ExportError;
 use super::{
-    Cursor, DataKind, Header, RawError, RawWarning, next_is_header, parse_header,
+    Cursor, DataKind, Dialect, Header, RawError, RawWarning, ltspice, next_is_header, parse_header,
     real_in_complex_plot, regular_file,
 };
 
@@ -115,13 +116,20 @@ fn locate(file: &mut BufReader<File>, len: u64) -> Result<Option<Vec<Located>>, 
         if cur.at_end() {
             break;
         }
+        if matches!(
+            ltspice::utf16_start(cur.rest(), cur.at()),
+            Ok(Some(_)) | Err(_)
+        ) {
+            // LTspice's UTF-16 text: the in-memory reader decodes it.
+            return Ok(None);
+        }
         if !has_data_line(cur.rest()) {
             // No `Binary:`/`Values:` within the limit: let the full reader
             // report what is wrong.
             return Ok(None);
         }
         let header = parse_header(&mut cur, &mut title, &mut date).map_err(Locate::Raw)?;
-        if !matches!(header.data, DataKind::Binary) {
+        if !matches!(header.data, DataKind::Binary) || header.plot.dialect != Dialect::Ngspice {
             return Ok(None);
         }
         let declared = header.plot.declared_points;
