@@ -78,6 +78,7 @@ const INNER_FRACTION: f64 = 0.1;
 /// The armature's cycle at the fixed point of the estimated pull (see the
 /// module notes), starting from `start`, the mechanics under the run's own
 /// flux. Returns the cycle and the number of mechanics runs it took.
+#[allow(clippy::too_many_arguments)] // the relay, its stops and the run's tolerances, as the pass has them
 pub fn settle(
     coil: &Coil,
     run: &CircuitRun,

@@ -1,6 +1,6 @@
 //! The main job, `chatterspice run`: every stage of the pipeline in order.
 //!
-//! scenario → [`Trajectory::of_step`] (the chatter and the armature's motion) →
+//! scenario → [`crate::mechanics::two_stage::step_closing`] (the chatter and the armature's motion) →
 //! [`Waveform`] (the contact conductance) → [`netlist`]
 //! (the contact include and the user's netlist with the `.include` added)
 //! → a [`Runner`] (ngspice in batch mode) → the raw file →

@@ -413,7 +413,7 @@ pub(crate) fn run<D: Drive>(
     let mut steps = 0usize;
     let mut bound = Bound::new(model);
     let mut ending: Option<Outcome> = None;
-    let mut track = Tracker::default();
+    let mut track = Tracker;
     'phases: while t < settings.t_end {
         let f = |t: f64, y: &Y| model.rate(t, y, modes);
         let mut solver = Dop853::new(f, t, y, h, tol);
@@ -439,8 +439,8 @@ pub(crate) fn run<D: Drive>(
             }
             let dense = solver.dense();
             h = solver.next_step();
-            if let Some(limit) = pole_limit(model, &step.y1) {
-                return Err(limit(step.t1));
+            if let Some(error) = pole_limit(model, &step.y1, step.t1) {
+                return Err(error);
             }
             match model.first_event(&dense, step.t1, modes) {
                 None => {
@@ -539,16 +539,14 @@ pub(crate) fn run<D: Drive>(
 }
 
 /// The error when the armature has pressed through to the magnet's pole
-/// (the drive's model ends there).
-fn pole_limit<D: Drive>(model: &Model<'_, D>, y: &Y) -> Option<impl Fn(f64) -> DriveError> {
+/// (the drive's model ends there) at `time`.
+fn pole_limit<D: Drive>(model: &Model<'_, D>, y: &Y, time: f64) -> Option<DriveError> {
     let pole = model.drive.pole();
-    let x = model.g() + y[0];
-    (x >= pole).then(move || {
-        move |time| DriveError::ArmatureAtPole {
-            time,
-            position: x,
-            pole,
-        }
+    let position = model.g() + y[0];
+    (position >= pole).then_some(DriveError::ArmatureAtPole {
+        time,
+        position,
+        pole,
     })
 }
 
@@ -816,7 +814,6 @@ fn rigid<D: Drive>(
 
 /// Peak and minimum contact forces and the largest opening after each
 /// release, sampled on the dense output.
-#[derive(Default)]
 struct Tracker;
 
 impl Tracker {

@@ -26,7 +26,7 @@
 //! integrated by DOP853 with dense output; every impact, release,
 //! lift-off and landing is located on the dense output by bisection to
 //! adjacent floats, and the state after it is set exactly on the surface.
-//! A closing ends when an energy bound ([`energy`]) proves that the
+//! A closing ends when an energy bound (docs/model.md §11) proves that the
 //! contact can no longer release (`stuck`), or reach the contact again
 //! (`ends_open`).
 
