@@ -52,6 +52,11 @@ pub(crate) trait Drive {
     fn time_scale(&self) -> f64;
     /// m, the largest position the model holds for (the pole face).
     fn pole(&self) -> f64;
+    /// N, the force when it is a constant (the step drive), which lets an
+    /// engine solve the motion in closed form; `None` otherwise.
+    fn constant(&self) -> Option<f64> {
+        None
+    }
 }
 
 /// Which equations a step integrated.

@@ -598,7 +598,7 @@ impl Trajectory {
             .pieces
             .into_iter()
             .map(|piece| Segment {
-                t0: piece.dense.t0,
+                t0: piece.t0,
                 t1: piece.t1,
                 side: if piece.contact_closed() {
                     Side::Make

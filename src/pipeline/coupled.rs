@@ -140,6 +140,8 @@ pub struct Coupled {
     pub deck: Deck,
     /// ngspice's version, e.g. `"39"`.
     pub version: Option<String>,
+    /// A relay with a pole face: the armature's impacts on it.
+    pub pole_face: Vec<crate::chatter::Impact>,
 }
 
 impl Coupled {
@@ -492,10 +494,10 @@ pub fn run_coupled_plan(
         });
         let converged = change <= options.tolerance && iteration > 1;
         let thinning = PATH_TOLERANCE * (coil.air_gap + coil.iron_gap);
-        let strokes = if converged || !options.accelerate {
-            let strokes;
-            (chatter, back, path, strokes) = records(cycle, thinning);
-            strokes
+        let (strokes, pole_face) = if converged || !options.accelerate {
+            let (strokes, pole_face);
+            (chatter, back, path, strokes, pole_face) = records(cycle, thinning);
+            (strokes, pole_face)
         } else {
             let Some(Vector::Real(time)) = plot.scale() else {
                 return Err(CouplingError::MissingVector {
@@ -534,7 +536,7 @@ pub fn run_coupled_plan(
                 iteration,
                 source,
             })?;
-            (chatter, back, path, _) = records(next, thinning);
+            (chatter, back, path, _, _) = records(next, thinning);
             continue;
         };
         if converged {
@@ -562,6 +564,7 @@ pub fn run_coupled_plan(
                 iterations,
                 deck,
                 version,
+                pole_face,
             });
         }
     }
@@ -602,16 +605,24 @@ pub fn nc_include(
 
 /// The records a pass hands on: the two contacts' chatter, the armature
 /// path thinned to `thinning` (m) for ngspice, and the strokes.
-fn records(
-    trajectory: Trajectory,
-    thinning: f64,
-) -> (Chatter, Chatter, Vec<(f64, f64)>, Vec<Stroke>) {
+fn records(trajectory: Trajectory, thinning: f64) -> Records {
     let path = thin(&trajectory.path(), thinning);
     let strokes = trajectory.strokes().to_vec();
+    let pole_face = trajectory.pole_face_impacts().to_vec();
     let (make, back) = trajectory.into_contacts();
     let back = back.expect("a driven cycle records its rest stop");
-    (make, back, path, strokes)
+    (make, back, path, strokes, pole_face)
 }
+
+/// What a converged pass hands on: the NO and NC contacts' records, the
+/// armature's path, the strokes and the pole-face impacts.
+type Records = (
+    Chatter,
+    Chatter,
+    Vec<(f64, f64)>,
+    Vec<Stroke>,
+    Vec<crate::chatter::Impact>,
+);
 
 /// A contact in `state` from 0 to `t_end`: before the first iteration,
 /// the NO contact open and the NC contact closed (the armature at rest).

@@ -240,6 +240,9 @@ pub struct RunResult {
     pub operations: Vec<Operation>,
     /// With `[arc]`: every arc and breakdown at the contact.
     pub arcs: Option<ArcReport>,
+    /// With `[pole_face]`: the armature's impacts on the pole face (the
+    /// contact's record is then the blade's).
+    pub pole_face: Option<Vec<crate::chatter::Impact>>,
 }
 
 /// Run the whole pipeline on `scenario` with `runner`. A scenario with a
@@ -278,9 +281,16 @@ pub fn run_plan(
         source,
     })?;
     let gap = GapProfile::from_trajectory(&trajectory);
+    let pole_face = plan
+        .two_stage()
+        .pole_face
+        .is_some()
+        .then(|| trajectory.pole_face_impacts().to_vec());
     let chatter = trajectory.into_chatter();
     let (waveform, model) = contact_waveform_of(scenario, surface, &chatter)?;
-    run_chatter(plan, chatter, waveform, &model, gap, runner, options)
+    let mut result = run_chatter(plan, chatter, waveform, &model, gap, runner, options)?;
+    result.pole_face = pole_face;
+    Ok(result)
 }
 
 /// [`run`] with a measured chatter sequence (e.g. from
@@ -468,6 +478,7 @@ fn run_chatter(
     Ok(RunResult {
         coupling: None,
         operations: Vec::new(),
+        pole_face: None,
         arcs,
         netlist: netlist_path,
         chatter,
@@ -628,6 +639,11 @@ fn run_coil(plan: &Plan, runner: &dyn Runner, options: &RunOptions) -> Result<Ru
         warnings,
         coupling: Some(coupled.iterations),
         operations: coupled.operations,
+        pole_face: plan
+            .two_stage()
+            .pole_face
+            .is_some()
+            .then_some(coupled.pole_face),
         arcs,
     })
 }

@@ -209,7 +209,12 @@ impl<'a> RunJson<'a> {
                     bounce_added: p.comparison.as_ref(),
                 })
                 .collect(),
-            bounce: BounceJson::new(&run.chatter, dimensionless),
+            bounce: match &run.pole_face {
+                Some(impacts) => {
+                    BounceJson::new(&run.chatter, dimensionless).with_pole_face(impacts)
+                }
+                None => BounceJson::new(&run.chatter, dimensionless),
+            },
             ngspice: NgspiceJson {
                 version: run.simulation.version.as_deref(),
                 elapsed: sim(&run.simulation).0,

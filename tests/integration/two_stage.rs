@@ -398,3 +398,53 @@ fn a_stiff_light_blade_converges_to_the_one_mass_model() {
     assert_eq!(two.contact.bounce_count, one.bounce_count);
     assert_eq!(two.contact.outcome, Outcome::Stuck);
 }
+
+#[test]
+fn the_integrating_and_the_exact_engines_agree() {
+    // The same relay under the same constant force, once as the step
+    // drive (solved exactly, mode by mode) and once as a force F(t, x)
+    // (integrated by DOP853; the rest stop it adds is never reached).
+    let m = armature();
+    let settings = Settings::default();
+    for release in [Release::Position, Release::Force] {
+        let relay = relay(true, release);
+        let exact = simulate_two_stage(
+            &m,
+            &relay,
+            &contact(),
+            &settings,
+            Drive::Step,
+            Horizon::Closing,
+        )
+        .unwrap();
+        let force = |_t: f64, _x: f64| m.force;
+        let integrated = simulate_two_stage(
+            &m,
+            &relay,
+            &contact(),
+            &settings,
+            Drive::Force(&force),
+            Horizon::Closing,
+        )
+        .unwrap();
+        let (a, b) = (&exact.contact, &integrated.contact);
+        assert_eq!(a.impacts.len(), b.impacts.len(), "{release:?}");
+        assert_eq!(a.outcome, b.outcome);
+        for (x, y) in a.impacts.iter().zip(&b.impacts) {
+            close(x.impact_time, y.impact_time, 1e-8, "impact time");
+            close(
+                x.impact_velocity,
+                y.impact_velocity,
+                1e-6,
+                "impact velocity",
+            );
+        }
+        close(
+            a.settle_time.unwrap(),
+            b.settle_time.unwrap(),
+            1e-8,
+            "settle time",
+        );
+        assert_eq!(exact.pole_face.len(), integrated.pole_face.len());
+    }
+}

@@ -61,38 +61,60 @@ pub(crate) enum Stop {
 /// The three stops' modes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct Modes {
-    contact: Stop,
-    pole: Stop,
-    rest: Stop,
+    pub(crate) contact: Stop,
+    pub(crate) pole: Stop,
+    pub(crate) rest: Stop,
 }
 
-/// One accepted step, cut at its event: valid on `[dense.t0, t1]`, exact
-/// `y1` at `t1`.
+/// How a piece's state is had between its ends.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Motion {
+    /// DOP853's dense output of the step.
+    Dense(Box<Dense<5>>),
+    /// The exact solution of a linear mode from `w0` (scaled deviation
+    /// from the mode's equilibrium) at `t0`.
+    Linear {
+        w0: super::linear::W,
+        mode: std::sync::Arc<super::linear::LinearMode>,
+    },
+}
+
+/// One accepted step, cut at its event: valid on `[t0, t1]`, exact `y1`
+/// at `t1`.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Piece {
-    pub dense: Dense<5>,
+    pub motion: Motion,
+    pub t0: f64,
     pub t1: f64,
     pub y1: Y,
     pub modes: Modes,
 }
 
 impl Piece {
+    pub(crate) fn dense(dense: Dense<5>, t1: f64, y1: Y, modes: Modes) -> Piece {
+        Piece {
+            t0: dense.t0,
+            motion: Motion::Dense(Box::new(dense)),
+            t1,
+            y1,
+            modes,
+        }
+    }
+
     pub(crate) fn at(&self, t: f64) -> Y {
         if t >= self.t1 {
-            self.y1
-        } else {
-            self.dense.at(t.max(self.dense.t0))
+            return self.y1;
+        }
+        let t = t.max(self.t0);
+        match &self.motion {
+            Motion::Dense(dense) => dense.at(t),
+            Motion::Linear { w0, mode } => mode.y_of(&mode.at(w0, t - self.t0)),
         }
     }
 
     /// Whether the contact is closed over this piece.
     pub(crate) fn contact_closed(&self) -> bool {
         self.modes.contact != Stop::Open
-    }
-
-    #[allow(dead_code)]
-    pub(crate) fn span(&self) -> (f64, f64) {
-        (self.dense.t0, self.t1)
     }
 }
 
@@ -107,7 +129,7 @@ pub(crate) fn state_at(pieces: &[Piece], t: f64) -> Y {
 
 /// Which stop an event belongs to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Which {
+pub(crate) enum Which {
     Contact,
     Pole,
     Rest,
@@ -316,7 +338,7 @@ impl<D: Drive> Model<'_, D> {
 }
 
 /// The records a run builds.
-struct Records {
+pub(crate) struct Records {
     contact: Vec<Impact>,
     intervals: Vec<Interval>,
     pole: Vec<Impact>,
@@ -328,6 +350,34 @@ struct Records {
 }
 
 impl Records {
+    /// Whether the contact has been touched.
+    pub(crate) fn contact_is_empty(&self) -> bool {
+        self.contact.is_empty()
+    }
+
+    /// Take in the state `y` in `modes`: the engaged contact's force
+    /// (`force(y)`), the opening after a release, the reach before the
+    /// first touch.
+    pub(crate) fn observe(&mut self, gap: f64, modes: Modes, y: &Y, force: impl Fn(&Y) -> f64) {
+        match modes.contact {
+            Stop::Engaged | Stop::Pressed => {
+                let f = force(y);
+                if let Some(last) = self.contact.last_mut() {
+                    last.peak_force = Some(last.peak_force.map_or(f, |p: f64| p.max(f)));
+                    last.min_force = Some(last.min_force.map_or(f, |p: f64| p.min(f)));
+                }
+            }
+            Stop::Open => match self.contact.last_mut() {
+                Some(last) => {
+                    let opening = (-y[2]).max(0.0);
+                    last.max_gap_after =
+                        Some(last.max_gap_after.map_or(opening, |p: f64| p.max(opening)));
+                }
+                None => self.reach = self.reach.max(gap + y[2]),
+            },
+        }
+    }
+
     fn switch(intervals: &mut Vec<Interval>, t: f64, state: ContactState) {
         if let Some(last) = intervals.last_mut() {
             if last.state == state {
@@ -350,18 +400,79 @@ fn release(impact: &mut Impact, t: f64, v: f64) {
     impact.restitution = (impact.impact_velocity > 0.0).then(|| -v / impact.impact_velocity);
 }
 
-/// Simulate the relay of `m` built as `build` onto the contact `contact`
-/// (and the rest stop's law `back`, a driven run) under `drive`, from the
-/// drive's state `e0`, to `horizon`. Parameters must have been validated.
-///
-/// `rest`: whether the armature has a rest stop at x = 0 (the driven
-/// models do; the step-force model, as the exact engine, does not).
+/// A run in progress: where it is, in which modes, and what it recorded.
+pub(crate) struct Progress {
+    pub t: f64,
+    pub y: Y,
+    pub modes: Modes,
+    pub rec: Records,
+    pub pieces: Vec<Piece>,
+    pub steps: usize,
+    pub bound: Bound,
+    /// The ending, when one was decided before the horizon.
+    pub ending: Option<Outcome>,
+}
+
+impl Progress {
+    /// Apply the event of `which` at `t` (state `y` there, before it).
+    pub(crate) fn event<D: Drive>(
+        &mut self,
+        model: &Model<'_, D>,
+        settings: &Settings,
+        which: Which,
+        t: f64,
+        mut y: Y,
+    ) {
+        self.modes = transition(model, settings, which, t, &mut y, self.modes, &mut self.rec);
+        if let Some(last) = self.pieces.last_mut() {
+            last.y1 = y;
+        }
+        self.t = t;
+        self.y = y;
+        if self.rec.contact.len() >= MAX_EVENTS {
+            self.ending = Some(Outcome::EventLimit);
+        }
+    }
+
+    /// Count one more step, failing past the limit.
+    pub(crate) fn count_step(
+        &mut self,
+        m: &Mechanics,
+        settings: &Settings,
+    ) -> Result<(), DriveError> {
+        self.steps += 1;
+        if self.steps > MAX_DRIVEN_STEPS {
+            return Err(DriveError::TooManySteps {
+                steps: MAX_DRIVEN_STEPS,
+                time: self.t,
+                t_end: settings.t_end,
+                mass: m.mass,
+                stiffness: m.stiffness,
+                period: 2.0 * std::f64::consts::PI * (m.mass / m.stiffness).sqrt(),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Simulate the relay of `model` from the drive's state `e0` to
+/// `horizon`. Parameters must have been validated.
 pub(crate) fn run<D: Drive>(
     model: &Model<'_, D>,
     settings: &Settings,
     e0: f64,
     horizon: Horizon,
 ) -> Result<TwoStageRun, DriveError> {
+    let mut progress = start(model, e0);
+    match super::linear::LinearSystem::of(model) {
+        Some(system) => super::linear::propagate(&system, model, settings, horizon, &mut progress)?,
+        None => integrate(model, settings, horizon, &mut progress)?,
+    }
+    Ok(finish(model, settings, horizon, progress))
+}
+
+/// The state at t = 0: on the rest stop when the drive does not lift it.
+fn start<D: Drive>(model: &Model<'_, D>, e0: f64) -> Progress {
     let m = model.m;
     let g = m.gap;
     let x0 = m.initial_position;
@@ -405,30 +516,34 @@ pub(crate) fn run<D: Drive>(
     } else if model.rest && x0 == 0.0 {
         rec.lift_offs.push(0.0);
     }
+    Progress {
+        t: 0.0,
+        y,
+        modes,
+        rec,
+        pieces: Vec::new(),
+        steps: 0,
+        bound: Bound::new(model),
+        ending: None,
+    }
+}
+
+/// DOP853 from event to event, to the horizon.
+fn integrate<D: Drive>(
+    model: &Model<'_, D>,
+    settings: &Settings,
+    horizon: Horizon,
+    p: &mut Progress,
+) -> Result<(), DriveError> {
     let tol = tolerance(model);
-    let omega = fastest(model);
-    let mut h = 0.05 / omega;
-    let mut t = 0.0;
-    let mut pieces: Vec<Piece> = Vec::new();
-    let mut steps = 0usize;
-    let mut bound = Bound::new(model);
-    let mut ending: Option<Outcome> = None;
+    let mut h = 0.05 / fastest(model);
     let mut track = Tracker;
-    'phases: while t < settings.t_end {
+    while p.t < settings.t_end && p.ending.is_none() {
+        let modes = p.modes;
         let f = |t: f64, y: &Y| model.rate(t, y, modes);
-        let mut solver = Dop853::new(f, t, y, h, tol);
+        let mut solver = Dop853::new(f, p.t, p.y, h, tol);
         loop {
-            steps += 1;
-            if steps > MAX_DRIVEN_STEPS {
-                return Err(DriveError::TooManySteps {
-                    steps: MAX_DRIVEN_STEPS,
-                    time: t,
-                    t_end: settings.t_end,
-                    mass: m.mass,
-                    stiffness: m.stiffness,
-                    period: 2.0 * std::f64::consts::PI * (m.mass / m.stiffness).sqrt(),
-                });
-            }
+            p.count_step(model.m, settings)?;
             let step = solver.step(settings.t_end).map_err(DriveError::from)?;
             if !step.y1.iter().all(|v| v.is_finite()) {
                 return Err(MechanicsError::StepSizeTooSmall {
@@ -444,59 +559,50 @@ pub(crate) fn run<D: Drive>(
             }
             match model.first_event(&dense, step.t1, modes) {
                 None => {
-                    track.sample(model, &dense, step.t1, modes, &mut rec);
-                    pieces.push(Piece {
-                        dense,
-                        t1: step.t1,
-                        y1: step.y1,
-                        modes,
-                    });
-                    t = step.t1;
-                    y = step.y1;
+                    track.sample(model, &dense, step.t1, modes, &mut p.rec);
+                    p.pieces.push(Piece::dense(dense, step.t1, step.y1, modes));
+                    p.t = step.t1;
+                    p.y = step.y1;
                     if horizon == Horizon::Closing
-                        && let Some(end) = decided(model, &mut bound, t, &y, modes, &rec)
+                        && let Some(end) = decided(model, &mut p.bound, p.t, &p.y, modes, &p.rec)
                     {
-                        ending = Some(end);
-                        break 'phases;
+                        p.ending = Some(end);
+                        return Ok(());
                     }
-                    if t >= settings.t_end {
-                        break 'phases;
+                    if p.t >= settings.t_end {
+                        return Ok(());
                     }
                 }
                 Some((te, which)) => {
-                    let mut ye = dense.at(te);
-                    track.sample(model, &dense, te, modes, &mut rec);
-                    pieces.push(Piece {
-                        dense,
-                        t1: te,
-                        y1: ye,
-                        modes,
-                    });
-                    modes = transition(model, settings, which, te, &mut ye, modes, &mut rec);
-                    if let Some(last) = pieces.last_mut() {
-                        last.y1 = ye;
-                    }
-                    t = te;
-                    y = ye;
-                    if rec.contact.len() >= MAX_EVENTS {
-                        ending = Some(Outcome::EventLimit);
-                        break 'phases;
-                    }
-                    continue 'phases;
+                    let ye = dense.at(te);
+                    track.sample(model, &dense, te, modes, &mut p.rec);
+                    p.pieces.push(Piece::dense(dense, te, ye, modes));
+                    p.event(model, settings, which, te, ye);
+                    break;
                 }
             }
         }
     }
-    // Whatever was decided, the motion is held where it stopped to t_end.
-    if t < settings.t_end {
-        pieces.push(Piece {
-            dense: Dense::constant(t, settings.t_end, y),
-            t1: settings.t_end,
-            y1: y,
-            modes,
-        });
-    }
+    Ok(())
+}
+
+/// The run's records, with the motion held where it stopped to `t_end`.
+fn finish<D: Drive>(
+    model: &Model<'_, D>,
+    settings: &Settings,
+    horizon: Horizon,
+    mut p: Progress,
+) -> TwoStageRun {
     let t_end = settings.t_end;
+    if p.t < t_end {
+        p.pieces.push(Piece::dense(
+            Dense::constant(p.t, t_end, p.y),
+            t_end,
+            p.y,
+            p.modes,
+        ));
+    }
+    let rec = &mut p.rec;
     for list in [&mut rec.intervals, &mut rec.back_intervals] {
         if let Some(last) = list.last_mut() {
             last.end = t_end;
@@ -514,7 +620,7 @@ pub(crate) fn run<D: Drive>(
         t_end,
     };
     let strokes: Vec<Stroke> = strokes(&rec.lift_offs, &rec.contact, &back.impacts);
-    let shortfall = g - rec.reach;
+    let shortfall = model.g() - rec.reach;
     let contact = match horizon {
         Horizon::Cycle => summary(
             std::mem::take(&mut rec.intervals),
@@ -523,19 +629,24 @@ pub(crate) fn run<D: Drive>(
             shortfall,
             t_end,
         ),
-        Horizon::Closing => {
-            closing_summary(model, &mut bound, &mut rec, ending, (t, y, modes), t_end)
-        }
+        Horizon::Closing => closing_summary(
+            model,
+            &mut p.bound,
+            rec,
+            p.ending,
+            (p.t, p.y, p.modes),
+            t_end,
+        ),
     };
-    Ok(TwoStageRun {
+    TwoStageRun {
         contact,
-        pole_face: rec.pole,
+        pole_face: std::mem::take(&mut p.rec.pole),
         back,
-        lift_off: rec.lift_offs.first().copied(),
+        lift_off: p.rec.lift_offs.first().copied(),
         strokes,
-        steps,
-        pieces,
-    })
+        steps: p.steps,
+        pieces: p.pieces,
+    }
 }
 
 /// The error when the armature has pressed through to the magnet's pole
@@ -552,7 +663,7 @@ fn pole_limit<D: Drive>(model: &Model<'_, D>, y: &Y, time: f64) -> Option<DriveE
 
 /// The closing's chatter: its ending decided by the energy bound, or read
 /// at the horizon.
-fn closing_summary<D: Drive>(
+pub(crate) fn closing_summary<D: Drive>(
     model: &Model<'_, D>,
     bound: &mut Bound,
     rec: &mut Records,
@@ -603,7 +714,7 @@ fn closing_summary<D: Drive>(
 
 /// Whether a closing's ending is decided at `t`: the contact closed and
 /// unable to release, or open after touching and unable to reach it again.
-fn decided<D: Drive>(
+pub(crate) fn decided<D: Drive>(
     model: &Model<'_, D>,
     bound: &mut Bound,
     t: f64,
@@ -623,7 +734,7 @@ fn decided<D: Drive>(
 
 /// Apply the event of `which` at `t` to the state and the records; the
 /// new modes.
-fn transition<D: Drive>(
+pub(crate) fn transition<D: Drive>(
     model: &Model<'_, D>,
     settings: &Settings,
     which: Which,
@@ -898,7 +1009,7 @@ fn fastest<D: Drive>(model: &Model<'_, D>) -> f64 {
 }
 
 /// A constant force (the step drive), as a [`Drive`].
-struct Constant {
+pub(crate) struct Constant {
     force: f64,
     time_scale: f64,
 }
@@ -926,6 +1037,10 @@ impl Drive for Constant {
 
     fn pole(&self) -> f64 {
         f64::INFINITY
+    }
+
+    fn constant(&self) -> Option<f64> {
+        Some(self.force)
     }
 }
 

@@ -32,6 +32,7 @@
 
 pub(crate) mod energy;
 pub mod engine;
+pub(crate) mod linear;
 
 use super::cycle::Stroke;
 use super::{DriveError, Mechanics, MechanicsError, Surface};
