@@ -1,6 +1,6 @@
-//! `chatterspice raw FILE`: an ngspice raw file as CSV (streamed), a JSON
-//! summary of its plots, or, with `--signal`, the probe analysis of `run`
-//! on any raw file.
+//! `chatterspice raw FILE`: a raw file (ngspice's or LTspice's) as CSV
+//! (streamed for ngspice's binary files), a JSON summary of its plots, or,
+//! with `--signal`, the probe analysis of `run` on any raw file.
 
 use std::io::{self, Write};
 use std::path::PathBuf;
@@ -16,9 +16,10 @@ use chatterspice::scenario::Probe;
 
 #[derive(Debug, Args)]
 pub struct RawArgs {
-    /// The raw file (ngspice binary or ASCII).
+    /// The raw file (ngspice or LTspice, binary or ASCII).
     pub file: PathBuf,
-    /// Plot to use, numbered from 0 in file order [default: the last].
+    /// Plot to use, numbered from 0 in file order (each step of an LTspice
+    /// `.step` run is a plot) [default: the last].
     #[arg(long)]
     pub plot: Option<usize>,
     /// Output format [default: csv; table with --signal].

@@ -9,6 +9,9 @@ stored as float32 is the double rounded to nearest float32, as
 struct.pack('<f') and Rust's `as f32` both do.
 
     python3 tests/data/ltspice/generate.py    # rewrites the .raw files
+
+It also writes two seeds of the rawfile fuzz target, in
+fuzz/seeds/rawfile/.
 """
 
 import os
@@ -214,9 +217,33 @@ def noise():
     write("noise.raw", binary_file(h, rows, ["d", "f", "f", "f"]))
 
 
+# --- fuzz seeds: combinations the test files leave out ---
+
+def fuzz_seeds():
+    """Writes fuzz/seeds/rawfile/ltspice_*.raw (see scripts/fuzz)."""
+    out = os.path.join(HERE, "..", "..", "..", "fuzz", "seeds", "rawfile")
+    os.makedirs(out, exist_ok=True)
+    # Complex, FastAccess and stepped at once.
+    rows = ac_rows(3, 1000.0) + ac_rows(3, 2000.0)
+    h = header("* seed", "AC Analysis", "complex forward log stepped fastaccess", AC_VARS, len(rows))
+    with open(os.path.join(out, "ltspice_ac_stepped_fastaccess.raw"), "wb") as f:
+        f.write(binary_file(h, rows, ["c"] * 4, fastaccess=True))
+    # A byte order mark, stepped ASCII values, then a second, binary plot
+    # and an all-zero point after its declared ones.
+    rows = stepped_rows()[:7]
+    variables = [("time", "time"), ("V(out)", "voltage"), ("I(R1)", "device_current")]
+    h = header("* seed", "Transient Analysis", "real forward stepped", variables, len(rows))
+    data = b"\xff\xfe" + ascii_file(h, rows, False)
+    h = header("* seed", "Transient Analysis", "real forward", variables, 2)
+    data += binary_file(h, rows[:2], ["d", "f", "f"]) + bytes(16)
+    with open(os.path.join(out, "ltspice_bom_ascii_then_binary.raw"), "wb") as f:
+        f.write(data)
+
+
 if __name__ == "__main__":
     transient()
     stepped()
     ac()
     op()
     noise()
+    fuzz_seeds()
