@@ -440,6 +440,11 @@ impl Drive for CoilDrive {
         0.5 * c * c * (self.coil.inductance(to) - self.coil.inductance(from))
     }
 
+    fn held_work(&self, _t: f64, psi: f64, from: f64, to: f64) -> f64 {
+        // At constant flux the pull ψ²/(2k) does not depend on position.
+        0.5 * psi * psi / self.k * (to - from)
+    }
+
     fn e_scale(&self) -> f64 {
         // The final flux with the contacts closed.
         (self.coil.inductance(self.gap) * self.voltage / self.resistance)

@@ -52,6 +52,13 @@ pub(crate) trait Drive {
     fn time_scale(&self) -> f64;
     /// m, the largest position the model holds for (the pole face).
     fn pole(&self) -> f64;
+    /// J, the work of the drive with its state `e` held (its own dynamics
+    /// stopped) on an armature moving from `from` to `to` (m): the
+    /// potential of the energy bound that ends a two-stage closing. By
+    /// default [`Drive::frozen_work`].
+    fn held_work(&self, t: f64, e: f64, from: f64, to: f64) -> f64 {
+        self.frozen_work(t, e, from, to)
+    }
     /// N, the force when it is a constant (the step drive), which lets an
     /// engine solve the motion in closed form; `None` otherwise.
     fn constant(&self) -> Option<f64> {

@@ -119,6 +119,12 @@ pub fn plot(run: &RunResult) -> Result<String, BundleError> {
         run.chatter.outcome
     );
     Ok(svg::render(&SvgPlot {
+        pole_face: run
+            .pole_face
+            .iter()
+            .flatten()
+            .map(|i| i.impact_time)
+            .collect(),
         title,
         window: svg::suggested_window(last_event, end),
         contact: Some(ContactTrace::States(&run.chatter.intervals)),

@@ -130,6 +130,34 @@ pub struct SvgPlot<'a> {
     /// Arcs and breakdowns to mark on the contact panel: (start, end, s;
     /// `true` for an arc, `false` for a breakdown).
     pub arcs: Vec<(f64, f64, bool)>,
+    /// s, the armature's impacts on the pole face (a relay with a contact
+    /// blade), marked above the contact panel.
+    pub pole_face: Vec<f64>,
+}
+
+/// A small downward triangle over the contact panel (whose top is `top`)
+/// at each pole-face impact in the window `(t0, t1)`.
+fn pole_face_marks(
+    out: &mut String,
+    impacts: &[f64],
+    (t0, t1): (f64, f64),
+    x: &dyn Fn(f64) -> f64,
+    top: f64,
+) {
+    for &t in impacts.iter().filter(|&&t| t >= t0 && t <= t1) {
+        let xt = x(t);
+        let _ = writeln!(
+            out,
+            r#"<path d="M{} {}L{} {}L{} {}Z" fill="{EDGE_COLOR}"><title>pole-face impact at {} s</title></path>"#,
+            num(xt - 4.0),
+            num(top - 7.0),
+            num(xt + 4.0),
+            num(top - 7.0),
+            num(xt),
+            num(top - 1.0),
+            num(t)
+        );
+    }
 }
 
 /// A time window from 0 to a little after `last_event` (s; e.g. the last
@@ -244,10 +272,11 @@ pub fn render(plot: &SvgPlot) -> Result<String, SvgError> {
             }
             _ => (
                 Axis::states(),
-                if plot.arcs.is_empty() {
-                    "contact"
-                } else {
-                    "contact (arcs shaded, breakdowns low)"
+                match (plot.arcs.is_empty(), plot.pole_face.is_empty()) {
+                    (true, true) => "contact",
+                    (true, false) => "contact (▼ pole-face impacts)",
+                    (false, true) => "contact (arcs shaded, breakdowns low)",
+                    (false, false) => "contact (arcs shaded, breakdowns low, ▼ pole-face impacts)",
                 },
                 points.clone(),
             ),
@@ -285,6 +314,7 @@ pub fn render(plot: &SvgPlot) -> Result<String, SvgError> {
             r#"<polyline fill="none" stroke="{CONTACT_COLOR}" stroke-width="1.5" stroke-linejoin="round" points="{}"/></g>"#,
             polyline(&values, x, y)
         );
+        pole_face_marks(&mut out, &plot.pole_face, (t0, t1), &x, top);
         panel_frame(&mut out, top, CONTACT_HEIGHT);
         let _ = writeln!(
             out,
@@ -835,6 +865,7 @@ mod tests {
             contact: Some(ContactTrace::States(intervals)),
             probes: vec![ProbePanel::from_analysis(&a, Series { time, value })],
             arcs: Vec::new(),
+            pole_face: Vec::new(),
         }
     }
 
@@ -878,6 +909,7 @@ mod tests {
             contact: None,
             probes: vec![probe],
             arcs: Vec::new(),
+            pole_face: Vec::new(),
         };
         let svg = render(&plot).unwrap();
         // The range [-0.5, 1] V padded by 8 % of its span: [-0.62, 1.12].
@@ -899,6 +931,28 @@ mod tests {
         // Non-finite samples are skipped, not drawn.
         let points = decimate(&time, &[0.0, f64::NAN, 20.0, 30.0], 0.0, 3.0, 4);
         assert_eq!(points, vec![(0.0, 0.0), (2.0, 20.0), (3.0, 30.0)]);
+    }
+
+    #[test]
+    fn pole_face_impacts_are_marked_over_the_contact_panel() {
+        let (time, value) = square(2001);
+        let iv = intervals();
+        let mut plot = demo(&time, &value, &iv);
+        // Two in the 1 ms window, one after it.
+        plot.pole_face = vec![3e-4, 4.5e-4, 2e-3];
+        let svg = render(&plot).unwrap();
+        assert_balanced(&svg);
+        assert_eq!(
+            svg.matches("<title>pole-face impact at ").count(),
+            2,
+            "{svg}"
+        );
+        assert!(svg.contains("pole-face impacts)"));
+        assert!(
+            !render(&demo(&time, &value, &iv))
+                .unwrap()
+                .contains("pole-face")
+        );
     }
 
     #[test]
@@ -983,6 +1037,7 @@ mod tests {
             })),
             probes: vec![],
             arcs: Vec::new(),
+            pole_face: Vec::new(),
         };
         let svg = render(&plot).unwrap();
         assert_balanced(&svg);
@@ -1012,6 +1067,7 @@ mod tests {
             contact: None,
             probes: vec![],
             arcs: Vec::new(),
+            pole_face: Vec::new(),
         };
         assert_eq!(render(&empty), Err(SvgError::Empty));
     }

@@ -121,3 +121,67 @@ fn the_iterations_are_reported_and_shrink() {
     let finite: Vec<f64> = changes.iter().copied().filter(|c| c.is_finite()).collect();
     assert!(finite.windows(2).all(|w| w[1] <= w[0]), "{changes:?}");
 }
+
+#[test]
+fn a_two_stage_relay_coupled_to_its_coil_agrees_with_the_direct_solver() {
+    use chatterspice::coil::direct::direct_closing;
+    let ng = ngspice_or_skip!();
+    // The reference relay with a contact blade and a pole face 0.1 mm past
+    // the make (the magnet's pole is at 0.65 mm).
+    let origin = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/coil/reference.toml");
+    let text = std::fs::read_to_string(&origin).unwrap()
+        + "\n[blade]\nmass = 3.0e-5\nstiffness = 3000.0\ndamping = 0.01\n\
+           \n[pole_face]\novertravel = 1.0e-4\nlaw = \"kelvin-voigt\"\nstiffness = 5.0e6\ndamping = 20.0\n";
+    let scenario = Scenario::parse(&text, &origin).unwrap();
+    let coupled = run_coupled(&scenario, &ng, &CouplingOptions::default())
+        .unwrap_or_else(|e| panic!("{}", common::chain(&e)));
+    let m = &scenario.mechanics;
+    let mechanics = Mechanics {
+        mass: m.mass,
+        stiffness: m.stiffness,
+        damping: m.damping,
+        force: 0.0,
+        gap: m.gap,
+        initial_position: 0.0,
+        initial_velocity: 0.0,
+        preload: m.preload,
+    };
+    let (direct, run) = direct_closing(
+        &Coil::from(scenario.coil.as_ref().unwrap()),
+        &Source {
+            voltage: 5.0,
+            series_resistance: 0.0,
+        },
+        &mechanics,
+        &scenario.two_stage(),
+        &scenario.surface(),
+        &scenario.settings(),
+    )
+    .unwrap();
+    let run = run.expect("a two-stage run");
+    let close = |a: f64, b: f64, what: &str| {
+        assert!(
+            (a / b - 1.0).abs() < 1e-3,
+            "{what}: coupled {a} vs direct {b}"
+        )
+    };
+    close(
+        coupled.chatter.first_impact.unwrap(),
+        direct.first_impact.unwrap(),
+        "first impact",
+    );
+    assert_eq!(coupled.chatter.bounce_count, direct.bounce_count);
+    close(
+        coupled.chatter.settle_time.unwrap(),
+        direct.settle_time.unwrap(),
+        "settle",
+    );
+    // The armature reaches the pole face after the make, in both.
+    assert!(!run.pole_face.is_empty() && !coupled.pole_face.is_empty());
+    close(
+        coupled.pole_face[0].impact_time,
+        run.pole_face[0].impact_time,
+        "first pole-face impact",
+    );
+    assert!(run.pole_face[0].impact_time > direct.first_impact.unwrap());
+}

@@ -129,7 +129,7 @@ impl<'m, 'a, D: Drive> Frozen<'m, 'a, D> {
         let m = model.m;
         let g = m.gap;
         let mut v = 0.5 * m.stiffness * xa * xa + m.preload * xa
-            - model.drive.frozen_work(self.t, self.e, 0.0, xa);
+            - model.drive.held_work(self.t, self.e, 0.0, xa);
         match &model.build.blade {
             Some(b) => {
                 v += 0.5 * b.stiffness * (xa - xb) * (xa - xb);
