@@ -104,6 +104,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         contact: None,
         probes: panels,
         arcs: Vec::new(),
+        pole_face: Vec::new(),
     };
     std::fs::write(&out, svg::render(&plot)?)?;
     eprintln!("wrote {}", out.display());
