@@ -73,6 +73,21 @@ pub fn render(chatter: &Chatter) -> String {
     out
 }
 
+/// The pole face in one line: how often the armature hit it, and when
+/// first.
+fn pole_face_line(impacts: &[crate::chatter::Impact]) -> String {
+    match impacts.first() {
+        None => "the armature never reached the pole face".to_owned(),
+        Some(first) => format!(
+            "{} pole-face impact{}, the first at {} ({})",
+            impacts.len(),
+            if impacts.len() == 1 { "" } else { "s" },
+            ms(Some(first.impact_time)),
+            engineering(first.impact_velocity, "m/s"),
+        ),
+    }
+}
+
 /// The armature's impacts on the pole face, as a table under the
 /// contact's (a relay with a pole face).
 pub fn pole_face(impacts: &[crate::chatter::Impact]) -> String {
@@ -154,7 +169,11 @@ pub fn render_run(run: &RunResult) -> String {
     if w.widened_closures() > 0 {
         let _ = write!(contact, ", {} touches widened", w.widened_closures());
     }
-    let mut lines = vec![("relay", relay), ("contact", contact), ("circuit", circuit)];
+    let mut lines = vec![("relay", relay)];
+    if let Some(impacts) = &run.pole_face {
+        lines.push(("pole", pole_face_line(impacts)));
+    }
+    lines.extend([("contact", contact), ("circuit", circuit)]);
     if let Some(passes) = &run.coupling {
         let last = passes.last().map_or(f64::NAN, |p| p.change);
         lines.push((

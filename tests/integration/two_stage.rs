@@ -448,3 +448,150 @@ fn the_integrating_and_the_exact_engines_agree() {
         assert_eq!(exact.pole_face.len(), integrated.pole_face.len());
     }
 }
+
+#[test]
+fn hunt_crossley_and_rigid_surfaces_work_on_both_stops() {
+    use chatterspice::mechanics::surface::hunt_crossley_chi;
+    let m = armature();
+    let hc = Surface::HuntCrossley {
+        stiffness: 1e9,
+        exponent: 1.5,
+        chi: hunt_crossley_chi(0.8, 0.3).unwrap(),
+    };
+    let rigid = Surface::Rigid { restitution: 0.5 };
+    for (contact_law, pole_law) in [(hc, rigid), (rigid, hc)] {
+        let relay = TwoStage {
+            blade: Some(BLADE),
+            pole_face: Some(PoleFace {
+                overtravel: OVERTRAVEL,
+                surface: pole_law,
+                release: Release::Position,
+            }),
+            release: Release::Position,
+        };
+        let stops = Stops {
+            make: contact_law,
+            back: None,
+        };
+        let run = simulate_two_stage(
+            &m,
+            &relay,
+            &stops,
+            &Settings::default(),
+            Drive::Step,
+            Horizon::Closing,
+        )
+        .unwrap();
+        let c = &run.contact;
+        assert!(
+            c.outcome.is_closed(),
+            "{contact_law:?} / {pole_law:?}: {:?}",
+            c.outcome
+        );
+        assert!(c.impacts.len() > 1 && !run.pole_face.is_empty());
+        // Every contact releases before the next touch, in time order.
+        for pair in c.impacts.windows(2) {
+            let released = pair[0].release_time.expect("an earlier contact released");
+            assert!(pair[0].impact_time <= released && released <= pair[1].impact_time);
+        }
+    }
+}
+
+/// The one-mass model with a Kelvin–Voigt contact released by force,
+/// integrated as [`Reference`] does.
+fn one_mass_released_by_force(m: &Mechanics, t_end: f64, h: f64) -> Vec<(f64, bool)> {
+    let (s0, r0) = CONTACT;
+    let g = m.gap;
+    let rate = |y: [f64; 2], engaged: bool| {
+        let fc = if engaged {
+            s0 * (y[0] - g) + r0 * y[1]
+        } else {
+            0.0
+        };
+        [
+            y[1],
+            (m.force - m.stiffness * y[0] - m.damping * y[1] - fc) / m.mass,
+        ]
+    };
+    let rk4 = |y: [f64; 2], h: f64, c: bool| {
+        let k1 = rate(y, c);
+        let k2 = rate([y[0] + h / 2.0 * k1[0], y[1] + h / 2.0 * k1[1]], c);
+        let k3 = rate([y[0] + h / 2.0 * k2[0], y[1] + h / 2.0 * k2[1]], c);
+        let k4 = rate([y[0] + h * k3[0], y[1] + h * k3[1]], c);
+        [
+            y[0] + h / 6.0 * (k1[0] + 2.0 * k2[0] + 2.0 * k3[0] + k4[0]),
+            y[1] + h / 6.0 * (k1[1] + 2.0 * k2[1] + 2.0 * k3[1] + k4[1]),
+        ]
+    };
+    let guard = |y: [f64; 2], c: bool| {
+        let delta = y[0] - g;
+        let push = s0 * delta + r0 * y[1];
+        if c {
+            delta.min(push)
+        } else {
+            (-delta).max(-push)
+        }
+    };
+    let (mut y, mut c, mut t) = ([0.0, 0.0], false, 0.0);
+    let mut out = Vec::new();
+    while t < t_end {
+        let next = rk4(y, h, c);
+        if guard(next, c) >= 0.0 {
+            y = next;
+            t += h;
+            continue;
+        }
+        let (mut lo, mut hi) = (0.0, h);
+        for _ in 0..80 {
+            let mid = 0.5 * (lo + hi);
+            if guard(rk4(y, mid, c), c) < 0.0 {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        y = rk4(y, hi, c);
+        t += hi;
+        c = !c;
+        out.push((t, c));
+    }
+    out
+}
+
+#[test]
+fn a_one_mass_contact_released_by_force_agrees_with_an_independent_integration() {
+    let m = armature();
+    let relay = TwoStage {
+        blade: None,
+        pole_face: None,
+        release: Release::Force,
+    };
+    let run = simulate_two_stage(
+        &m,
+        &relay,
+        &contact(),
+        &Settings::default(),
+        Drive::Step,
+        Horizon::Closing,
+    )
+    .unwrap();
+    let horizon = run.contact.settle_time.unwrap() + 1e-4;
+    let reference = one_mass_released_by_force(&m, horizon, 2e-9);
+    let mut engine = Vec::new();
+    for i in &run.contact.impacts {
+        engine.push((i.impact_time, true));
+        if let Some(r) = i.release_time {
+            engine.push((r, false));
+        }
+    }
+    assert_eq!(engine.len(), reference.len(), "{engine:?}\n{reference:?}");
+    for (a, b) in engine.iter().zip(&reference) {
+        assert_eq!(a.1, b.1);
+        close(a.0, b.0, 1e-6, "event time");
+    }
+    // Released by force, the contact is shorter than by position.
+    let by_position = simulate(&m, &contact().make, &Settings::default()).unwrap();
+    let (f, p) = (&run.contact.impacts[0], &by_position.impacts[0]);
+    assert!(f.contact_time.unwrap() < p.contact_time.unwrap());
+    assert!(f.restitution.unwrap() > p.restitution.unwrap());
+}
