@@ -179,7 +179,9 @@ pub fn quantity(value: f64, unit: &str) -> String {
 #[non_exhaustive]
 pub enum CheckError {
     /// Nothing to check: the scenario has no `[limits]` and no probe with
-    /// a limit (for [`relay_only`], no `[limits]`).
+    /// a limit. Not returned by this version's checks, which report the
+    /// figures and pass when there is nothing to hold; kept for callers
+    /// that match on it.
     #[error(
         "{}: nothing to check: add a [limits] section (max_bounce_time, max_bounces, \
          max_operate_time, max_settle_time; with a coil max_release_time, \
@@ -195,6 +197,27 @@ pub enum CheckError {
     /// alone of a coil-driven relay).
     #[error(transparent)]
     Scenario(#[from] ScenarioError),
+    /// The two-stage relay, or a coil on its DC step, could not be
+    /// simulated.
+    #[error("{}: the mechanics simulation failed", path.display())]
+    Motion {
+        /// The scenario file.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: crate::mechanics::DriveError,
+    },
+    /// A coil-driven relay without its driver circuit needs the voltage
+    /// of its DC step.
+    #[error(
+        "{}: a coil-driven relay without its driver circuit is checked on an ideal DC step \
+         of its coil voltage: give `coil.drive_voltage` (V) or `datasheet.coil_voltage`",
+        path.display()
+    )]
+    NoDriveVoltage {
+        /// The scenario file.
+        path: PathBuf,
+    },
     /// The mechanics simulation failed.
     #[error("{}: the mechanics simulation failed", path.display())]
     Mechanics {
@@ -487,9 +510,10 @@ pub fn run_with(
     runner: &dyn Runner,
     options: &RunOptions,
 ) -> Result<(Verdict, Evidence), CheckError> {
-    let probe_limits = limits_to_hold(scenario)?;
-    // A coil-driven relay moves only in its driver circuit.
-    if probe_limits || scenario.coil.is_some() {
+    let probe_limits = needs_circuit(scenario);
+    // A coil-driven relay moves in its driver circuit when it has one;
+    // without one, on the ideal DC step of its coil voltage.
+    if probe_limits || (scenario.coil.is_some() && scenario.circuit.is_some()) {
         let result = pipeline::run(scenario, runner, options).map_err(Box::new)?;
         return Ok((evaluate(scenario, &result), Evidence::Run(Box::new(result))));
     }
@@ -506,18 +530,6 @@ pub fn needs_circuit(scenario: &Scenario) -> bool {
     scenario.probes.iter().any(Probe::has_limits) || arc_limits
 }
 
-/// Whether a limit needs the circuit; an error when nothing at all is
-/// limited.
-fn limits_to_hold(scenario: &Scenario) -> Result<bool, CheckError> {
-    let probe_limits = needs_circuit(scenario);
-    if scenario.limits.is_none() && !probe_limits {
-        return Err(CheckError::NoLimits {
-            path: scenario.origin.clone(),
-        });
-    }
-    Ok(probe_limits)
-}
-
 /// Check `scenario` against a measured chatter sequence (a scope record)
 /// instead of its mechanics: the `[limits]` on the record alone, and, when
 /// a probe has a limit and a `runner` is given, the record switching the
@@ -528,7 +540,7 @@ pub fn measured(
     runner: Option<&dyn Runner>,
     options: &RunOptions,
 ) -> Result<(Verdict, Evidence), CheckError> {
-    let probe_limits = limits_to_hold(scenario)?;
+    let probe_limits = needs_circuit(scenario);
     if let (true, Some(runner)) = (probe_limits, runner) {
         let result =
             pipeline::run_measured(scenario, intervals, runner, options).map_err(Box::new)?;
@@ -560,26 +572,63 @@ pub fn measured(
 /// # Ok::<(), chatterspice::check::CheckError>(())
 /// ```
 pub fn relay_only(scenario: &Scenario) -> Result<(Verdict, Evidence), CheckError> {
-    if scenario.limits.is_none() {
-        return Err(CheckError::NoLimits {
-            path: scenario.origin.clone(),
-        });
-    }
-    let chatter = simulate(
-        &scenario.mechanics()?,
-        &scenario.surface(),
-        &scenario.settings(),
-    )
-    .map_err(|source| CheckError::Mechanics {
-        path: scenario.origin.clone(),
-        source,
-    })?;
+    let chatter = relay_chatter(scenario)?;
     let checks = scenario
         .limits
         .as_ref()
         .map(|l| relay_checks(l, &chatter, &[]))
         .unwrap_or_default();
     Ok((Verdict::new(checks), Evidence::Mechanics(chatter)))
+}
+
+/// The relay's own closing, as built, without a circuit: the step force
+/// (the exact one-mass engine, or the two-stage one), or for a coil-driven
+/// relay the ideal DC step of `coil.drive_voltage` (else
+/// `datasheet.coil_voltage`) on its coil, as a datasheet measures.
+pub fn relay_chatter(scenario: &Scenario) -> Result<Chatter, CheckError> {
+    let path = || scenario.origin.clone();
+    let build = scenario.two_stage();
+    if let Some(section) = &scenario.coil {
+        let voltage = scenario
+            .dc_step_voltage()
+            .ok_or_else(|| CheckError::NoDriveVoltage { path: path() })?;
+        let (chatter, _) = crate::coil::direct::direct_closing(
+            &crate::coil::Coil::from(section),
+            &crate::coil::Source {
+                voltage,
+                series_resistance: 0.0,
+            },
+            &scenario.armature(),
+            &build,
+            &scenario.surface(),
+            &scenario.settings(),
+        )
+        .map_err(|source| CheckError::Motion {
+            path: path(),
+            source,
+        })?;
+        return Ok(chatter);
+    }
+    let mechanics = scenario.mechanics()?;
+    if build.is_one_mass() {
+        return simulate(&mechanics, &scenario.surface(), &scenario.settings()).map_err(|source| {
+            CheckError::Mechanics {
+                path: path(),
+                source,
+            }
+        });
+    }
+    crate::mechanics::two_stage::step_closing(
+        &mechanics,
+        &build,
+        &scenario.surface(),
+        &scenario.settings(),
+    )
+    .map(crate::mechanics::Trajectory::into_chatter)
+    .map_err(|source| CheckError::Motion {
+        path: path(),
+        source,
+    })
 }
 
 #[cfg(test)]

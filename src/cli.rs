@@ -346,7 +346,6 @@ fn bounce(args: &BounceArgs) -> Result<()> {
         return emit(&text, args.output.as_deref(), args.force);
     }
     let scenario = load_scenario(args.scenario.as_deref())?;
-    let mechanics = scenario.mechanics()?;
     let surface = scenario.surface();
     let build = scenario.two_stage();
     let failed = || {
@@ -355,11 +354,21 @@ fn bounce(args: &BounceArgs) -> Result<()> {
             scenario.origin.display()
         )
     };
-    let dimensionless = Dimensionless::of(&mechanics, &surface);
-    let text = if build.is_one_mass() {
+    let text = if scenario.coil.is_some() {
+        let (chatter, run) = coil_step(&scenario).with_context(failed)?;
+        let pole_face = build
+            .pole_face
+            .is_some()
+            .then(|| run.as_ref().map_or(&[][..], |r| &r.pole_face[..]));
+        report::render_two_stage(args.format.into(), &chatter, None, pole_face)
+    } else if build.is_one_mass() {
+        let mechanics = scenario.mechanics()?;
+        let dimensionless = Dimensionless::of(&mechanics, &surface);
         let chatter = simulate(&mechanics, &surface, &scenario.settings()).with_context(failed)?;
         report::render(args.format.into(), &chatter, Some(&dimensionless))
     } else {
+        let mechanics = scenario.mechanics()?;
+        let dimensionless = Dimensionless::of(&mechanics, &surface);
         let trajectory = chatterspice::mechanics::two_stage::step_closing(
             &mechanics,
             &build,
@@ -379,6 +388,38 @@ fn bounce(args: &BounceArgs) -> Result<()> {
         )
     };
     emit(&text, args.output.as_deref(), args.force)
+}
+
+/// A coil-driven relay without its driver circuit: the ideal DC step of
+/// `coil.drive_voltage` (else `datasheet.coil_voltage`) on the coil from
+/// t = 0, as a datasheet measures it. The closing's chatter, and the
+/// two-stage record when the relay has a blade.
+fn coil_step(
+    scenario: &Scenario,
+) -> Result<(
+    chatterspice::Chatter,
+    Option<chatterspice::mechanics::two_stage::TwoStageRun>,
+)> {
+    let section = scenario.coil.as_ref().expect("a coil-driven scenario");
+    let voltage = scenario.dc_step_voltage().with_context(|| {
+        format!(
+            "{}: a coil-driven relay without its driver circuit is simulated on an ideal DC \
+             step of its coil voltage: give `coil.drive_voltage` (V) or \
+             `datasheet.coil_voltage`",
+            scenario.origin.display()
+        )
+    })?;
+    Ok(chatterspice::coil::direct::direct_closing(
+        &chatterspice::coil::Coil::from(section),
+        &chatterspice::coil::Source {
+            voltage,
+            series_resistance: 0.0,
+        },
+        &scenario.armature(),
+        &scenario.two_stage(),
+        &scenario.surface(),
+        &scenario.settings(),
+    )?)
 }
 
 fn run(args: &RunArgs) -> Result<()> {
@@ -438,7 +479,8 @@ fn run(args: &RunArgs) -> Result<()> {
 
 fn check(args: &CheckArgs) -> Result<Status> {
     let scenario = load_scenario(args.scenario.as_deref())?;
-    let needs_ngspice = scenario.coil.is_some() || check::needs_circuit(&scenario);
+    let needs_ngspice =
+        (scenario.coil.is_some() && scenario.circuit.is_some()) || check::needs_circuit(&scenario);
     let options = args.simulator.run_options();
     let (verdict, evidence) = if let Some(csv) = &args.measured {
         let intervals = read_measured(csv)?;
@@ -530,6 +572,16 @@ fn pwl(args: &PwlArgs) -> Result<()> {
             let intervals = read_measured(csv)?;
             let gap = pipeline::record_gap(&scenario, &intervals);
             (Waveform::from_intervals(&intervals, &model)?, gap)
+        }
+        None if scenario.coil.is_some() => {
+            let (chatter, _) = coil_step(&scenario).with_context(|| {
+                format!(
+                    "{}: the mechanics simulation failed",
+                    scenario.origin.display()
+                )
+            })?;
+            let gap = pipeline::record_gap(&scenario, &chatter.intervals);
+            (pipeline::contact_waveform(&scenario, &chatter)?.0, gap)
         }
         None => {
             let (mechanics, surface, settings) = (

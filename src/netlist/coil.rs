@@ -115,6 +115,7 @@ mod tests {
             pole_area: 2e-5,
             air_gap: 6e-4,
             iron_gap: 5e-5,
+            drive_voltage: None,
         }
     }
 

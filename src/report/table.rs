@@ -392,6 +392,13 @@ pub fn render_check(verdict: &Verdict, chatter: &Chatter, operations: &[Operatio
         from_coil_on(&closing),
     );
     out.push('\n');
+    if verdict.checks.is_empty() {
+        out.push_str(
+            "no limits to hold: add a [limits] section or limits on a [[probe]] to check \
+             these figures against\n",
+        );
+        return out;
+    }
     let mut rows =
         vec![["", "limit", "quantity", "actual", "", "limit", "margin"].map(String::from)];
     for c in &verdict.checks {

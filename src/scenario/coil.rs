@@ -17,6 +17,11 @@ pub struct CoilSection {
     pub air_gap: f64,
     /// m, the iron path as an equivalent air gap.
     pub iron_gap: f64,
+    /// V, the ideal DC step that `bounce` and `pwl` (and any command run
+    /// without a circuit that holds the coil) put on the coil at t = 0, as
+    /// a datasheet measures; without it, `datasheet.coil_voltage`.
+    #[serde(default)]
+    pub drive_voltage: Option<f64>,
 }
 
 impl Check<'_> {
@@ -54,7 +59,16 @@ impl Check<'_> {
             c.iron_gap,
             c.iron_gap >= 0.0,
             "must be ≥ 0: the iron path as an equivalent air gap, in m",
-        )
+        )?;
+        if let Some(v) = c.drive_voltage {
+            self.number(
+                "coil.drive_voltage",
+                v,
+                v > 0.0 && v <= 1e5,
+                "must be > 0: the DC voltage stepped onto the coil at t = 0, in V",
+            )?;
+        }
+        Ok(())
     }
 }
 

@@ -291,6 +291,33 @@ impl Scenario {
         })
     }
 
+    /// The armature's mechanics whatever drives it: [`Scenario::mechanics`]
+    /// with the force of a coil-driven relay at 0 (its coil makes it).
+    pub fn armature(&self) -> Mechanics {
+        let m = &self.mechanics;
+        Mechanics {
+            mass: m.mass,
+            stiffness: m.stiffness,
+            damping: m.damping,
+            force: m.force.unwrap_or(0.0),
+            gap: m.gap,
+            initial_position: m.initial_position,
+            initial_velocity: m.initial_velocity,
+            preload: m.preload,
+        }
+    }
+
+    /// V, the ideal DC step a coil-driven relay gets without its driver
+    /// circuit: `coil.drive_voltage`, else `datasheet.coil_voltage`;
+    /// `None` without a `[coil]` or without either key.
+    pub fn dc_step_voltage(&self) -> Option<f64> {
+        self.coil.as_ref()?;
+        self.coil
+            .as_ref()
+            .and_then(|c| c.drive_voltage)
+            .or(self.datasheet.as_ref().and_then(|d| d.coil_voltage))
+    }
+
     /// The surface law, with a Hunt–Crossley restitution already converted
     /// to χ.
     pub fn surface(&self) -> Surface {

@@ -136,16 +136,70 @@ fn relay_limits_alone_need_no_ngspice() {
 }
 
 #[test]
-fn nothing_to_check_or_a_bad_limit_is_bad_input() {
+fn a_check_without_limits_reports_the_figures_and_passes() {
     let dir = tempfile::tempdir().unwrap();
     let path = scenario(dir.path(), "", "");
     chatterspice()
         .args(["check", path.to_str().unwrap()])
         .assert()
-        .code(2)
-        .stderr(
-            predicate::str::contains("nothing to check").and(predicate::str::contains("[limits]")),
+        .code(0)
+        .stdout(
+            predicate::str::contains("no limits to hold").and(predicate::str::contains("bounces")),
         );
+    let out = chatterspice()
+        .args(["check", path.to_str().unwrap(), "--format", "json"])
+        .assert()
+        .code(0);
+    let v: Value = serde_json::from_slice(&out.get_output().stdout).unwrap();
+    assert_eq!(v["passed"], true, "{v}");
+    assert_eq!(v["checks"].as_array().map(Vec::len), Some(0));
+    assert!(v["bounce"]["bounce_count"].as_u64().unwrap() > 0, "{v}");
+}
+
+#[test]
+fn a_bundled_part_is_checked_and_bounced_on_its_dc_step_without_ngspice() {
+    let part = concat!(env!("CARGO_MANIFEST_DIR"), "/parts/omron-g5le-1-dc5.toml");
+    for command in ["check", "bounce"] {
+        let out = chatterspice()
+            .args([command, part, "--format", "json"])
+            .env("PATH", "/nonexistent")
+            .assert()
+            .code(0);
+        let v: Value = serde_json::from_slice(&out.get_output().stdout).unwrap();
+        let bounce = if command == "check" { &v["bounce"] } else { &v };
+        // The part's datasheet: operate 10 ms max. at 5 V; the nominal
+        // relay makes at its coil voltage.
+        let first = bounce["first_impact"].as_f64().expect("it makes");
+        assert!(first > 0.0 && first <= 10.0e-3 * 1.001, "{v}");
+    }
+}
+
+#[test]
+fn a_coil_without_a_circuit_or_a_voltage_names_the_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("coil.toml");
+    std::fs::write(
+        &path,
+        "[mechanics]\nmass = 2e-4\nstiffness = 800.0\ndamping = 0.04\npreload = 0.1\ngap = 4.5e-4\n\
+         [coil]\nresistance = 70.0\nturns = 3000\npole_area = 2e-5\nair_gap = 6e-4\niron_gap = 5e-5\n\
+         [surface]\nlaw = \"kelvin-voigt\"\nstiffness = 8e4\ndamping = 0.37536\n",
+    )
+    .unwrap();
+    for command in ["check", "bounce", "pwl"] {
+        chatterspice()
+            .args([command, path.to_str().unwrap()])
+            .assert()
+            .code(2)
+            .stderr(
+                predicate::str::contains("coil.drive_voltage")
+                    .and(predicate::str::contains("datasheet.coil_voltage")),
+            );
+    }
+}
+
+#[test]
+fn a_bad_limit_is_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
     let path = scenario(dir.path(), "", "max_bounce_time = -1.0");
     chatterspice()
         .args(["check", path.to_str().unwrap()])

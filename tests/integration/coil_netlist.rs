@@ -20,6 +20,7 @@ const COIL: CoilSection = CoilSection {
     pole_area: 2e-5,
     air_gap: 6e-4,
     iron_gap: 5e-5,
+    drive_voltage: None,
 };
 
 fn inductance(x: f64) -> f64 {
