@@ -360,6 +360,32 @@ pub struct ProbeAnalysis {
     /// starting level (and usually its return: two edges). `glitches` of a
     /// current counts the pulses after the first. `None` for a voltage.
     pub pulses: Option<usize>,
+    /// What a debouncer of this signal must cover; `None` without an edge.
+    pub debounce: Option<Debounce>,
+}
+
+/// The two figures a designer sizes a debouncer with, from a probe's
+/// edges.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Debounce {
+    /// s, last edge − first edge: a debouncer that ignores its input for
+    /// T after the first edge needs T > lockout.
+    pub lockout: f64,
+    /// s, the longest time between two consecutive edges: a debouncer
+    /// that waits for its input to be stable for T needs T > stable_for
+    /// (0 with a single edge).
+    pub stable_for: f64,
+}
+
+impl Debounce {
+    /// The figures of edges at `times` (s, in order); `None` without one.
+    pub fn of(times: &[f64]) -> Option<Debounce> {
+        let (first, last) = (times.first()?, times.last()?);
+        Some(Debounce {
+            lockout: last - first,
+            stable_for: times.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max),
+        })
+    }
 }
 
 impl ProbeAnalysis {
@@ -539,6 +565,7 @@ pub fn analyze_samples(
         _ => None,
     };
     let edges = &schmitt.edges;
+    let times: Vec<f64> = edges.iter().map(|e| e.time).collect();
     // A current pulse is two edges (it rises and falls): count pulses.
     let pulses = (kind == ProbeKind::Current).then(|| edges.len().div_ceil(2));
     Ok(ProbeAnalysis {
@@ -562,6 +589,7 @@ pub fn analyze_samples(
         shortest_pulse: edges.iter().filter_map(|e| e.width).min_by(f64::total_cmp),
         transitions: schmitt.edges,
         current,
+        debounce: Debounce::of(&times),
     })
 }
 
@@ -816,6 +844,21 @@ fn window(time: &[f64], values: &[f64], a: f64, b: f64) -> Window {
         previous = Some((t, v));
     }
     w
+}
+
+#[cfg(test)]
+mod debounce_tests {
+    use super::Debounce;
+
+    #[test]
+    fn lockout_spans_the_edges_and_stable_for_is_the_longest_gap() {
+        let d = Debounce::of(&[1.0e-3, 1.2e-3, 1.25e-3, 1.9e-3, 2.0e-3]).unwrap();
+        assert!((d.lockout - 1.0e-3).abs() < 1e-15);
+        assert!((d.stable_for - 0.65e-3).abs() < 1e-15);
+        let one = Debounce::of(&[3e-3]).unwrap();
+        assert_eq!((one.lockout, one.stable_for), (0.0, 0.0));
+        assert_eq!(Debounce::of(&[]), None);
+    }
 }
 
 #[cfg(test)]

@@ -443,27 +443,31 @@ fn signed(value: f64, unit: &str) -> String {
 }
 
 /// The columns of [`probe_row`].
-const PROBE_HEADER: [&str; 8] = [
+const PROBE_HEADER: [&str; 10] = [
     "probe",
     "edges",
     "glitches",
     "first edge",
     "last edge",
     "shortest pulse",
+    "lockout",
+    "stable for",
     "min",
     "max",
 ];
 
-fn probe_row(label: &str, a: &ProbeAnalysis) -> [String; 8] {
+fn probe_row(label: &str, a: &ProbeAnalysis) -> [String; 10] {
     let unit = a.kind.unit();
+    let time = |t: Option<f64>| t.map_or_else(|| ABSENT.to_owned(), |t| engineering(t, "s"));
     [
         label.to_owned(),
         a.edges.to_string(),
         a.glitches.to_string(),
         ms(a.first_edge),
         ms(a.last_edge),
-        a.shortest_pulse
-            .map_or_else(|| ABSENT.to_owned(), |t| engineering(t, "s")),
+        time(a.shortest_pulse),
+        time(a.debounce.map(|d| d.lockout)),
+        time(a.debounce.map(|d| d.stable_for)),
         engineering(a.min, unit),
         engineering(a.max, unit),
     ]

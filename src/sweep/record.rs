@@ -74,6 +74,10 @@ pub struct ProbeRecord {
     pub peak: f64,
     /// Schmitt edges with an ideal contact, when that ran too.
     pub ideal_edges: Option<usize>,
+    /// s, last edge − first edge (`None` without an edge).
+    pub lockout: Option<f64>,
+    /// s, the longest time between two consecutive edges.
+    pub stable_for: Option<f64>,
 }
 
 /// What one sample gave: a row of `sweep.csv`.

@@ -355,12 +355,16 @@ fn parse_row(
     for _ in 0..signals {
         let edges = count(next())?;
         let peak = number(next())?;
+        let lockout = number(next())?;
+        let stable_for = number(next())?;
         let ideal_edges = if columns.ideal { count(next())? } else { None };
         if let (Some(edges), Some(peak)) = (edges, peak) {
             probes.push(ProbeRecord {
                 edges,
                 peak,
                 ideal_edges,
+                lockout,
+                stable_for,
             });
         }
     }
@@ -430,6 +434,8 @@ mod tests {
                 edges: 7,
                 peak: 3.3,
                 ideal_edges: Some(1),
+                lockout: Some(2e-4),
+                stable_for: Some(1e-4),
             }],
             verdict: Verdict::Fail,
             failed_limits: vec!["limits.max_bounces".into(), "probe[0].max_edges".into()],

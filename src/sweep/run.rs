@@ -451,6 +451,8 @@ fn record_probes(record: &mut Record, result: &RunResult) {
             edges: p.analysis.edges,
             peak: p.analysis.max.abs().max(p.analysis.min.abs()),
             ideal_edges: p.ideal.as_ref().map(|i| i.edges),
+            lockout: p.analysis.debounce.map(|d| d.lockout),
+            stable_for: p.analysis.debounce.map(|d| d.stable_for),
         })
         .collect();
     if let Some(arcs) = &result.arcs {

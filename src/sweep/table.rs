@@ -8,7 +8,8 @@
 //! of its operations: coil off → break, and the bounce on the rest stop);
 //! with `[arc]` `arc_count`, `arc_energy` (J, all arcs of the run) and
 //! `breakdowns`; then per probe
-//! `<signal>.edges` and `<signal>.peak` (max |value|, V or A), then
+//! `<signal>.edges`, `<signal>.peak` (max |value|, V or A),
+//! `<signal>.lockout` and `<signal>.stable_for` (s, the debounce figures), then
 //! `verdict` (`pass`, `fail`, `error`; see [`super::verdict`]),
 //! `failed_limits` (the keys of the limits that failed, space-separated,
 //! e.g. `limits.max_bounce_time probe[0].max_edges`) and `error` (why the
@@ -72,6 +73,8 @@ pub fn header(keys: &[String], signals: &[String], columns: Columns) -> Vec<u8> 
     for s in signals {
         names.push(format!("{s}.edges"));
         names.push(format!("{s}.peak"));
+        names.push(format!("{s}.lockout"));
+        names.push(format!("{s}.stable_for"));
         if ideal {
             names.push(format!("{s}.ideal_edges"));
         }
@@ -91,7 +94,7 @@ pub fn width(keys: usize, signals: usize, columns: Columns) -> usize {
         + OUTCOME_COLUMNS.len()
         + if coil { RELEASE_COLUMNS.len() } else { 0 }
         + if arc { ARC_COLUMNS.len() } else { 0 }
-        + signals * if ideal { 3 } else { 2 }
+        + signals * if ideal { 5 } else { 4 }
         + 3
 }
 
@@ -141,6 +144,8 @@ pub fn rows(records: &[Record], keys: usize, probes: usize, columns: Columns) ->
             w.write_field(p.map_or_else(String::new, |p| p.edges.to_string()))
                 .expect("writing to memory");
             number(&mut w, p.map(|p| p.peak));
+            number(&mut w, p.and_then(|p| p.lockout));
+            number(&mut w, p.and_then(|p| p.stable_for));
             if ideal {
                 w.write_field(
                     p.and_then(|p| p.ideal_edges)
@@ -514,6 +519,8 @@ mod tests {
                 edges: 5,
                 peak: 3.3,
                 ideal_edges: None,
+                lockout: None,
+                stable_for: None,
             }],
             verdict: Verdict::Pass,
             failed_limits: vec![],
@@ -528,7 +535,7 @@ mod tests {
         assert_eq!(
             String::from_utf8(h).unwrap(),
             "index,mechanics.mass,surface.damping,outcome,bounce_count,first_impact,settle_time,\
-             bounce_time,\"v(a,b).edges\",\"v(a,b).peak\",verdict,failed_limits,error\n"
+             bounce_time,\"v(a,b).edges\",\"v(a,b).peak\",\"v(a,b).lockout\",\"v(a,b).stable_for\",verdict,failed_limits,error\n"
         );
         let mut failed = record(1);
         failed.probes.clear();
@@ -540,13 +547,13 @@ mod tests {
         let text = String::from_utf8(rows(&[record(0)], 2, 1, Columns::default())).unwrap();
         assert_eq!(
             text,
-            "0,0.00015,0.25,stuck,3,0.001,0.002,0.001,5,3.3,pass,,\n"
+            "0,0.00015,0.25,stuck,3,0.001,0.002,0.001,5,3.3,,,pass,,\n"
         );
         failed.values.clear();
         let text = String::from_utf8(rows(&[failed], 2, 1, Columns::default())).unwrap();
         assert_eq!(
             text,
-            "1,,,,,0.001,0.002,0.001,,,error,,\"ngspice failed: timeout, 60 s\"\n"
+            "1,,,,,0.001,0.002,0.001,,,,,error,,\"ngspice failed: timeout, 60 s\"\n"
         );
     }
 

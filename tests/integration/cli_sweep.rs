@@ -84,7 +84,7 @@ fn ngspice_csv_is_the_same_for_one_and_two_jobs() {
     assert_eq!(
         lines.next().unwrap(),
         "index,mechanics.force,mechanics.mass,surface.damping,outcome,bounce_count,\
-         first_impact,settle_time,bounce_time,v(in).edges,v(in).peak,verdict,failed_limits,error"
+         first_impact,settle_time,bounce_time,v(in).edges,v(in).peak,v(in).lockout,v(in).stable_for,verdict,failed_limits,error"
     );
     let rows: Vec<&str> = lines.collect();
     assert_eq!(rows.len(), 6);

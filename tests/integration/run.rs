@@ -78,6 +78,27 @@ fn with_no_filter_every_bounce_is_an_edge_pair() {
     assert_eq!(result.probes[0].ideal.as_ref().unwrap().edges, 1);
     assert_eq!(cmp.extra_edges, 2 * chatter.bounce_count as i64);
     assert!((cmp.settle_delay.unwrap() - (settle - first)).abs() < 2.0 * 1e-8);
+
+    // The debounce figures: a lockout from the first make to the last, and
+    // the longest stable stretch inside the chatter, which with no filter
+    // is the mechanics' longest interval between a make and a break, or a
+    // break and the next make.
+    let debounce = probe.debounce.expect("edges, so figures");
+    let edge = 2.0 * scenario.contact.edge_time;
+    assert!(
+        (debounce.lockout - (settle - first)).abs() < edge,
+        "{debounce:?}"
+    );
+    let longest = chatter
+        .intervals
+        .iter()
+        .filter(|iv| iv.start >= first && iv.end <= settle)
+        .map(|iv| iv.end - iv.start)
+        .fold(0.0, f64::max);
+    assert!(
+        (debounce.stable_for - longest).abs() < edge,
+        "{debounce:?} vs {longest}"
+    );
 }
 
 #[test]
