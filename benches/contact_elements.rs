@@ -269,6 +269,7 @@ fn run_netlist(ng: &Ngspice, inc: &Include, w: &Waveform, stop: f64, netlist: &s
         probes: &["v(in)"],
         chatter_end: end.min(stop),
         stop_at_least: end.min(stop),
+        options: &[],
     })
     .expect("the bench deck is valid");
     let mut req = RunRequest::new(deck.text);

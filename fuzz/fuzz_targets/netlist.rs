@@ -40,6 +40,7 @@ fuzz_target!(|data: &[u8]| {
         probes: &["v(in)"],
         chatter_end: 1e-3,
         stop_at_least: 2e-3,
+        options: &[],
     };
     if let Ok(d) = prepare_deck(&req) {
         deck::check(&d, netlist_path());

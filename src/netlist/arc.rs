@@ -1,8 +1,10 @@
 //! The arc inside ngspice: lines added to the contact subcircuit.
 //!
-//! The contact's own element (the time-varying conductance) stays as it
-//! is, between internal node `a` and terminal `b`; the subcircuit's first
-//! terminal becomes `ax`, joined to `a` by a 0 V source `Vsense` that senses
+//! The include keeps its interface: the contact subcircuit comes first,
+//! with the terminals `a b`. Inside it, the plain contact (the
+//! time-varying conductance) is instantiated as `Xcore` from a helper
+//! subcircuit `<NAME>_core` written after it, between the internal node
+//! `ai` and terminal `b`; a 0 V source `Vsense` from `a` to `ai` senses
 //! the whole contact current. In parallel with the conductance:
 //!
 //! - the **arc state** `st` (1 burning or able to burn, 0 not): a
@@ -24,19 +26,25 @@
 //! Its current is sensed by `Vclamp`, and `Bva` copies the contact voltage to
 //! a node, so the raw file has what the arc analysis needs.
 //!
-//! The include also sets `.options method=gear`: against a capacitance
-//! across the contact (wiring, a snubber) the clamp's 10 kS make a mode
-//! of tens of picoseconds, which the trapezoidal rule, not being
-//! L-stable, turns into an alternation of the arc current from one time
-//! point to the next (measured: 0.02 A and 1.97 A in turn about a 1 A
-//! arc); Gear's method damps it. A netlist's own later `.options method`
-//! wins.
+//! Nothing in the include changes the rest of the user's circuit. Runs
+//! with an arc integrate with Gear's method ([`ARC_OPTIONS`], which the
+//! run deck carries, not the include): against a capacitance across the
+//! contact (wiring, a snubber) the clamp's 10 kS make a mode of tens of
+//! picoseconds, which the trapezoidal rule, not being L-stable, turns
+//! into an alternation of the arc current from one time point to the next
+//! (measured: 0.02 A and 1.97 A in turn about a 1 A arc); Gear's method
+//! damps it. A netlist's own later `.options method` wins. A user who
+//! includes the file in a circuit of their own (KiCad, a hand-written
+//! deck) sets the same option there.
 
 use super::contact::ContactInclude;
 use super::contact::{comment, line, pairs};
 use super::error::NetlistError;
 use crate::arc::{ArcModel, GapProfile};
 use crate::waveform::format_time;
+
+/// The option line a deck that runs the arc include carries.
+pub const ARC_OPTIONS: &str = ".options method=gear";
 
 /// V, the softplus width of the clamp.
 pub const CLAMP_SOFTNESS: f64 = 2e-3;
@@ -93,8 +101,9 @@ pub fn with_arc(
             format_time(model.field)
         ),
     );
-    line(&mut arc, "Vsense ax a 0");
-    line(&mut arc, "Vclamp a ac 0");
+    line(&mut arc, "Vsense a ai 0");
+    line(&mut arc, &format!("Xcore ai b {subckt}_core"));
+    line(&mut arc, "Vclamp ai ac 0");
     let samples = gap.samples();
     line(&mut arc, "Vvarc varc 0 PWL(");
     pairs(
@@ -148,21 +157,25 @@ pub fn with_arc(
             softplus("(-V(ac,b) - V(th))")
         ),
     );
-    line(&mut arc, "Bva va 0 V = V(a,b)");
+    line(&mut arc, "Bva va 0 V = V(ai,b)");
     comment(
         &mut arc,
-        "The clamp is stiff against any capacitance across the contact: the \
-         trapezoidal rule would make the arc current alternate from one time point \
-         to the next, so the run integrates with Gear's method.",
+        "The clamp is stiff against any capacitance across the contact: run the \
+         circuit with `.options method=gear` (the trapezoidal rule would make the arc \
+         current alternate from one time point to the next).",
     );
-    line(&mut arc, ".options method=gear");
 
-    let mut text = String::with_capacity(include.text.len() + arc.len() + 8);
+    // The contact with its arc first, pins `a b`; the plain contact after
+    // it as its helper.
+    let mut text = String::with_capacity(include.text.len() + arc.len() + 64);
     text.push_str(&include.text[..head_at]);
-    text.push_str(&format!(".subckt {subckt} ax b\n"));
-    text.push_str(&include.text[head_at + header.len()..ends_at]);
+    text.push_str(&header);
     text.push_str(&arc);
-    text.push_str(&include.text[ends_at..]);
+    text.push_str(&ends);
+    text.push_str(&format!(".subckt {subckt}_core a b\n"));
+    text.push_str(&include.text[head_at + header.len()..ends_at]);
+    text.push_str(&format!(".ends {subckt}_core\n"));
+    text.push_str(&include.text[ends_at + ends.len()..]);
     include.text = text;
     Ok(include)
 }
@@ -202,15 +215,28 @@ mod tests {
         let plain = include();
         let with = with_arc(plain.clone(), &arc, &gap).unwrap();
         let text = &with.text;
-        assert!(text.contains(".subckt CONTACT ax b\n") && !text.contains(".subckt CONTACT a b"));
-        assert_eq!(text.matches(".ends CONTACT").count(), 1);
+        // The contact first with pins a b; the plain contact after it.
+        let outer = text
+            .find(".subckt CONTACT a b\n")
+            .expect("the contact, pins a b");
+        let core = text.find(".subckt CONTACT_core a b\n").expect("its helper");
+        assert!(outer < core);
+        assert_eq!(text.matches(".ends CONTACT\n").count(), 1);
+        assert_eq!(text.matches(".ends CONTACT_core\n").count(), 1);
+        assert!(text.contains("Xcore ai b CONTACT_core"));
         // The conductance element is untouched, between a and b.
         assert!(text.contains("B1 a b I = V(a,b) * V(g)"));
         // V_arc at the last sample: 12 V + 1e4 V/m · 0.2 mm = 14 V; the
         // breakdown voltage there (Paschen plateau or above) is ≥ 327 V.
         assert!(text.contains(&format!("{} {}", format_time(3e-3), format_time(14.0))));
         assert!(text.contains(".model arc_state sw vt=3.992e-1 vh=8e-4"));
-        assert!(text.contains(".options method=gear"));
+        // Nothing that changes the user's whole circuit.
+        assert!(
+            !text
+                .to_ascii_lowercase()
+                .lines()
+                .any(|l| l.starts_with(".option"))
+        );
         // Not a contact include: an error, not a panic.
         let mut broken = plain;
         broken.text = broken.text.replace(".subckt CONTACT a b", "* gone");

@@ -66,6 +66,10 @@ pub struct DeckRequest<'a> {
     /// s, the stop time the caller wants (chatter end plus a margin): a
     /// `.tran` that stops earlier is a warning.
     pub stop_at_least: f64,
+    /// Option lines the deck carries right after the includes (before the
+    /// netlist's own, so that a later `.options` of the netlist wins),
+    /// e.g. the arc's integration method.
+    pub options: &'a [&'a str],
 }
 
 /// The run deck and what was noticed on the way.
@@ -564,6 +568,9 @@ fn write_deck(
     );
     if let Some((coil_include, _)) = req.coil {
         inliner.push(format!(".include {}", quote_if_needed(coil_include)), None);
+    }
+    for option in req.options {
+        inliner.push((*option).to_owned(), None);
     }
     for (index, (line, fate)) in lines.iter().zip(fates).enumerate().skip(1) {
         match fate {

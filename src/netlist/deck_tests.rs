@@ -57,6 +57,7 @@ fn req<'a>(text: &'a str, probes: &'a [&'a str]) -> DeckRequest<'a> {
         probes,
         chatter_end: 5e-3,
         stop_at_least: 8e-3,
+        options: &[],
     }
 }
 

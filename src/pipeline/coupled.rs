@@ -435,6 +435,11 @@ pub fn run_coupled_plan(
                 probes: &signals,
                 chatter_end: end,
                 stop_at_least: end,
+                options: if arc.is_some() {
+                    &[crate::netlist::arc::ARC_OPTIONS]
+                } else {
+                    &[]
+                },
             },
             &circuit.param_list(),
         )?;

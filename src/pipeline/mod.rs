@@ -402,6 +402,11 @@ fn run_chatter(
             probes: &signals,
             chatter_end: end,
             stop_at_least: end * STOP_MARGIN,
+            options: if arc.is_some() {
+                &[crate::netlist::arc::ARC_OPTIONS]
+            } else {
+                &[]
+            },
         },
         &circuit.param_list(),
     )?;

@@ -466,13 +466,22 @@ fn pwl_emits_the_arc_element_with_arc() {
     assert!(with.status.success());
     let text = String::from_utf8(with.stdout).unwrap();
     for needle in [
-        ".subckt CONTACT ax b",
-        "Vsense ax a 0",
+        ".subckt CONTACT a b",
+        "Vsense a ai 0",
+        "Xcore ai b CONTACT_core",
         "Barc ac b",
-        ".options method=gear",
+        ".subckt CONTACT_core a b",
     ] {
         assert!(text.contains(needle), "{needle}");
     }
+    // The contact first, its helper after; nothing for the whole circuit.
+    assert!(text.find(".subckt CONTACT a b").unwrap() < text.find(".subckt CONTACT_core").unwrap());
+    assert!(
+        !text
+            .lines()
+            .any(|l| l.trim_start().to_ascii_lowercase().starts_with(".option")),
+        "{text}"
+    );
     let without = cli()
         .args([
             "pwl",

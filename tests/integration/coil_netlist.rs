@@ -126,6 +126,7 @@ fn decay_time(netlist: &str) -> Option<f64> {
         probes: &[],
         chatter_end: 0.0,
         stop_at_least: 0.0,
+        options: &[],
     })
     .unwrap();
     let mut req = RunRequest::new(deck.text);

@@ -107,6 +107,7 @@ fn run_pullup(
         probes: &["v(in)"],
         chatter_end: stop,
         stop_at_least: stop,
+        options: &[],
     })
     .unwrap();
     let mut req = RunRequest::new(deck.text.clone());
@@ -368,6 +369,7 @@ fn deck_error(file: &str) -> NetlistError {
         probes: &["v(in)"],
         chatter_end: 4e-4,
         stop_at_least: 6e-4,
+        options: &[],
     })
     .unwrap_err()
 }
@@ -443,6 +445,7 @@ fn instance_in_an_included_file_counts() {
         probes: &[],
         chatter_end: 4e-4,
         stop_at_least: 6e-4,
+        options: &[],
     })
     .unwrap();
     assert_inlined(
@@ -491,6 +494,7 @@ fn relative_netlist_path_gives_absolute_includes() {
         probes: &[],
         chatter_end: 4e-4,
         stop_at_least: 6e-4,
+        options: &[],
     })
     .unwrap();
     let lib = std::env::current_dir()
