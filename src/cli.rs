@@ -69,6 +69,26 @@ pub enum Command {
     /// The bundled relay parts (each fitted to its datasheet), or one
     /// part's scenario.
     Parts(calibrate::PartsArgs),
+    /// Print a shell completion script: `chatterspice completions bash >
+    /// ~/.local/share/bash-completion/completions/chatterspice`.
+    Completions(CompletionsArgs),
+}
+
+/// `chatterspice completions SHELL`.
+#[derive(Debug, Args)]
+pub struct CompletionsArgs {
+    /// The shell to complete for.
+    #[arg(value_enum)]
+    pub shell: clap_complete::Shell,
+}
+
+/// The completion script for `shell`, on stdout.
+fn completions(args: &CompletionsArgs) -> Result<()> {
+    use clap::CommandFactory;
+    let mut command = Cli::command();
+    let mut out = Vec::new();
+    clap_complete::generate(args.shell, &mut command, "chatterspice", &mut out);
+    emit(&String::from_utf8_lossy(&out), None, false)
 }
 
 /// How a command that did its job ended.
@@ -94,6 +114,7 @@ impl Command {
             Command::Capture(args) => done(capture::capture(args)),
             Command::Fit(args) => done(calibrate::fit(args)),
             Command::Parts(args) => done(calibrate::parts(args)),
+            Command::Completions(args) => done(completions(args)),
         }
     }
 }

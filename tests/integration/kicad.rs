@@ -80,3 +80,151 @@ fn the_exported_netlist_runs_as_the_walkthrough_says() {
     // The exported file is never edited.
     assert_eq!(std::fs::read(&netlist).unwrap(), before);
 }
+
+/// An S-expression: an atom or a list.
+#[derive(Debug)]
+enum Sexp {
+    Atom(String),
+    List(Vec<Sexp>),
+}
+
+fn parse_sexp(text: &str) -> Sexp {
+    fn list(chars: &mut std::iter::Peekable<std::str::Chars>) -> Vec<Sexp> {
+        let mut out = Vec::new();
+        while let Some(&c) = chars.peek() {
+            match c {
+                '(' => {
+                    chars.next();
+                    out.push(Sexp::List(list(chars)));
+                }
+                ')' => {
+                    chars.next();
+                    return out;
+                }
+                '"' => {
+                    chars.next();
+                    let mut s = String::new();
+                    while let Some(c) = chars.next() {
+                        match c {
+                            '\\' => s.extend(chars.next()),
+                            '"' => break,
+                            c => s.push(c),
+                        }
+                    }
+                    out.push(Sexp::Atom(s));
+                }
+                c if c.is_whitespace() => {
+                    chars.next();
+                }
+                _ => {
+                    let mut s = String::new();
+                    while let Some(&c) = chars.peek() {
+                        if c.is_whitespace() || c == '(' || c == ')' {
+                            break;
+                        }
+                        s.push(c);
+                        chars.next();
+                    }
+                    out.push(Sexp::Atom(s));
+                }
+            }
+        }
+        panic!("unbalanced S-expression");
+    }
+    let mut chars = text.trim().chars().peekable();
+    assert_eq!(chars.next(), Some('('));
+    let top = Sexp::List(list(&mut chars));
+    assert!(chars.next().is_none(), "text after the library");
+    top
+}
+
+fn head(s: &Sexp) -> Option<&str> {
+    match s {
+        Sexp::List(items) => match items.first() {
+            Some(Sexp::Atom(a)) => Some(a),
+            _ => None,
+        },
+        Sexp::Atom(_) => None,
+    }
+}
+
+fn atom(s: &Sexp, k: usize) -> Option<&str> {
+    match s {
+        Sexp::List(items) => match items.get(k) {
+            Some(Sexp::Atom(a)) => Some(a),
+            _ => None,
+        },
+        Sexp::Atom(_) => None,
+    }
+}
+
+/// Every list under `s` whose head is `name`.
+fn all<'a>(s: &'a Sexp, name: &str, out: &mut Vec<&'a Sexp>) {
+    if let Sexp::List(items) = s {
+        if head(s) == Some(name) {
+            out.push(s);
+        }
+        for item in items {
+            all(item, name, out);
+        }
+    }
+}
+
+#[test]
+fn the_symbol_library_s_contact_matches_the_include_the_tool_writes() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(root.join("kicad/chatterspice.kicad_sym")).unwrap();
+    let lib = parse_sexp(&text);
+    assert_eq!(head(&lib), Some("kicad_symbol_lib"));
+    let Sexp::List(items) = &lib else {
+        unreachable!()
+    };
+    let contact = items
+        .iter()
+        .find(|s| head(s) == Some("symbol") && atom(s, 1) == Some("RelayContact"))
+        .expect("a RelayContact symbol");
+    let mut props = Vec::new();
+    all(contact, "property", &mut props);
+    let field = |name: &str| {
+        props
+            .iter()
+            .find(|p| atom(p, 1) == Some(name))
+            .and_then(|p| atom(p, 2))
+            .unwrap_or_else(|| panic!("no {name}"))
+    };
+    assert_eq!(field("Sim.Device"), "SUBCKT");
+    assert_eq!(field("Sim.Name"), "CONTACT");
+    assert_eq!(field("Sim.Library"), "contact.inc");
+    assert_eq!(field("Sim.Pins"), "1=a 2=b");
+    let mut pins = Vec::new();
+    all(contact, "pin", &mut pins);
+    let mut names: Vec<String> = pins
+        .iter()
+        .filter_map(|p| {
+            let mut n = Vec::new();
+            all(p, "name", &mut n);
+            n.first().and_then(|n| atom(n, 1)).map(str::to_owned)
+        })
+        .collect();
+    names.sort();
+    assert_eq!(names, ["a", "b"]);
+    // The include the tool writes (plain, and with an arc) defines that
+    // subcircuit first, with those pins.
+    for scenario in [
+        "examples/kicad/relay.toml",
+        "examples/scenarios/lamp-arc.toml",
+    ] {
+        let out = Command::cargo_bin("chatterspice")
+            .unwrap()
+            .args(["pwl", root.join(scenario).to_str().unwrap()])
+            .output()
+            .unwrap();
+        assert!(out.status.success());
+        let include = String::from_utf8(out.stdout).unwrap();
+        let first = include
+            .lines()
+            .find(|l| l.to_ascii_lowercase().starts_with(".subckt"))
+            .unwrap();
+        assert_eq!(first, ".subckt CONTACT a b", "{scenario}");
+    }
+}

@@ -30,6 +30,7 @@ mod ltspice;
 mod mechanics_closed_forms;
 mod mechanics_sweep;
 mod netlist;
+mod packaging;
 mod parts;
 mod rawfile;
 mod rawfile_interp;
