@@ -169,6 +169,53 @@ pub fn partial(path: &Path) -> PathBuf {
     PathBuf::from(name)
 }
 
+/// The first field in which two identities differ (shard aside): (name,
+/// `a`'s value, `b`'s value).
+pub fn differs(a: &Identity, b: &Identity) -> Option<(&'static str, String, String)> {
+    let show = |v: &Option<u64>| v.map_or_else(|| "none".to_owned(), |s| s.to_string());
+    if a.scenario_digest != b.scenario_digest {
+        Some((
+            "scenario (digest of the scenario and netlist)",
+            a.scenario_digest.clone(),
+            b.scenario_digest.clone(),
+        ))
+    } else if a.seed != b.seed {
+        Some(("seed", show(&a.seed), show(&b.seed)))
+    } else if a.samples != b.samples {
+        Some(("sample count", a.samples.to_string(), b.samples.to_string()))
+    } else if a.mode != b.mode {
+        Some(("mode", a.mode.clone(), b.mode.clone()))
+    } else if a.ideal != b.ideal {
+        Some((
+            "ideal-contact setting",
+            a.ideal.to_string(),
+            b.ideal.to_string(),
+        ))
+    } else if a.tool != b.tool {
+        Some(("tool version", a.tool.clone(), b.tool.clone()))
+    } else {
+        None
+    }
+}
+
+/// The identity file beside sweep CSV `csv`, when there is one.
+pub fn meta_beside(csv: &Path) -> Result<Option<Meta>, ResumeError> {
+    let path = meta_path(csv);
+    if !path.exists() {
+        return Ok(None);
+    }
+    let text = crate::input::read_to_string(&path).map_err(|source| ResumeError::NoMeta {
+        path: path.clone(),
+        source,
+    })?;
+    serde_json::from_str(&text)
+        .map(Some)
+        .map_err(|e| ResumeError::BadMeta {
+            path,
+            problem: e.to_string(),
+        })
+}
+
 /// Reads the identity file `path` and checks it belongs to the sweep
 /// `ours` and is incomplete.
 pub fn check_meta(path: &Path, ours: &Identity) -> Result<Meta, ResumeError> {
@@ -183,40 +230,9 @@ pub fn check_meta(path: &Path, ours: &Identity) -> Result<Meta, ResumeError> {
     })?;
     let theirs = &meta.identity;
     let show = |v: &Option<String>| v.clone().unwrap_or_else(|| "none".to_owned());
-    let differs: Option<(&'static str, String, String)> =
-        if theirs.scenario_digest != ours.scenario_digest {
-            Some((
-                "scenario (digest of the scenario and netlist)",
-                theirs.scenario_digest.clone(),
-                ours.scenario_digest.clone(),
-            ))
-        } else if theirs.seed != ours.seed {
-            Some((
-                "seed",
-                show(&theirs.seed.map(|s| s.to_string())),
-                show(&ours.seed.map(|s| s.to_string())),
-            ))
-        } else if theirs.samples != ours.samples {
-            Some((
-                "sample count",
-                theirs.samples.to_string(),
-                ours.samples.to_string(),
-            ))
-        } else if theirs.shard != ours.shard {
-            Some(("shard", show(&theirs.shard), show(&ours.shard)))
-        } else if theirs.mode != ours.mode {
-            Some(("mode", theirs.mode.clone(), ours.mode.clone()))
-        } else if theirs.ideal != ours.ideal {
-            Some((
-                "ideal-contact setting",
-                theirs.ideal.to_string(),
-                ours.ideal.to_string(),
-            ))
-        } else if theirs.tool != ours.tool {
-            Some(("tool version", theirs.tool.clone(), ours.tool.clone()))
-        } else {
-            None
-        };
+    let differs = differs(theirs, ours).or_else(|| {
+        (theirs.shard != ours.shard).then(|| ("shard", show(&theirs.shard), show(&ours.shard)))
+    });
     if let Some((field, theirs, ours)) = differs {
         return Err(ResumeError::Different {
             path,

@@ -446,6 +446,28 @@ pub fn merge_files(
         path: output.to_owned(),
         source,
     };
+    // Every shard with an identity file beside it must be of one sweep.
+    let mut known: Option<(PathBuf, super::resume::Identity)> = None;
+    for path in inputs {
+        let Some(meta) = super::resume::meta_beside(path)? else {
+            continue;
+        };
+        match &known {
+            None => known = Some((path.clone(), meta.identity)),
+            Some((first, identity)) => {
+                if let Some((field, a, b)) = super::resume::differs(identity, &meta.identity) {
+                    return Err(MergeFilesError::DifferentSweeps {
+                        first: first.clone(),
+                        other: path.clone(),
+                        field,
+                        first_value: a,
+                        other_value: b,
+                    });
+                }
+            }
+        }
+    }
+    let expected = expected.or(known.as_ref().map(|(_, i)| i.samples));
     let mut staged = crate::output::Staged::new(output, overwrite)?;
     let mut readers = Vec::with_capacity(inputs.len());
     for path in inputs {
@@ -479,6 +501,29 @@ pub enum MergeFilesError {
     /// The inputs could not be merged.
     #[error(transparent)]
     Merge(#[from] MergeError),
+    /// Two inputs belong to different sweeps, by the identity files beside
+    /// them.
+    #[error(
+        "{} and {} are shards of different sweeps: their {field} differs ({first_value} \
+         against {other_value}); merge only the shards of one sweep",
+        first.display(),
+        other.display()
+    )]
+    DifferentSweeps {
+        /// The first input with an identity file.
+        first: PathBuf,
+        /// The input that differs from it.
+        other: PathBuf,
+        /// What differs: `seed`, `scenario (...)`, `sample count`, ...
+        field: &'static str,
+        /// Its value for `first`.
+        first_value: String,
+        /// Its value for `other`.
+        other_value: String,
+    },
+    /// An identity file beside an input cannot be read.
+    #[error(transparent)]
+    Identity(#[from] super::resume::ResumeError),
     /// The output could not be created or put in place (e.g. it exists
     /// and overwriting was not asked for).
     #[error(transparent)]

@@ -253,6 +253,67 @@ fn merge_reports_missing_samples_and_refuses_to_write() {
 }
 
 #[test]
+fn merge_refuses_shards_of_different_sweeps_naming_what_differs() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = scenario(dir.path(), VARY);
+    let shard = |k: &str, seed: &str, out: &str| {
+        chatterspice()
+            .arg("sweep")
+            .arg(&s)
+            .args([
+                "--mechanics-only",
+                "--samples",
+                "40",
+                "--seed",
+                seed,
+                "--shard",
+                k,
+                "--out",
+            ])
+            .arg(dir.path().join(out))
+            .assert()
+            .success();
+        dir.path()
+            .join(out)
+            .join(format!("sweep.{}.csv", k.replace('/', "-of-")))
+    };
+    let a = shard("1/2", "7", "a");
+    let b = shard("2/2", "8", "b");
+    let merged = dir.path().join("merged.csv");
+    chatterspice()
+        .arg("merge")
+        .arg(&merged)
+        .args([&a, &b])
+        .assert()
+        .code(2)
+        .stderr(
+            predicate::str::contains("different sweeps")
+                .and(predicate::str::contains("seed"))
+                .and(predicate::str::contains("7 against 8")),
+        );
+    assert!(!merged.exists());
+    // The shards of one sweep merge; the sample count comes from their
+    // identity files, so a missing shard is found without --samples.
+    let b = shard("2/2", "7", "c");
+    chatterspice()
+        .arg("merge")
+        .arg(&merged)
+        .args([&a, &b])
+        .assert()
+        .success();
+    let rows = std::fs::read_to_string(&merged).unwrap().lines().count();
+    assert_eq!(rows, 41);
+    let alone = dir.path().join("alone.csv");
+    chatterspice()
+        .arg("merge")
+        .arg(&alone)
+        .arg(&a)
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("missing"));
+}
+
+#[test]
 fn an_unknown_vary_key_is_exit_2_naming_the_key_and_listing_the_keys() {
     let dir = tempfile::tempdir().unwrap();
     let s = scenario(dir.path(), "[sweep.vary]\n\"mechanics.mas\" = 0.1");
