@@ -259,6 +259,31 @@ pub fn finished_rows(
     columns: super::table::Columns,
     shard: Shard,
 ) -> Result<(Vec<u8>, Vec<Record>), ResumeError> {
+    read_rows(path, header, keys, signals, columns, Some(shard))
+}
+
+/// Every whole row of sweep CSV `path`, in file order, whatever their
+/// indices (a merge that allowed missing samples).
+pub fn all_rows(
+    path: &Path,
+    header: &[u8],
+    keys: usize,
+    signals: usize,
+    columns: super::table::Columns,
+) -> Result<Vec<Record>, ResumeError> {
+    read_rows(path, header, keys, signals, columns, None).map(|(_, records)| records)
+}
+
+/// The rows of `path`; with `shard`, only while they continue its
+/// sequence of samples.
+fn read_rows(
+    path: &Path,
+    header: &[u8],
+    keys: usize,
+    signals: usize,
+    columns: super::table::Columns,
+    shard: Option<Shard>,
+) -> Result<(Vec<u8>, Vec<Record>), ResumeError> {
     let bytes =
         crate::input::read_limited(path, u64::MAX).map_err(|source| ResumeError::ReadCsv {
             path: path.to_owned(),
@@ -296,12 +321,14 @@ pub fn finished_rows(
             break;
         }
         let record = parse_row(&row, keys, signals, columns).map_err(|p| bad(line, p))?;
-        let expected = shard.sample(records.len() as u64);
-        if record.index != expected {
-            return Err(bad(
-                line,
-                format!("sample {} where {expected} was due", record.index),
-            ));
+        if let Some(shard) = shard {
+            let expected = shard.sample(records.len() as u64);
+            if record.index != expected {
+                return Err(bad(
+                    line,
+                    format!("sample {} where {expected} was due", record.index),
+                ));
+            }
         }
         records.push(record);
         end = header.len() + reader.position().byte() as usize;

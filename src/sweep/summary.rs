@@ -116,6 +116,19 @@ impl Collected {
 
     /// The summary; `sampler` gives the worst sample's values.
     pub fn summary(&self, sampler: &Sampler) -> Result<Summary, SweepError> {
+        self.summary_with(sampler.is_grid(), sampler.seed(), |index| {
+            sampler.values_vec(index)
+        })
+    }
+
+    /// The summary of a grid (`grid`) or a random sweep of `seed`, with the
+    /// worst sample's values from `values(index)`.
+    pub fn summary_with(
+        &self,
+        grid: bool,
+        seed: Option<u64>,
+        values: impl Fn(u64) -> Result<Vec<f64>, SweepError>,
+    ) -> Result<Summary, SweepError> {
         let n = self.len() as u64;
         let mut outcomes = BTreeMap::new();
         for o in &self.outcome {
@@ -142,7 +155,7 @@ impl Collected {
         let worst = match self.worst() {
             Some(i) => {
                 let index = self.index[i];
-                let values = sampler.values_vec(index)?;
+                let values = values(index)?;
                 Some(Worst {
                     index,
                     outcome: self.outcome[i].map(Outcome::as_str),
@@ -157,8 +170,8 @@ impl Collected {
         };
         Ok(Summary {
             samples: n,
-            kind: if sampler.is_grid() { "grid" } else { "random" },
-            seed: sampler.seed(),
+            kind: if grid { "grid" } else { "random" },
+            seed,
             keys: self.keys.clone(),
             outcomes,
             verdicts,

@@ -303,6 +303,33 @@ fn merge_refuses_shards_of_different_sweeps_naming_what_differs() {
         .success();
     let rows = std::fs::read_to_string(&merged).unwrap().lines().count();
     assert_eq!(rows, 41);
+    // With a summary beside it, of all 40 samples.
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["samples"], 40, "{summary}");
+    assert_eq!(summary["seed"], 7);
+    let whole = dir.path().join("whole");
+    chatterspice()
+        .arg("sweep")
+        .arg(&s)
+        .args([
+            "--mechanics-only",
+            "--samples",
+            "40",
+            "--seed",
+            "7",
+            "--out",
+        ])
+        .arg(&whole)
+        .assert()
+        .success();
+    let one_run: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(whole.join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["bounce_count"], one_run["bounce_count"]);
+    assert_eq!(summary["worst"], one_run["worst"]);
+    std::fs::remove_file(dir.path().join("summary.json")).unwrap();
     let alone = dir.path().join("alone.csv");
     chatterspice()
         .arg("merge")
