@@ -27,7 +27,7 @@
 use super::{Coil, CoilError};
 use crate::chatter::Chatter;
 use crate::mechanics::cycle;
-use crate::mechanics::driven::{self, Drive, Phase, Piece, State};
+use crate::mechanics::driven::{self, Drive, Piece, State, StepKind};
 use crate::mechanics::trajectory::Segment;
 use crate::mechanics::{self, Mechanics, Settings, Surface};
 
@@ -236,7 +236,7 @@ pub fn direct_closing(
     surface: &Surface,
     settings: &Settings,
 ) -> Result<(Chatter, Option<crate::mechanics::two_stage::TwoStageRun>), CoilError> {
-    use crate::mechanics::two_stage::engine::{Model, run};
+    use crate::mechanics::two_stage::engine::{Relay, run};
     if build.is_one_mass() {
         return Ok((
             simulate_direct(coil, source, mechanics, surface, settings)?.chatter,
@@ -259,7 +259,7 @@ pub fn direct_closing(
         });
     }
     let drive = CoilDrive::new(coil, source, m.gap);
-    let model = Model {
+    let model = Relay {
         m: &m,
         build,
         contact: *surface,
@@ -326,7 +326,7 @@ impl CoilDrive {
                 // The last piece of the first flight ends at the touch.
                 let piece = pieces(&run.steps)
                     .rev()
-                    .find(|p| p.phase == Phase::Flight && p.t1 <= t)
+                    .find(|p| p.phase == StepKind::Flight && p.t1 <= t)
                     .expect("a flight reached the first touch");
                 self.current(piece.y1[2], m.gap + piece.y1[0])
             }),
@@ -347,7 +347,7 @@ impl CoilDrive {
             current: self.current(y[2], self.gap + y[0]),
         };
         let mut falling = false;
-        for piece in pieces(steps).filter(|p| p.phase != Phase::Held && p.t1 > lift_off) {
+        for piece in pieces(steps).filter(|p| p.phase != StepKind::Held && p.t1 > lift_off) {
             let (y0, y1) = (piece.y0(), piece.y1);
             let (d0, d1) = (self.current_rate(&y0), self.current_rate(&y1));
             if falling && d0 >= 0.0 {
@@ -387,11 +387,11 @@ impl CoilDrive {
                 let wh = w * half;
                 source += wh * self.voltage * i;
                 resistive += wh * self.resistance * i * i;
-                if *phase != Phase::Held {
+                if *phase != StepKind::Held {
                     work += wh * self.coil.force_from_flux(y[2]) * y[1];
                     lost += wh * m.damping * y[1] * y[1];
                 }
-                if *phase == Phase::Contact {
+                if *phase == StepKind::Contact {
                     lost += wh * crate::mechanics::surface::surface_loss(surface, y[0], y[1]);
                 }
             }

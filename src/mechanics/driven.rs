@@ -68,7 +68,7 @@ pub(crate) trait Drive {
 
 /// Which equations a step integrated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Phase {
+pub(crate) enum StepKind {
     Held,
     Flight,
     Contact,
@@ -80,7 +80,7 @@ pub(crate) enum Phase {
 /// ([`super::trajectory`]).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Piece<'a> {
-    pub phase: Phase,
+    pub phase: StepKind,
     pub step: &'a Step<3>,
     pub t1: f64,
     pub y1: State,

@@ -94,7 +94,7 @@ pub struct HcOutcome {
 }
 
 /// The integrated state (u, v, t): u = √δ (√m), v = δ̇ (m/s), t (s).
-pub(crate) type State = Vector3<f64>;
+pub(crate) type HcState = Vector3<f64>;
 
 /// The most steps [`HcContact::trace`] keeps of one contact.
 pub(crate) const MAX_TRACE_STEPS: usize = 200_000;
@@ -170,7 +170,7 @@ impl HcContact {
         }
     }
 
-    fn energy_margin(&self, y: &State) -> f64 {
+    fn energy_margin(&self, y: &HcState) -> f64 {
         // E − U(g), with x = g + δ: the spring and drive terms expand to
         // (k g − F) δ + ½ k δ², avoiding cancellation of large ½kx² terms.
         let (d, v) = (y[0] * y[0], y[1]);
@@ -203,8 +203,8 @@ impl HcContact {
         &self,
         equations: Regularized<P>,
         v_hit: f64,
-    ) -> Dop853<3, impl Fn(f64, &State) -> State, 2> {
-        let rhs = move |_s: f64, y: &State| equations.rate(y);
+    ) -> Dop853<3, impl Fn(f64, &HcState) -> HcState, 2> {
+        let rhs = move |_s: f64, y: &HcState| equations.rate(y);
         // Scales: the depth at which the surface alone would stop the
         // impact (energy balance), the time to get there, and the
         // fictitious time s = t/u for it.
@@ -218,12 +218,12 @@ impl HcContact {
         let tol = Tolerance {
             rtol,
             // (The solver controls u and v only; t's entry goes unread.)
-            atol: State::new(rtol * u_scale, rtol * v_hit, rtol * t_scale),
+            atol: HcState::new(rtol * u_scale, rtol * v_hit, rtol * t_scale),
         };
         let h0 = H0 * s_scale;
         // t is a quadrature of u (dt/ds = u, read by no equation): only u
         // and v set the step size.
-        Dop853::new(rhs, 0.0, State::new(0.0, v_hit, 0.0), h0, tol).controlling_first::<2>()
+        Dop853::new(rhs, 0.0, HcState::new(0.0, v_hit, 0.0), h0, tol).controlling_first::<2>()
     }
 
     /// [`HcContact::run`] for one spring law.
@@ -358,9 +358,9 @@ impl HcContact {
         step: &Dop853Step<3>,
         solver: &mut Dop853<3, F, 2>,
         find_peak: bool,
-    ) -> (State, f64)
+    ) -> (HcState, f64)
     where
-        F: Fn(f64, &State) -> State,
+        F: Fn(f64, &HcState) -> HcState,
     {
         let dense = solver.dense();
         let (s_rel, y) = release(step, &dense);
@@ -381,7 +381,7 @@ impl HcContact {
         solver: &mut Dop853<3, F, 2>,
     ) -> f64
     where
-        F: Fn(f64, &State) -> State,
+        F: Fn(f64, &HcState) -> HcState,
     {
         let dense = solver.dense();
         self.peak_in(equations, &dense, (step.t0, step.y0), (step.t1, step.y1))
@@ -395,10 +395,10 @@ impl HcContact {
         &self,
         equations: &Regularized<P>,
         dense: &Dense<3>,
-        (s0, y0): (f64, State),
-        (s1, y1): (f64, State),
+        (s0, y0): (f64, HcState),
+        (s1, y1): (f64, HcState),
     ) -> f64 {
-        let rate = |y: &State| equations.scaled_force_rate(y);
+        let rate = |y: &HcState| equations.scaled_force_rate(y);
         let (rate0, rate1) = (rate(&y0), rate(&y1));
         let ends = equations.force(&y0).max(equations.force(&y1));
         if !(rate0 > 0.0 && rate1 < 0.0) {
@@ -413,7 +413,7 @@ impl HcContact {
 
 /// The (s, state) at release in a step where u changes sign, by Newton's
 /// method on the dense output (du/ds = v/2) from the secant point.
-fn release(step: &Dop853Step<3>, dense: &Dense<3>) -> (f64, State) {
+fn release(step: &Dop853Step<3>, dense: &Dense<3>) -> (f64, HcState) {
     let (u0, u1) = (step.y0[0], step.y1[0]);
     let mut s = step.t0 + (step.t1 - step.t0) * u0 / (u0 - u1);
     let mut y = dense.at(s);
@@ -514,12 +514,12 @@ impl<P: Spring> Regularized<P> {
     /// d(u, v, t)/ds: (v/2, u·δ̈, u), with u·δ̈ expanded so that its
     /// slowest term, u·δⁿ, is one product shorter.
     #[inline]
-    fn rate(&self, y: &State) -> State {
+    fn rate(&self, y: &HcState) -> HcState {
         let (u, v) = (y[0], y[1]);
         let d = u * u;
         let linear = u * (self.drive - self.damping * v - self.stiffness * d);
         let surface = self.surface * self.spring.power_times_u(d, u) * self.rate_factor(v);
-        State::new(0.5 * v, linear - surface, u)
+        HcState::new(0.5 * v, linear - surface, u)
     }
 
     /// The clamp Fc ≥ 0 acts only on the rate factor 1 + χ δ̇, so that
@@ -532,7 +532,7 @@ impl<P: Spring> Regularized<P> {
 
     /// δ̈ (m/s²) at the state (u, v, t).
     #[inline]
-    fn acceleration(&self, y: &State) -> f64 {
+    fn acceleration(&self, y: &HcState) -> f64 {
         let (u, v) = (y[0], y[1]);
         let d = u * u;
         let spring = self.spring.power(d, u);
@@ -542,7 +542,7 @@ impl<P: Spring> Regularized<P> {
 
     /// The contact force (N) at the state: `force_at` without its square
     /// root, since u = √δ is at hand.
-    fn force(&self, y: &State) -> f64 {
+    fn force(&self, y: &HcState) -> f64 {
         let (u, v) = (y[0], y[1]);
         if u <= 0.0 {
             return 0.0;
@@ -552,7 +552,7 @@ impl<P: Spring> Regularized<P> {
 
     /// The force's rate of change dFc/dt divided by the positive ks δⁿ⁻¹:
     /// n δ̇ (1 + χ δ̇) + χ δ δ̈, whose sign change marks the force maximum.
-    fn scaled_force_rate(&self, y: &State) -> f64 {
+    fn scaled_force_rate(&self, y: &HcState) -> f64 {
         let (u, v) = (y[0], y[1]);
         self.exponent * v * (1.0 + self.chi * v) + self.chi * u * u * self.acceleration(y)
     }

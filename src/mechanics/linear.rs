@@ -327,7 +327,7 @@ impl LinearPiece {
     /// first zero: e^(−at), cos wt and sin wt there, which the closed form
     /// gives for free (see above).
     #[inline(always)]
-    fn zeros_and_phase(&self, c: Combo, d: Combo) -> (Zeros, Option<Phase>) {
+    fn zeros_and_phase(&self, c: Combo, d: Combo) -> (Zeros, Option<SwingPhase>) {
         if c.p == 0.0 && c.q == 0.0 {
             return (Zeros::NONE, None);
         }
@@ -363,7 +363,7 @@ impl LinearPiece {
                 value,
                 factor: -self.mode.half_period_decay,
             };
-            let phase = Phase {
+            let phase = SwingPhase {
                 decay,
                 cos: -sign * qw / r,
                 sin: sign * c.p / r,
@@ -573,7 +573,7 @@ impl LinearPiece {
         (t_hi, y_hi): (f64, f64),
         offset: f64,
         between_extrema: bool,
-        mirror: Option<Phase>,
+        mirror: Option<SwingPhase>,
     ) -> (f64, f64) {
         // Up to κ = 1 (a half swing decays by e^(−π) or less) the undamped
         // start is close; beyond, the generic iteration serves.
@@ -619,7 +619,7 @@ impl LinearPiece {
     /// and sin θ are known exactly. Halley's method converges from there in
     /// two steps (for the engine's relays about 3e-2 and 4e-6 rad), so
     /// each step *advances* the three numbers by the step (addition
-    /// theorems, [`Phase::advance`]) instead of calling `exp` and
+    /// theorems, [`SwingPhase::advance`]) instead of calling `exp` and
     /// `sin_cos` anew: per crossing, one `acos` and one `exp`. Bisection
     /// takes over if Halley leaves the bracket or stalls.
     ///
@@ -633,7 +633,7 @@ impl LinearPiece {
     /// that step from u is within [`SMALL_STEP`] it is as close as the
     /// `acos` start or closer (within 3e-2 rad for κ ≤ 1; about 1e-3 for
     /// the engine's relays), and its phase follows from the turn's by
-    /// [`Phase::advance`]: no `acos` and no second `exp`. Beyond (a slow
+    /// [`SwingPhase::advance`]: no `acos` and no second `exp`. Beyond (a slow
     /// start near the bottom of the swing, or heavy damping), the `acos`
     /// start serves.
     fn polish_half_swing(
@@ -641,7 +641,7 @@ impl LinearPiece {
         t_lo: f64,
         y_lo: f64,
         offset: f64,
-        mirror: Option<Phase>,
+        mirror: Option<SwingPhase>,
     ) -> (f64, f64) {
         use std::f64::consts::PI;
         let Mode {
@@ -668,7 +668,7 @@ impl LinearPiece {
             // known exactly.
             let frac = ((1.0 - offset / y_lo) * inv_swing).clamp(0.0, 1.0);
             let theta = (1.0 - 2.0 * frac).acos();
-            let p = Phase {
+            let p = SwingPhase {
                 cos: 1.0 - 2.0 * frac,
                 sin: 2.0 * (frac * (1.0 - frac)).sqrt(),
                 decay: (-kappa * theta).exp(),
@@ -708,7 +708,7 @@ impl LinearPiece {
                 moved = 0.5 * (hi - lo);
                 theta = lo + moved;
                 let (sin, cos) = theta.sin_cos();
-                p = Phase {
+                p = SwingPhase {
                     cos,
                     sin,
                     decay: (-kappa * theta).exp(),
@@ -748,19 +748,19 @@ impl LinearPiece {
 
 /// e^(−κθ), cos θ and sin θ at one phase θ of a half swing.
 #[derive(Debug, Clone, Copy)]
-struct Phase {
+struct SwingPhase {
     decay: f64,
     cos: f64,
     sin: f64,
 }
 
-impl Phase {
+impl SwingPhase {
     /// The same at θ + `step` (= `theta_new`), by addition theorems with
     /// short series where the step is small enough for them to be exact
     /// to rounding (the first omitted terms are below 1e-17 relative):
     /// far cheaper than `sin_cos` and `exp`, which serve larger steps.
     #[inline(always)]
-    fn advance(self, step: f64, kappa: f64, theta_new: f64) -> Phase {
+    fn advance(self, step: f64, kappa: f64, theta_new: f64) -> SwingPhase {
         let x = -kappa * step;
         if step.abs() <= TINY_STEP && x.abs() <= TINY_STEP {
             // A converging Halley step: to δ⁵, δ⁴ and x⁵ (the first
@@ -771,7 +771,7 @@ impl Phase {
             let x2 = x * x;
             let exp_m1 =
                 x * ((1.0 + 0.5 * x) + x2 * ((1.0 / 6.0 + x * (1.0 / 24.0)) + x2 * (1.0 / 120.0)));
-            return Phase {
+            return SwingPhase {
                 decay: self.decay + self.decay * exp_m1,
                 cos: self.cos + (self.cos * cos_m1 - self.sin * sin),
                 sin: self.sin + (self.sin * cos_m1 + self.cos * sin),
@@ -790,7 +790,7 @@ impl Phase {
         };
         if step.abs() > SMALL_STEP {
             let (sin, cos) = theta_new.sin_cos();
-            return Phase { decay, cos, sin };
+            return SwingPhase { decay, cos, sin };
         }
         // sin δ and cos δ − 1 to δ¹¹ and δ¹² as polynomials in δ², grouped
         // (Estrin) to shorten the dependency chain; the reciprocal
@@ -804,7 +804,7 @@ impl Phase {
             * ((-0.5 + d2 * (1.0 / 24.0))
                 + d4 * ((-1.0 / 720.0 + d2 * (1.0 / 40320.0))
                     + d4 * (-1.0 / 3628800.0 + d2 * (1.0 / 479001600.0))));
-        Phase {
+        SwingPhase {
             decay,
             cos: self.cos + (self.cos * cos_m1 - self.sin * sin),
             sin: self.sin + (self.sin * cos_m1 + self.cos * sin),
@@ -817,7 +817,7 @@ impl Phase {
 const TAYLOR_STEP: f64 = 1.0 / 131072.0;
 
 /// The largest step (radians) and change of the decay exponent that
-/// [`Phase::advance`] takes by series: Halley's steps, and the step from a
+/// [`SwingPhase::advance`] takes by series: Halley's steps, and the step from a
 /// turn to the mirrored start ([`LinearPiece::polish_half_swing`]).
 const SMALL_STEP: f64 = 1.0 / 4.0;
 const TINY_STEP: f64 = 1.0 / 256.0;
@@ -885,7 +885,7 @@ mod tests {
         for kappa in [0.0f64, 0.05, 1.0, 3.0] {
             let theta: f64 = 0.7;
             let (sin, cos) = theta.sin_cos();
-            let p = Phase {
+            let p = SwingPhase {
                 decay: (-kappa * theta).exp(),
                 cos,
                 sin,
@@ -908,7 +908,7 @@ mod tests {
         for kappa in [0.0f64, 0.01, 1.0 / 16.0] {
             for theta in [0.1f64, 1.3, 2.9] {
                 let (sin, cos) = theta.sin_cos();
-                let p = Phase {
+                let p = SwingPhase {
                     decay: (-kappa * theta).exp(),
                     cos,
                     sin,

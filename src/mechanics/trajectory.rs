@@ -22,7 +22,7 @@
 //! as the normally-closed one).
 
 use super::cycle::{Cycle, Stops, Stroke};
-use super::driven::{Phase, Piece, State, state_on};
+use super::driven::{Piece, State, StepKind, state_on};
 use super::engine::{free_flight, kelvin_voigt_contact};
 use super::forced::simulate_cycle;
 use super::hunt_crossley::{HcContact, HcStep};
@@ -30,7 +30,7 @@ use super::integrate::Step;
 use super::linear::LinearPiece;
 use super::surface::surface_force;
 use super::two_stage::TwoStageRun;
-use super::two_stage::engine::Piece as StagedPiece;
+use super::two_stage::engine::Span as StagedSpan;
 use super::{DriveError, Mechanics, MechanicsError, Settings, Surface};
 use crate::chatter::{Chatter, ContactState, Impact};
 
@@ -177,7 +177,7 @@ enum Motion {
     Contact { step: HcStep, touch: f64 },
     /// One step of the two-stage engine: the state is
     /// `(u_a, v_a, u_b, v_b, e)`; the contact point is the blade's.
-    Staged(Box<StagedPiece>),
+    Staged(Box<StagedSpan>),
 }
 
 /// A stretch of the trajectory between two instants.
@@ -248,10 +248,12 @@ impl Segment {
     /// piece and for the back stop's contact, which a closing never has.
     pub(crate) fn piece(&self) -> Option<Piece<'_>> {
         let (phase, step, y1) = match &self.motion {
-            Motion::Held { step, y1, .. } => (Phase::Held, step, y1),
-            Motion::Integrated { step, y1 } if self.side == Side::Open => (Phase::Flight, step, y1),
+            Motion::Held { step, y1, .. } => (StepKind::Held, step, y1),
+            Motion::Integrated { step, y1 } if self.side == Side::Open => {
+                (StepKind::Flight, step, y1)
+            }
             Motion::Integrated { step, y1 } if self.side == Side::Make => {
-                (Phase::Contact, step, y1)
+                (StepKind::Contact, step, y1)
             }
             _ => return None,
         };

@@ -610,7 +610,7 @@ pub fn nc_include(
 
 /// The records a pass hands on: the two contacts' chatter, the armature
 /// path thinned to `thinning` (m) for ngspice, and the strokes.
-fn records(trajectory: Trajectory, thinning: f64) -> Records {
+fn records(trajectory: Trajectory, thinning: f64) -> PassRecords {
     let path = thin(&trajectory.path(), thinning);
     let strokes = trajectory.strokes().to_vec();
     let pole_face = trajectory.pole_face_impacts().to_vec();
@@ -621,7 +621,7 @@ fn records(trajectory: Trajectory, thinning: f64) -> Records {
 
 /// What a converged pass hands on: the NO and NC contacts' records, the
 /// armature's path, the strokes and the pole-face impacts.
-type Records = (
+type PassRecords = (
     Chatter,
     Chatter,
     Vec<(f64, f64)>,

@@ -33,19 +33,19 @@ use super::super::Surface;
 use super::super::driven::Drive;
 use super::super::surface::surface_energy;
 use super::Release;
-use super::engine::{Model, Modes, Y};
+use super::engine::{Modes, Relay, Y};
 
 /// Golden-section iterations: the bracket shrinks by 0.618^80 ≈ 2e-17.
 const ITERATIONS: usize = 80;
 
 /// The energy bound's state: when it was last checked.
-pub(crate) struct Bound {
+pub(crate) struct EnergyBound {
     steps: usize,
 }
 
-impl Bound {
-    pub(crate) fn new<D: Drive>(_model: &Model<'_, D>) -> Bound {
-        Bound { steps: 0 }
+impl EnergyBound {
+    pub(crate) fn new<D: Drive>(_model: &Relay<'_, D>) -> EnergyBound {
+        EnergyBound { steps: 0 }
     }
 
     /// Whether to check at this step: every fourth accepted step.
@@ -57,7 +57,7 @@ impl Bound {
     /// Whether the closed contact can never release again.
     pub(crate) fn cannot_release<D: Drive>(
         &mut self,
-        model: &Model<'_, D>,
+        model: &Relay<'_, D>,
         t: f64,
         y: &Y,
         _modes: Modes,
@@ -71,7 +71,7 @@ impl Bound {
     /// Whether the open contact can never be reached again.
     pub(crate) fn cannot_reach<D: Drive>(
         &mut self,
-        model: &Model<'_, D>,
+        model: &Relay<'_, D>,
         t: f64,
         y: &Y,
         _modes: Modes,
@@ -88,7 +88,7 @@ impl Bound {
 
 /// The model with its drive frozen at (t, e).
 struct Frozen<'m, 'a, D> {
-    model: &'m Model<'a, D>,
+    model: &'m Relay<'a, D>,
     t: f64,
     e: f64,
     /// m, the range of armature positions to search.
@@ -97,7 +97,7 @@ struct Frozen<'m, 'a, D> {
 }
 
 impl<'m, 'a, D: Drive> Frozen<'m, 'a, D> {
-    fn at(model: &'m Model<'a, D>, t: f64, y: &Y) -> Self {
+    fn at(model: &'m Relay<'a, D>, t: f64, y: &Y) -> Self {
         let m = model.m;
         let g = m.gap;
         let o = model.build.pole_face.map_or(0.0, |p| p.overtravel);

@@ -25,7 +25,7 @@ use super::super::integrate::Tolerance;
 use super::super::{
     DriveError, MAX_DRIVEN_STEPS, MAX_EVENTS, Mechanics, MechanicsError, Settings, Surface,
 };
-use super::energy::Bound;
+use super::energy::EnergyBound;
 use super::{Release, TwoStage, TwoStageRun};
 use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome};
 
@@ -68,7 +68,7 @@ pub(crate) struct Modes {
 
 /// How a piece's state is had between its ends.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) enum Motion {
+pub(crate) enum Interpolant {
     /// DOP853's dense output of the step.
     Dense(Box<Dense<5>>),
     /// The exact solution of a linear mode from `w0` (scaled deviation
@@ -82,19 +82,19 @@ pub(crate) enum Motion {
 /// One accepted step, cut at its event: valid on `[t0, t1]`, exact `y1`
 /// at `t1`.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Piece {
-    pub motion: Motion,
+pub(crate) struct Span {
+    pub motion: Interpolant,
     pub t0: f64,
     pub t1: f64,
     pub y1: Y,
     pub modes: Modes,
 }
 
-impl Piece {
-    pub(crate) fn dense(dense: Dense<5>, t1: f64, y1: Y, modes: Modes) -> Piece {
-        Piece {
+impl Span {
+    pub(crate) fn dense(dense: Dense<5>, t1: f64, y1: Y, modes: Modes) -> Span {
+        Span {
             t0: dense.t0,
-            motion: Motion::Dense(Box::new(dense)),
+            motion: Interpolant::Dense(Box::new(dense)),
             t1,
             y1,
             modes,
@@ -107,8 +107,8 @@ impl Piece {
         }
         let t = t.max(self.t0);
         match &self.motion {
-            Motion::Dense(dense) => dense.at(t),
-            Motion::Linear { w0, mode } => mode.y_of(&mode.at(w0, t - self.t0)),
+            Interpolant::Dense(dense) => dense.at(t),
+            Interpolant::Linear { w0, mode } => mode.y_of(&mode.at(w0, t - self.t0)),
         }
     }
 
@@ -119,7 +119,7 @@ impl Piece {
 }
 
 /// The state at `t` on a run's pieces, held at the ends.
-pub(crate) fn state_at(pieces: &[Piece], t: f64) -> Y {
+pub(crate) fn state_at(pieces: &[Span], t: f64) -> Y {
     let k = pieces.partition_point(|p| p.t1 < t);
     match pieces.get(k).or(pieces.last()) {
         Some(p) => p.at(t),
@@ -136,7 +136,7 @@ pub(crate) enum Which {
 }
 
 /// The model: parameters and the drive.
-pub(crate) struct Model<'a, D> {
+pub(crate) struct Relay<'a, D> {
     pub m: &'a Mechanics,
     pub build: &'a TwoStage,
     pub contact: Surface,
@@ -166,7 +166,7 @@ fn law(surface: &Surface, delta: f64, rate: f64) -> f64 {
     }
 }
 
-impl<D: Drive> Model<'_, D> {
+impl<D: Drive> Relay<'_, D> {
     fn g(&self) -> f64 {
         self.m.gap
     }
@@ -338,7 +338,7 @@ impl<D: Drive> Model<'_, D> {
 }
 
 /// The records a run builds.
-pub(crate) struct Records {
+pub(crate) struct Tally {
     contact: Vec<Impact>,
     intervals: Vec<Interval>,
     pole: Vec<Impact>,
@@ -349,7 +349,7 @@ pub(crate) struct Records {
     reach: f64,
 }
 
-impl Records {
+impl Tally {
     /// Whether the contact has been touched.
     pub(crate) fn contact_is_empty(&self) -> bool {
         self.contact.is_empty()
@@ -405,10 +405,10 @@ pub(crate) struct Progress {
     pub t: f64,
     pub y: Y,
     pub modes: Modes,
-    pub rec: Records,
-    pub pieces: Vec<Piece>,
+    pub rec: Tally,
+    pub pieces: Vec<Span>,
     pub steps: usize,
-    pub bound: Bound,
+    pub bound: EnergyBound,
     /// The ending, when one was decided before the horizon.
     pub ending: Option<Outcome>,
 }
@@ -417,7 +417,7 @@ impl Progress {
     /// Apply the event of `which` at `t` (state `y` there, before it).
     pub(crate) fn event<D: Drive>(
         &mut self,
-        model: &Model<'_, D>,
+        model: &Relay<'_, D>,
         settings: &Settings,
         which: Which,
         t: f64,
@@ -458,7 +458,7 @@ impl Progress {
 /// Simulate the relay of `model` from the drive's state `e0` to
 /// `horizon`. Parameters must have been validated.
 pub(crate) fn run<D: Drive>(
-    model: &Model<'_, D>,
+    model: &Relay<'_, D>,
     settings: &Settings,
     e0: f64,
     horizon: Horizon,
@@ -472,7 +472,7 @@ pub(crate) fn run<D: Drive>(
 }
 
 /// The state at t = 0: on the rest stop when the drive does not lift it.
-fn start<D: Drive>(model: &Model<'_, D>, e0: f64) -> Progress {
+fn start<D: Drive>(model: &Relay<'_, D>, e0: f64) -> Progress {
     let m = model.m;
     let g = m.gap;
     let x0 = m.initial_position;
@@ -490,7 +490,7 @@ fn start<D: Drive>(model: &Model<'_, D>, e0: f64) -> Progress {
         modes.rest = Stop::Pressed;
         y[1] = 0.0;
     }
-    let mut rec = Records {
+    let mut rec = Tally {
         contact: Vec::new(),
         intervals: vec![Interval {
             state: ContactState::Open,
@@ -523,14 +523,14 @@ fn start<D: Drive>(model: &Model<'_, D>, e0: f64) -> Progress {
         rec,
         pieces: Vec::new(),
         steps: 0,
-        bound: Bound::new(model),
+        bound: EnergyBound::new(model),
         ending: None,
     }
 }
 
 /// DOP853 from event to event, to the horizon.
 fn integrate<D: Drive>(
-    model: &Model<'_, D>,
+    model: &Relay<'_, D>,
     settings: &Settings,
     horizon: Horizon,
     p: &mut Progress,
@@ -560,7 +560,7 @@ fn integrate<D: Drive>(
             match model.first_event(&dense, step.t1, modes) {
                 None => {
                     track.sample(model, &dense, step.t1, modes, &mut p.rec);
-                    p.pieces.push(Piece::dense(dense, step.t1, step.y1, modes));
+                    p.pieces.push(Span::dense(dense, step.t1, step.y1, modes));
                     p.t = step.t1;
                     p.y = step.y1;
                     if horizon == Horizon::Closing
@@ -576,7 +576,7 @@ fn integrate<D: Drive>(
                 Some((te, which)) => {
                     let ye = dense.at(te);
                     track.sample(model, &dense, te, modes, &mut p.rec);
-                    p.pieces.push(Piece::dense(dense, te, ye, modes));
+                    p.pieces.push(Span::dense(dense, te, ye, modes));
                     p.event(model, settings, which, te, ye);
                     break;
                 }
@@ -588,14 +588,14 @@ fn integrate<D: Drive>(
 
 /// The run's records, with the motion held where it stopped to `t_end`.
 fn finish<D: Drive>(
-    model: &Model<'_, D>,
+    model: &Relay<'_, D>,
     settings: &Settings,
     horizon: Horizon,
     mut p: Progress,
 ) -> TwoStageRun {
     let t_end = settings.t_end;
     if p.t < t_end {
-        p.pieces.push(Piece::dense(
+        p.pieces.push(Span::dense(
             Dense::constant(p.t, t_end, p.y),
             t_end,
             p.y,
@@ -651,7 +651,7 @@ fn finish<D: Drive>(
 
 /// The error when the armature has pressed through to the magnet's pole
 /// (the drive's model ends there) at `time`.
-fn pole_limit<D: Drive>(model: &Model<'_, D>, y: &Y, time: f64) -> Option<DriveError> {
+fn pole_limit<D: Drive>(model: &Relay<'_, D>, y: &Y, time: f64) -> Option<DriveError> {
     let pole = model.drive.pole();
     let position = model.g() + y[0];
     (position >= pole).then_some(DriveError::ArmatureAtPole {
@@ -664,9 +664,9 @@ fn pole_limit<D: Drive>(model: &Model<'_, D>, y: &Y, time: f64) -> Option<DriveE
 /// The closing's chatter: its ending decided by the energy bound, or read
 /// at the horizon.
 pub(crate) fn closing_summary<D: Drive>(
-    model: &Model<'_, D>,
-    bound: &mut Bound,
-    rec: &mut Records,
+    model: &Relay<'_, D>,
+    bound: &mut EnergyBound,
+    rec: &mut Tally,
     ending: Option<Outcome>,
     (t, y, modes): (f64, Y, Modes),
     t_end: f64,
@@ -715,12 +715,12 @@ pub(crate) fn closing_summary<D: Drive>(
 /// Whether a closing's ending is decided at `t`: the contact closed and
 /// unable to release, or open after touching and unable to reach it again.
 pub(crate) fn decided<D: Drive>(
-    model: &Model<'_, D>,
-    bound: &mut Bound,
+    model: &Relay<'_, D>,
+    bound: &mut EnergyBound,
     t: f64,
     y: &Y,
     modes: Modes,
-    rec: &Records,
+    rec: &Tally,
 ) -> Option<Outcome> {
     if rec.contact.is_empty() || !bound.due(t) {
         return None;
@@ -735,13 +735,13 @@ pub(crate) fn decided<D: Drive>(
 /// Apply the event of `which` at `t` to the state and the records; the
 /// new modes.
 pub(crate) fn transition<D: Drive>(
-    model: &Model<'_, D>,
+    model: &Relay<'_, D>,
     settings: &Settings,
     which: Which,
     t: f64,
     y: &mut Y,
     mut modes: Modes,
-    rec: &mut Records,
+    rec: &mut Tally,
 ) -> Modes {
     let g = model.g();
     let no_blade = model.build.blade.is_none();
@@ -756,7 +756,7 @@ pub(crate) fn transition<D: Drive>(
                 }
                 let v = y[3];
                 rec.contact.push(Impact::touch(t, v));
-                Records::switch(&mut rec.intervals, t, ContactState::Closed);
+                Tally::switch(&mut rec.intervals, t, ContactState::Closed);
                 modes.contact = match model.contact {
                     Surface::Rigid { restitution } => rigid(
                         model,
@@ -781,7 +781,7 @@ pub(crate) fn transition<D: Drive>(
                 if let Some(last) = rec.contact.last_mut() {
                     release(last, t, y[3]);
                 }
-                Records::switch(&mut rec.intervals, t, ContactState::Open);
+                Tally::switch(&mut rec.intervals, t, ContactState::Open);
                 modes.contact = Stop::Open;
             }
         },
@@ -819,7 +819,7 @@ pub(crate) fn transition<D: Drive>(
                     y[2] = -g;
                 }
                 rec.back.push(Impact::touch(t, -y[1]));
-                Records::switch(&mut rec.back_intervals, t, ContactState::Closed);
+                Tally::switch(&mut rec.back_intervals, t, ContactState::Closed);
                 modes.rest = match model.back {
                     None => {
                         y[1] = 0.0;
@@ -842,7 +842,7 @@ pub(crate) fn transition<D: Drive>(
                 if let Some(last) = rec.back.last_mut() {
                     release(last, t, -y[1]);
                 }
-                Records::switch(&mut rec.back_intervals, t, ContactState::Open);
+                Tally::switch(&mut rec.back_intervals, t, ContactState::Open);
                 rec.lift_offs.push(t);
                 modes.rest = Stop::Open;
             }
@@ -857,14 +857,14 @@ pub(crate) fn transition<D: Drive>(
 /// `min_gap`). Returns the stop's new mode; records the rebound.
 #[allow(clippy::too_many_arguments)]
 fn rigid<D: Drive>(
-    model: &Model<'_, D>,
+    model: &Relay<'_, D>,
     settings: &Settings,
     which: Which,
     t: f64,
     y: &mut Y,
     modes: Modes,
     e: f64,
-    rec: &mut Records,
+    rec: &mut Tally,
 ) -> Stop {
     let no_blade = model.build.blade.is_none();
     // The velocity components of the body that hits, and its sign toward
@@ -914,7 +914,7 @@ fn rigid<D: Drive>(
             Which::Pole => None,
         };
         if let Some(iv) = intervals {
-            Records::switch(iv, t, ContactState::Open);
+            Tally::switch(iv, t, ContactState::Open);
         }
         if which == Which::Rest {
             rec.lift_offs.push(t);
@@ -930,11 +930,11 @@ struct Tracker;
 impl Tracker {
     fn sample<D: Drive>(
         &mut self,
-        model: &Model<'_, D>,
+        model: &Relay<'_, D>,
         dense: &Dense<5>,
         t1: f64,
         modes: Modes,
-        rec: &mut Records,
+        rec: &mut Tally,
     ) {
         let t0 = dense.t0;
         for k in 0..=SAMPLES {
@@ -974,7 +974,7 @@ impl Tracker {
 }
 
 /// Tolerances for the state's components.
-fn tolerance<D: Drive>(model: &Model<'_, D>) -> Tolerance<5> {
+fn tolerance<D: Drive>(model: &Relay<'_, D>) -> Tolerance<5> {
     let g = model.g();
     let omega = (model.m.stiffness / model.m.mass).sqrt();
     Tolerance {
@@ -990,7 +990,7 @@ fn tolerance<D: Drive>(model: &Model<'_, D>) -> Tolerance<5> {
 }
 
 /// rad/s, the fastest natural frequency in the model (the first trial step).
-fn fastest<D: Drive>(model: &Model<'_, D>) -> f64 {
+fn fastest<D: Drive>(model: &Relay<'_, D>) -> f64 {
     let m = model.m;
     let mut w = (m.stiffness / m.mass).sqrt();
     let mass_at_contact = model.build.blade.map_or(m.mass, |b| b.mass);
@@ -1101,7 +1101,7 @@ pub fn simulate_two_stage(
                 force: m.force,
                 time_scale: (m.mass / m.stiffness).sqrt(),
             };
-            let model = Model {
+            let model = Relay {
                 m,
                 build,
                 contact: stops.make,
@@ -1120,7 +1120,7 @@ pub fn simulate_two_stage(
                 });
             }
             let forced = super::super::forced::Forced::new(m, force);
-            let model = Model {
+            let model = Relay {
                 m,
                 build,
                 contact: stops.make,

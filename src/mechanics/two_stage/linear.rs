@@ -34,7 +34,7 @@ use nalgebra::{Matrix4, Vector4};
 use super::super::driven::Drive;
 use super::super::{DriveError, Settings, Surface};
 use super::Release;
-use super::engine::{Horizon, Model, Modes, Motion, Piece, Progress, Stop, Which, Y};
+use super::engine::{Horizon, Interpolant, Modes, Progress, Relay, Span, Stop, Which, Y};
 use crate::chatter::Outcome;
 
 /// The scaled deviation from a mode's equilibrium.
@@ -177,7 +177,7 @@ impl LinearSystem {
     /// The linear system of `model`, when it is one: a constant force (no
     /// rest stop), a blade, a Kelvin–Voigt contact, and a Kelvin–Voigt
     /// pole face or none.
-    pub(crate) fn of<D: Drive>(model: &Model<'_, D>) -> Option<LinearSystem> {
+    pub(crate) fn of<D: Drive>(model: &Relay<'_, D>) -> Option<LinearSystem> {
         let force = model.drive.constant()?;
         let blade = model.build.blade?;
         if model.rest {
@@ -370,18 +370,18 @@ const TERMS: usize = 28;
 /// One step's motion as a power series in τ: `w(τ) = Σ c_k τ^k`,
 /// `c_k = a^k w0 / k!`. Built only for steps where something must be
 /// located; any linear form of it is then a scalar polynomial.
-struct Series {
+struct Taylor {
     c: [W; TERMS],
 }
 
-impl Series {
-    fn new(mode: &LinearMode, w0: &W) -> Series {
+impl Taylor {
+    fn new(mode: &LinearMode, w0: &W) -> Taylor {
         let mut c = [W::zeros(); TERMS];
         c[0] = *w0;
         for k in 1..TERMS {
             c[k] = mode.a * c[k - 1] / k as f64;
         }
-        Series { c }
+        Taylor { c }
     }
 
     fn at(&self, tau: f64) -> W {
@@ -494,7 +494,7 @@ fn first_event(
     w1: &W,
     (aw0, aw1): (&W, &W),
     h: f64,
-    series: &mut Option<Series>,
+    series: &mut Option<Taylor>,
 ) -> Option<(f64, Which)> {
     let mut best: Option<(f64, Which)> = None;
     for &(which, guard) in guards {
@@ -502,7 +502,7 @@ fn first_event(
         if !needs {
             continue;
         }
-        let series = series.get_or_insert_with(|| Series::new(mode, w0));
+        let series = series.get_or_insert_with(|| Taylor::new(mode, w0));
         let polys: Vec<Poly> = guard.forms().map(|f| series.poly(f)).collect();
         let value = |tau: f64| match guard {
             Guard::One(_) => polys[0].value(tau),
@@ -553,7 +553,7 @@ fn first_event(
 /// Propagate `p` exactly from event to event, to the horizon.
 pub(crate) fn propagate<D: Drive>(
     system: &LinearSystem,
-    model: &Model<'_, D>,
+    model: &Relay<'_, D>,
     settings: &Settings,
     horizon: Horizon,
     p: &mut Progress,
@@ -579,7 +579,7 @@ pub(crate) fn propagate<D: Drive>(
             let w1 = if h == mode.h {
                 mode.phi * w
             } else {
-                Series::new(&mode, &w).at(h)
+                Taylor::new(&mode, &w).at(h)
             };
             let mut series = None;
             let aw1 = mode.a * w1;
@@ -601,8 +601,8 @@ pub(crate) fn propagate<D: Drive>(
                 &mut series,
             );
             let y_end = mode.y_of(&w_end);
-            p.pieces.push(Piece {
-                motion: Motion::Linear {
+            p.pieces.push(Span {
+                motion: Interpolant::Linear {
                     w0: w,
                     mode: mode.clone(),
                 },
@@ -657,7 +657,7 @@ fn track(
     (aw0, aw1): (&W, &W),
     h: f64,
     (force, ub): (&Form, &Form),
-    series: &mut Option<Series>,
+    series: &mut Option<Taylor>,
 ) {
     let mut at = |w: &W| {
         let y = mode.y_of(w);
@@ -676,7 +676,7 @@ fn track(
     };
     let inside = turns(watched, aw0, aw1);
     if inside {
-        let series = series.get_or_insert_with(|| Series::new(mode, w0));
+        let series = series.get_or_insert_with(|| Taylor::new(mode, w0));
         if let Some(tm) = series.poly(watched).extremum(h) {
             at(&series.at(tm));
         }

@@ -228,7 +228,7 @@ pub struct TwoStageRun {
     /// Integration steps taken.
     pub steps: usize,
     /// The motion, step by step, for [`super::Trajectory`].
-    pub(crate) pieces: Vec<engine::Piece>,
+    pub(crate) pieces: Vec<engine::Span>,
 }
 
 impl TwoStageRun {
