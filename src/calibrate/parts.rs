@@ -231,6 +231,23 @@ pub fn json() -> String {
     text
 }
 
+/// One part as JSON: its listing (as in [`json`]) and its fitted
+/// scenario under `scenario`, the TOML's tables as JSON objects.
+pub fn part_json(part: &Part) -> String {
+    let mut value = serde_json::to_value(listing(part)).expect("a part serializes");
+    let scenario: toml::Value =
+        toml::from_str(part.scenario).expect("the bundled scenarios are valid TOML");
+    if let serde_json::Value::Object(map) = &mut value {
+        map.insert(
+            "scenario".to_owned(),
+            serde_json::to_value(scenario).expect("TOML values serialize"),
+        );
+    }
+    let mut text = serde_json::to_string_pretty(&value).expect("a part serializes");
+    text.push('\n');
+    text
+}
+
 /// `parts` as a table: one block per part.
 pub fn table() -> String {
     use std::fmt::Write;

@@ -169,7 +169,8 @@ pub struct PartsArgs {
     #[arg(value_name = "NAME")]
     pub name: Option<String>,
 
-    /// Output format of the list.
+    /// Output format: of the list; with NAME, `json` prints the part (its
+    /// figures and its scenario) as JSON instead of its TOML scenario.
     #[arg(long, value_enum, default_value_t = FitFormat::Table)]
     pub format: FitFormat,
 
@@ -185,7 +186,10 @@ pub struct PartsArgs {
 pub fn parts(args: &PartsArgs) -> Result<()> {
     refuse_existing(args.output.as_deref(), args.force)?;
     let text = match &args.name {
-        Some(name) => parts::find(name)?.scenario.to_owned(),
+        Some(name) => match args.format {
+            FitFormat::Table => parts::find(name)?.scenario.to_owned(),
+            FitFormat::Json => parts::part_json(&parts::find(name)?),
+        },
         None => match args.format {
             FitFormat::Table => parts::table(),
             FitFormat::Json => parts::json(),

@@ -225,3 +225,104 @@ fn sweep_summaries_match_their_schema() {
         assert_valid("sweep-summary", &summary, name);
     }
 }
+
+#[test]
+fn raw_summaries_of_every_test_file_match_their_schema() {
+    let mut n = 0;
+    for dir in ["tests/data/raw", "tests/data/ltspice"] {
+        for entry in std::fs::read_dir(root().join(dir)).unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().is_none_or(|e| e != "raw") {
+                continue;
+            }
+            let out = Command::cargo_bin("chatterspice")
+                .unwrap()
+                .args(["raw", path.to_str().unwrap(), "--format", "json"])
+                .output()
+                .unwrap();
+            if !out.status.success() {
+                continue;
+            }
+            let doc: Value = serde_json::from_slice(&out.stdout).unwrap();
+            assert_valid("raw", &doc, &path.display().to_string());
+            n += 1;
+        }
+    }
+    assert!(n >= 20, "{n} raw files");
+}
+
+/// A scope trace of a bouncing contact pulling 3.3 V low, with noise.
+fn scope_csv(dir: &std::path::Path) -> PathBuf {
+    let edges = [1e-3, 1.05e-3, 1.3e-3, 1.34e-3, 1.6e-3];
+    let mut text = String::from("time,v\n");
+    for k in 0..3000 {
+        let t = k as f64 * 1e-6;
+        let closed = edges.iter().filter(|&&e| e <= t).count() % 2 == 1;
+        let noise = 0.01 * ((k * 7919 % 101) as f64 / 50.0 - 1.0);
+        let v = if closed { 0.0 } else { 3.3 } + noise;
+        text.push_str(&format!("{t:e},{v}\n"));
+    }
+    let path = dir.join("scope.csv");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn capture_and_fit_output_match_their_schemas() {
+    let dir = tempfile::tempdir().unwrap();
+    let scope = scope_csv(dir.path());
+    let scope = scope.to_str().unwrap();
+    let capture = json_of(&["capture", scope, "--format", "json"], 0);
+    assert_eq!(capture["bounce_count"], 2, "{capture}");
+    assert_valid("capture", &capture, "capture");
+    let record = dir.path().join("record.csv");
+    Command::cargo_bin("chatterspice")
+        .unwrap()
+        .args([
+            "capture",
+            scope,
+            "--format",
+            "csv",
+            "-o",
+            record.to_str().unwrap(),
+        ])
+        .assert()
+        .success();
+    // A record fit and a datasheet fit.
+    let fit = json_of(
+        &[
+            "fit",
+            &example("kelvin-voigt.toml"),
+            "--measured",
+            record.to_str().unwrap(),
+            "--free",
+            "surface.damping,mechanics.force",
+            "--format",
+            "json",
+        ],
+        0,
+    );
+    assert_valid("fit", &fit, "record fit");
+    let prior = root().join("parts/priors/omron-g5le-1-dc5.toml");
+    let fit = json_of(&["fit", prior.to_str().unwrap(), "--format", "json"], 0);
+    assert_valid("fit", &fit, "datasheet fit");
+}
+
+#[test]
+fn the_parts_list_and_every_part_match_their_schemas() {
+    let list = json_of(&["parts", "--format", "json"], 0);
+    assert_valid("parts", &list, "parts");
+    let names: Vec<String> = list
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["name"].as_str().unwrap().to_owned())
+        .collect();
+    assert!(names.len() >= 6);
+    for name in names {
+        let part = json_of(&["parts", &name, "--format", "json"], 0);
+        assert_valid("part", &part, &name);
+        assert_eq!(part["name"], name.as_str());
+        assert!(part["scenario"]["mechanics"]["mass"].is_number(), "{part}");
+    }
+}
