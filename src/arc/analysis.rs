@@ -207,152 +207,226 @@ pub fn analyze(
     chatter: &Chatter,
     coil_offs: &[f64],
 ) -> Result<ArcReport, MissingArcVector> {
-    let vectors = ArcVectors::in_plot(instance, plot).ok_or_else(|| MissingArcVector {
-        instance: instance.to_owned(),
-        vector: ArcVectors::of(instance).current,
-    })?;
-    let real = |name: &str| {
-        plot.real(name).ok_or_else(|| MissingArcVector {
-            instance: instance.to_owned(),
-            vector: name.to_owned(),
-        })
-    };
-    let time = match plot.scale() {
-        Some(Vector::Real(t)) => t,
-        _ => {
-            return Err(MissingArcVector {
-                instance: instance.to_owned(),
-                vector: "time".to_owned(),
-            });
-        }
-    };
-    let i = real(&vectors.current)?;
-    let v = real(&vectors.voltage)?;
-    let st = real(&vectors.state)?;
-    let ic = real(&vectors.clamp)?;
+    let samples = Samples::of(plot, instance)?;
     let openings = openings(chatter, coil_offs);
-    let n = time
-        .len()
-        .min(i.len())
-        .min(v.len())
-        .min(st.len())
-        .min(ic.len());
+    let runs = samples.runs(&openings, model);
+    let (arcs, breakdowns) = samples.events(&runs, &openings, gap);
+    let totals = totals(&arcs, &breakdowns);
+    Ok(ArcReport {
+        model: *model,
+        arcs,
+        breakdowns,
+        totals,
+        peak_voltage: samples.v[..samples.n]
+            .iter()
+            .fold(0.0f64, |m, x| m.max(x.abs())),
+    })
+}
 
-    #[derive(Clone, Copy, PartialEq)]
-    enum Kind {
-        Quiet,
-        Arc,
-        Discharge,
+/// What one sample of the open contact shows.
+#[derive(Clone, Copy, PartialEq)]
+enum Kind {
+    Quiet,
+    Arc,
+    Discharge,
+}
+
+/// A run of samples of one kind: (first, last, kind).
+type Run = (usize, usize, Kind);
+
+/// The vectors the analysis reads, over the points all of them have.
+struct Samples<'a> {
+    /// s
+    time: &'a [f64],
+    /// A, the contact current.
+    i: &'a [f64],
+    /// V, across the contact.
+    v: &'a [f64],
+    /// The arc state (≥ 0.5: on).
+    st: &'a [f64],
+    /// A, the clamp's current.
+    ic: &'a [f64],
+    /// The number of points every vector has.
+    n: usize,
+}
+
+impl<'a> Samples<'a> {
+    /// The arc vectors of contact instance `instance` in `plot`, or the
+    /// first one missing.
+    fn of(plot: &'a Plot, instance: &str) -> Result<Samples<'a>, MissingArcVector> {
+        let vectors = ArcVectors::in_plot(instance, plot).ok_or_else(|| MissingArcVector {
+            instance: instance.to_owned(),
+            vector: ArcVectors::of(instance).current,
+        })?;
+        let real = |name: &str| {
+            plot.real(name).ok_or_else(|| MissingArcVector {
+                instance: instance.to_owned(),
+                vector: name.to_owned(),
+            })
+        };
+        let time = match plot.scale() {
+            Some(Vector::Real(t)) => t,
+            _ => {
+                return Err(MissingArcVector {
+                    instance: instance.to_owned(),
+                    vector: "time".to_owned(),
+                });
+            }
+        };
+        let i = real(&vectors.current)?;
+        let v = real(&vectors.voltage)?;
+        let st = real(&vectors.state)?;
+        let ic = real(&vectors.clamp)?;
+        let n = time
+            .len()
+            .min(i.len())
+            .min(v.len())
+            .min(st.len())
+            .min(ic.len());
+        Ok(Samples {
+            time,
+            i,
+            v,
+            st,
+            ic,
+            n,
+        })
     }
-    // Only an open contact arcs or breaks down; while it is open the arc
-    // state decides which. (The clamp's own current cannot: against a
-    // capacitance across the contact, the trapezoidal rule makes it
-    // alternate from one time point to the next about the circuit's
-    // current, while its average, and the state, which sees it through a
-    // lag, are right.)
-    let open = |t: f64| {
-        let k = openings.partition_point(|o| o.start <= t);
-        k > 0 && t <= openings[k - 1].end
-    };
-    let kind = |k: usize| {
-        if !open(time[k]) {
-            Kind::Quiet
-        } else if st[k] >= 0.5 && ic[k].abs().max(i[k].abs()) > DISCHARGE_FRACTION * model.i_min {
-            Kind::Arc
-        } else if st[k] < 0.5 && ic[k].abs() > DISCHARGE_FRACTION * model.i_min {
-            Kind::Discharge
-        } else {
-            Kind::Quiet
-        }
-    };
 
-    // Runs of one kind of sample: (first, last, kind).
-    let mut runs: Vec<(usize, usize, Kind)> = Vec::new();
-    let mut k = 0;
-    while k < n {
-        let this = kind(k);
-        let first = k;
-        while k + 1 < n && kind(k + 1) == this {
+    /// The runs of arcing and of breaking-down samples, in time order:
+    /// a single time point is no event, and flicker within one opening
+    /// (gaps under [`MERGE_GAP`]) is one.
+    fn runs(&self, openings: &[Opening], model: &ArcModel) -> Vec<Run> {
+        let (time, i, st, ic, n) = (self.time, self.i, self.st, self.ic, self.n);
+        // Only an open contact arcs or breaks down; while it is open the arc
+        // state decides which. (The clamp's own current cannot: against a
+        // capacitance across the contact, the trapezoidal rule makes it
+        // alternate from one time point to the next about the circuit's
+        // current, while its average, and the state, which sees it through a
+        // lag, are right.)
+        let kind = |k: usize| {
+            if !is_open(openings, time[k]) {
+                Kind::Quiet
+            } else if st[k] >= 0.5 && ic[k].abs().max(i[k].abs()) > DISCHARGE_FRACTION * model.i_min
+            {
+                Kind::Arc
+            } else if st[k] < 0.5 && ic[k].abs() > DISCHARGE_FRACTION * model.i_min {
+                Kind::Discharge
+            } else {
+                Kind::Quiet
+            }
+        };
+
+        let mut runs: Vec<Run> = Vec::new();
+        let mut k = 0;
+        while k < n {
+            let this = kind(k);
+            let first = k;
+            while k + 1 < n && kind(k + 1) == this {
+                k += 1;
+            }
+            // A single time point has no duration and no energy: ngspice
+            // passing through the state, not an event.
+            if this != Kind::Quiet && k > first {
+                match runs.last_mut() {
+                    // Flicker within one opening is one event.
+                    Some(prev)
+                        if prev.2 == this
+                            && time[first] - time[prev.1] < MERGE_GAP
+                            && opening_at(openings, time[first])
+                                == opening_at(openings, time[prev.0]) =>
+                    {
+                        prev.1 = k;
+                    }
+                    _ => runs.push((first, k, this)),
+                }
+            }
             k += 1;
         }
-        // A single time point has no duration and no energy: ngspice
-        // passing through the state, not an event.
-        if this != Kind::Quiet && k > first {
-            match runs.last_mut() {
-                // Flicker within one opening is one event.
-                Some(prev)
-                    if prev.2 == this
-                        && time[first] - time[prev.1] < MERGE_GAP
-                        && opening_at(&openings, time[first])
-                            == opening_at(&openings, time[prev.0]) =>
-                {
-                    prev.1 = k;
+        runs
+    }
+
+    /// Each run as an arc or a breakdown: its opening, duration, peaks
+    /// and energy (trapezoids of |v·i|), and how it ended.
+    fn events(
+        &self,
+        runs: &[Run],
+        openings: &[Opening],
+        gap: &super::gap::GapProfile,
+    ) -> (Vec<ArcEvent>, Vec<Breakdown>) {
+        let (time, i, v, n) = (self.time, self.i, self.v, self.n);
+        let mut arcs = Vec::new();
+        let mut breakdowns: Vec<Breakdown> = Vec::new();
+        for (index, &(first, last, this)) in runs.iter().enumerate() {
+            let (mut energy, mut charge) = (0.0, 0.0);
+            for j in first..last {
+                let dt = time[j + 1] - time[j];
+                energy += 0.5 * ((v[j] * i[j]).abs() + (v[j + 1] * i[j + 1]).abs()) * dt;
+                charge += 0.5 * (i[j].abs() + i[j + 1].abs()) * dt;
+            }
+            let peak_current = i[first..=last].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            let (start, end) = (time[first], time[last]);
+            let (operation, opening) = opening_at(openings, start);
+            match this {
+                Kind::Arc => {
+                    let ends = if last + 1 >= n {
+                        "run_end"
+                    } else if !is_open(openings, time[last + 1]) {
+                        "contact_closed"
+                    } else {
+                        "current_below_i_min"
+                    };
+                    arcs.push(ArcEvent {
+                        operation,
+                        opening,
+                        start,
+                        duration: end - start,
+                        peak_current,
+                        energy,
+                        charge,
+                        gap_at_end: gap.at(end),
+                        ends,
+                    });
                 }
-                _ => runs.push((first, k, this)),
+                Kind::Discharge => {
+                    let next = runs.get(index + 1);
+                    let reignited = next.is_some_and(|&(f, _, kind)| {
+                        kind == Kind::Arc && time[f] - end < MERGE_GAP
+                    });
+                    breakdowns.push(Breakdown {
+                        operation,
+                        opening,
+                        start,
+                        duration: end - start,
+                        peak_voltage: v[first..=last].iter().fold(0.0f64, |m, x| m.max(x.abs())),
+                        peak_current,
+                        energy,
+                        reignited,
+                    });
+                }
+                Kind::Quiet => unreachable!("quiet runs are not kept"),
             }
         }
-        k += 1;
+        (arcs, breakdowns)
     }
+}
 
-    let mut arcs = Vec::new();
-    let mut breakdowns: Vec<Breakdown> = Vec::new();
-    for (index, &(first, last, this)) in runs.iter().enumerate() {
-        let (mut energy, mut charge) = (0.0, 0.0);
-        for j in first..last {
-            let dt = time[j + 1] - time[j];
-            energy += 0.5 * ((v[j] * i[j]).abs() + (v[j + 1] * i[j + 1]).abs()) * dt;
-            charge += 0.5 * (i[j].abs() + i[j + 1].abs()) * dt;
-        }
-        let peak_current = i[first..=last].iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        let (start, end) = (time[first], time[last]);
-        let (operation, opening) = opening_at(&openings, start);
-        match this {
-            Kind::Arc => {
-                let ends = if last + 1 >= n {
-                    "run_end"
-                } else if !open(time[last + 1]) {
-                    "contact_closed"
-                } else {
-                    "current_below_i_min"
-                };
-                arcs.push(ArcEvent {
-                    operation,
-                    opening,
-                    start,
-                    duration: end - start,
-                    peak_current,
-                    energy,
-                    charge,
-                    gap_at_end: gap.at(end),
-                    ends,
-                });
-            }
-            Kind::Discharge => {
-                let next = runs.get(index + 1);
-                let reignited = next
-                    .is_some_and(|&(f, _, kind)| kind == Kind::Arc && time[f] - end < MERGE_GAP);
-                breakdowns.push(Breakdown {
-                    operation,
-                    opening,
-                    start,
-                    duration: end - start,
-                    peak_voltage: v[first..=last].iter().fold(0.0f64, |m, x| m.max(x.abs())),
-                    peak_current,
-                    energy,
-                    reignited,
-                });
-            }
-            Kind::Quiet => unreachable!("quiet runs are not kept"),
-        }
-    }
+/// Whether the contact is open at `t` (s): inside one of `openings`.
+fn is_open(openings: &[Opening], t: f64) -> bool {
+    let k = openings.partition_point(|o| o.start <= t);
+    k > 0 && t <= openings[k - 1].end
+}
 
+/// The counts and energies over the run, and the most of them in one
+/// operation.
+fn totals(arcs: &[ArcEvent], breakdowns: &[Breakdown]) -> ArcTotals {
     let operations = arcs.iter().map(|a| a.operation + 1).max().unwrap_or(0);
     let mut per_operation = vec![(0.0, 0usize); operations];
-    for a in &arcs {
+    for a in arcs {
         per_operation[a.operation].0 += a.energy;
         per_operation[a.operation].1 += 1;
     }
-    let totals = ArcTotals {
+    ArcTotals {
         count: arcs.len(),
         energy: arcs.iter().map(|a| a.energy).fold(0.0, |s, e| s + e),
         breakdowns: breakdowns.len(),
@@ -360,14 +434,7 @@ pub fn analyze(
         longest: arcs.iter().map(|a| a.duration).fold(0.0, f64::max),
         max_operation_energy: per_operation.iter().map(|p| p.0).fold(0.0, f64::max),
         max_operation_count: per_operation.iter().map(|p| p.1).max().unwrap_or(0),
-    };
-    Ok(ArcReport {
-        model: *model,
-        arcs,
-        breakdowns,
-        totals,
-        peak_voltage: v[..n].iter().fold(0.0f64, |m, x| m.max(x.abs())),
-    })
+    }
 }
 
 /// For a run without `[arc]`: a warning when what the open contact saw

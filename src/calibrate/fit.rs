@@ -82,6 +82,8 @@ use crate::coil::{Coil, Source};
 use crate::mechanics::{Mechanics, simulate};
 use crate::scenario::{Scenario, ScenarioError};
 
+#[path = "fit_report.rs"]
+mod report;
 #[path = "fit_start.rs"]
 mod start;
 use start::closed_form_start;
@@ -794,7 +796,103 @@ fn event_residuals(measured: &[Event], model: &[Event]) -> (Vec<f64>, f64) {
 /// `[datasheet]` figures take part whenever it has any.
 pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitError> {
     let started = Instant::now();
-    let path = scenario.origin.display().to_string();
+    let problem = Problem::new(scenario, request)?;
+    let u_prior: Vec<f64> = problem.prior.iter().map(|p| p.ln()).collect();
+    let mut active: Vec<usize> = (0..problem.keys.len()).collect();
+    let mut notes = Vec::new();
+
+    // Multistart over the full candidate.
+    let starts = survey(&problem, &u_prior, &active);
+    let best = refine(&problem, &starts, &u_prior, &active);
+    // One bad edge: a glitch in the record, or a bounce it missed.
+    let (candidate, best) = set_aside_bad_edge(&problem, best, &active, &mut notes);
+    // The keys the data cannot see stay at their priors.
+    let held = hold_blind_keys(&problem, best, candidate, &u_prior, &mut active, &mut notes);
+    let parameters = report::uncertainties(&problem, &held, candidate, &u_prior, &active);
+    Ok(report::assemble(
+        &problem,
+        request,
+        &held.best.0,
+        candidate,
+        parameters,
+        notes,
+        started,
+    ))
+}
+
+/// The free keys with their priors and their bounds, in the key's unit.
+struct FreeKeys {
+    keys: Vec<String>,
+    prior: Vec<f64>,
+    low: Vec<f64>,
+    high: Vec<f64>,
+}
+
+/// What the fit is held against: the record's events, the datasheet (when
+/// it gives a figure) and the coil voltage of both.
+struct Evidence {
+    measured: Option<Vec<Event>>,
+    datasheet: Option<DatasheetSection>,
+    voltage: Option<f64>,
+}
+
+/// The point a stage reached and the cost there (sum of squares, prior
+/// rows included).
+type Point = (Vec<f64>, f64);
+
+/// The outcome of holding the keys the data cannot see: the refitted
+/// point, which keys are held, and the data Jacobian once every direction
+/// left is determined (`None` when that never happened).
+struct Held {
+    best: Point,
+    held: Vec<bool>,
+    jacobian: Option<DMatrix<f64>>,
+}
+
+impl<'a> Problem<'a> {
+    /// The problem of fitting `scenario` as `request` asks; an error for a
+    /// request that cannot start (no free key, no evidence, a prior that
+    /// does not simulate).
+    fn new(scenario: &'a Scenario, request: &FitRequest) -> Result<Problem<'a>, FitError> {
+        let path = scenario.origin.display().to_string();
+        let FreeKeys {
+            keys,
+            prior,
+            low,
+            high,
+        } = free_keys(scenario, request, &path)?;
+        let Evidence {
+            measured,
+            datasheet,
+            voltage,
+        } = evidence(scenario, request, &path)?;
+        let problem = Problem {
+            base: scenario,
+            keys,
+            prior,
+            low,
+            high,
+            measured,
+            datasheet,
+            voltage,
+            evaluations: std::cell::Cell::new(0),
+        };
+        let u_prior: Vec<f64> = problem.prior.iter().map(|p| p.ln()).collect();
+        if problem.data_residuals(&u_prior, Candidate::All).is_none() {
+            let message = match scenario.clone().set_numbers(&[]) {
+                Err(e) => e.to_string(),
+                Ok(()) => "its parameters are invalid".to_owned(),
+            };
+            return Err(FitError::Prior { path, message });
+        }
+        Ok(problem)
+    }
+}
+
+/// The free keys (the request's, else the scenario's `[fit] free`), each
+/// with its prior and its bounds (`[fit] bounds`, else a decade either
+/// side of the prior), checked.
+fn free_keys(scenario: &Scenario, request: &FitRequest, path: &str) -> Result<FreeKeys, FitError> {
     let section = scenario.fit.clone().unwrap_or_default();
     let keys = if request.free.is_empty() {
         section.free.clone()
@@ -809,17 +907,17 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
         let value = scenario
             .number(key)
             .map_err(|source| FitError::UnknownKey {
-                path: path.clone(),
+                path: path.to_owned(),
                 key: key.clone(),
                 source: Box::new(source),
             })?
             .ok_or_else(|| FitError::NoPrior {
-                path: path.clone(),
+                path: path.to_owned(),
                 key: key.clone(),
             })?;
         if !(value > 0.0 && value.is_finite()) {
             return Err(FitError::NotPositive {
-                path: path.clone(),
+                path: path.to_owned(),
                 key: key.clone(),
                 value,
             });
@@ -831,7 +929,7 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
             .unwrap_or([value / 10.0, value * 10.0]);
         if !(lo > 0.0 && lo <= value && value <= hi && hi.is_finite()) {
             return Err(FitError::Bounds {
-                path: path.clone(),
+                path: path.to_owned(),
                 key: key.clone(),
                 low: lo,
                 high: hi,
@@ -842,6 +940,18 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
         low.push(lo);
         high.push(hi);
     }
+    Ok(FreeKeys {
+        keys,
+        prior,
+        low,
+        high,
+    })
+}
+
+/// The evidence: the record's events and the datasheet's figures, checked
+/// (positive figures, a coil for the figures, a coil voltage for the
+/// times and for a coil-driven record, at least one of the two).
+fn evidence(scenario: &Scenario, request: &FitRequest, path: &str) -> Result<Evidence, FitError> {
     let datasheet = scenario
         .datasheet
         .clone()
@@ -855,7 +965,7 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
                 && !(value > 0.0 && value.is_finite())
             {
                 return Err(FitError::BadFigure {
-                    path: path.clone(),
+                    path: path.to_owned(),
                     figure,
                     value,
                 });
@@ -865,13 +975,15 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
     if let Some(d) = &datasheet {
         if scenario.coil.is_none() {
             return Err(FitError::NeedsCoil {
-                path: path.clone(),
+                path: path.to_owned(),
                 figure: figures(d)[0].0,
             });
         }
         let timed = d.operate_time.is_some() || d.bounce_time.is_some();
         if timed && d.coil_voltage.is_none() {
-            return Err(FitError::NeedsVoltage { path: path.clone() });
+            return Err(FitError::NeedsVoltage {
+                path: path.to_owned(),
+            });
         }
     }
     let voltage = scenario.datasheet.as_ref().and_then(|d| d.coil_voltage);
@@ -884,7 +996,9 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
                 });
             }
             if scenario.coil.is_some() && voltage.is_none() {
-                return Err(FitError::NeedsVoltage { path: path.clone() });
+                return Err(FitError::NeedsVoltage {
+                    path: path.to_owned(),
+                });
             }
             Some(events)
         }
@@ -893,101 +1007,118 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
     if measured.is_none() && datasheet.is_none() {
         return Err(FitError::NoEvidence);
     }
-    let problem = Problem {
-        base: scenario,
-        keys: keys.clone(),
-        prior: prior.clone(),
-        low,
-        high,
+    Ok(Evidence {
         measured,
         datasheet,
         voltage,
-        evaluations: std::cell::Cell::new(0),
-    };
-    let u_prior: Vec<f64> = prior.iter().map(|p| p.ln()).collect();
-    if problem.data_residuals(&u_prior, Candidate::All).is_none() {
-        let message = match scenario.clone().set_numbers(&[]) {
-            Err(e) => e.to_string(),
-            Ok(()) => "its parameters are invalid".to_owned(),
-        };
-        return Err(FitError::Prior { path, message });
-    }
+    })
+}
 
-    // Multistart over the full candidate.
-    let mut active: Vec<usize> = (0..keys.len()).collect();
+/// The starts of the local solver: the closed-form start, then the best
+/// points of a coarse survey of the log-bounds box.
+fn survey(problem: &Problem, u_prior: &[f64], active: &[usize]) -> Vec<Vec<f64>> {
     // A coarse survey of the log-bounds box (a Halton sequence:
     // deterministic and even) finds the basin: with many bounces the
     // misfit has many local minima where the event count changes, and
     // a local solver started far off lands in one of them.
     const BASES: [usize; 8] = [2, 3, 5, 7, 11, 13, 17, 19];
-    let survey = SURVEY_PER_KEY * keys.len();
+    let n = problem.keys.len();
+    let survey = SURVEY_PER_KEY * n;
     let mut sampled: Vec<(f64, Vec<f64>)> = (1..=survey)
         .map(|i| {
-            let u: Vec<f64> = (0..keys.len())
+            let u: Vec<f64> = (0..n)
                 .map(|k| {
                     let (lo, hi) = (problem.low[k].ln(), problem.high[k].ln());
                     lo + (hi - lo) * halton(i, BASES[k % BASES.len()])
                 })
                 .collect();
             let cost = problem
-                .residuals(&u, &active, Candidate::All)
+                .residuals(&u, active, Candidate::All)
                 .map_or(f64::INFINITY, |r| r.iter().map(|x| x * x).sum());
             (cost, u)
         })
         .collect();
     sampled.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut starts = vec![closed_form_start(&problem, &u_prior)];
+    let mut starts = vec![closed_form_start(problem, u_prior)];
     starts.extend(sampled.into_iter().take(EXTRA_STARTS).map(|(_, u)| u));
-    let mut best = (u_prior.clone(), f64::INFINITY);
-    for start in &starts {
-        let (u, cost) = problem.solve(start, &active, Candidate::All);
+    starts
+}
+
+/// The best point Levenberg–Marquardt reaches from any of `starts`, with
+/// every event taking part.
+fn refine(problem: &Problem, starts: &[Vec<f64>], u_prior: &[f64], active: &[usize]) -> Point {
+    let mut best = (u_prior.to_vec(), f64::INFINITY);
+    for start in starts {
+        let (u, cost) = problem.solve(start, active, Candidate::All);
         if cost < best.1 {
             best = (u, cost);
         }
     }
-    let mut candidate = Candidate::All;
-    let mut notes = Vec::new();
+    best
+}
 
-    // One bad edge: a glitch in the record, or a bounce it missed.
-    if let Some(measured) = &problem.measured {
-        let n_model = problem.evaluate(&best.0).map_or(0, |e| e.model.len());
-        let mut alternatives = Vec::new();
-        for j in 0..measured.len().saturating_sub(1) {
-            alternatives.push(Candidate::DropMeasured(j));
-        }
-        for j in 0..n_model.saturating_sub(1) {
-            alternatives.push(Candidate::DropModel(j));
-        }
-        let mut chosen = (candidate, best.clone());
-        for c in alternatives {
-            let (u, cost) = problem.solve(&best.0, &active, c);
-            if cost < 0.1 * best.1 && cost < chosen.1.1 {
-                chosen = (c, (u, cost));
-            }
-        }
-        if chosen.0 != Candidate::All {
-            candidate = chosen.0;
-            best = chosen.1;
-            notes.push(match candidate {
-                Candidate::DropMeasured(j) => format!(
-                    "set aside the measured {} at {:.6e} s and the {} after it as a spurious glitch",
-                    measured[j].kind.as_str(),
-                    measured[j].time,
-                    measured[j + 1].kind.as_str()
-                ),
-                _ => "the model has one bounce the record lacks (a missed edge pair); matched without it".to_owned(),
-            });
+/// With a record: refit from `best` with each adjacent pair of measured,
+/// or modelled, events dropped, and keep the drop that cuts the misfit
+/// tenfold (saying so in `notes`); else `best` with every event.
+fn set_aside_bad_edge(
+    problem: &Problem,
+    best: Point,
+    active: &[usize],
+    notes: &mut Vec<String>,
+) -> (Candidate, Point) {
+    let Some(measured) = &problem.measured else {
+        return (Candidate::All, best);
+    };
+    let n_model = problem.evaluate(&best.0).map_or(0, |e| e.model.len());
+    let mut alternatives = Vec::new();
+    for j in 0..measured.len().saturating_sub(1) {
+        alternatives.push(Candidate::DropMeasured(j));
+    }
+    for j in 0..n_model.saturating_sub(1) {
+        alternatives.push(Candidate::DropModel(j));
+    }
+    let mut chosen = (Candidate::All, best.clone());
+    for c in alternatives {
+        let (u, cost) = problem.solve(&best.0, active, c);
+        if cost < 0.1 * best.1 && cost < chosen.1.1 {
+            chosen = (c, (u, cost));
         }
     }
+    if chosen.0 != Candidate::All {
+        notes.push(match chosen.0 {
+            Candidate::DropMeasured(j) => format!(
+                "set aside the measured {} at {:.6e} s and the {} after it as a spurious glitch",
+                measured[j].kind.as_str(),
+                measured[j].time,
+                measured[j + 1].kind.as_str()
+            ),
+            _ => {
+                "the model has one bounce the record lacks (a missed edge pair); matched without it"
+                    .to_owned()
+            }
+        });
+    }
+    chosen
+}
 
-    // Hold the keys the data cannot see at their priors, one per
-    // near-singular direction.
+/// Hold the keys the data cannot see at their priors, one per
+/// near-singular direction of JᵀJ, refitting the rest after each (and
+/// saying so in `notes`); `active` loses the held keys.
+fn hold_blind_keys(
+    problem: &Problem,
+    mut best: Point,
+    candidate: Candidate,
+    u_prior: &[f64],
+    active: &mut Vec<usize>,
+    notes: &mut Vec<String>,
+) -> Held {
+    let keys = &problem.keys;
     let data_rows = problem.data_len();
     let mut held = vec![false; keys.len()];
     let mut jacobian = None;
     for _ in 0..keys.len() {
         let f = |x: &[f64]| problem.data_residuals(x, candidate);
-        let Some(j) = problem.jacobian(&best.0, &active, f, data_rows) else {
+        let Some(j) = problem.jacobian(&best.0, active, f, data_rows) else {
             break;
         };
         let a = j.transpose() * &j;
@@ -1024,186 +1155,18 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
             "`{}` is not determined by the evidence (it moves only together with {}); held at its prior {}",
             keys[k],
             if partners.is_empty() { "nothing: the evidence does not depend on it".to_owned() } else { partners.join(", ") },
-            prior[k]
+            problem.prior[k]
         ));
-        best = problem.solve(&best.0, &active, candidate);
+        best = problem.solve(&best.0, active, candidate);
         if active.is_empty() {
             break;
         }
     }
-
-    // Uncertainties.
-    let data = problem
-        .data_residuals(&best.0, candidate)
-        .unwrap_or_default();
-    let ssr: f64 = data.iter().map(|x| x * x).sum();
-    let dof = data_rows.saturating_sub(active.len()).max(1);
-    let rms2 = ssr / dof as f64;
-    let covariance = jacobian
-        .as_ref()
-        .and_then(|j| (j.transpose() * j).try_inverse());
-    let mut parameters = Vec::new();
-    for (k, key) in keys.iter().enumerate() {
-        let value = if best.0[k] == u_prior[k] {
-            prior[k]
-        } else {
-            best.0[k].exp()
-        };
-        let sigma = if held[k] {
-            None
-        } else {
-            let col = active.iter().position(|&a| a == k);
-            Some(match (&covariance, col) {
-                (Some(c), Some(col)) => value * (c[(col, col)] * rms2).sqrt(),
-                _ => f64::INFINITY,
-            })
-        };
-        let determined = sigma.is_some_and(|s| s.is_finite() && s < value);
-        parameters.push(ParameterRow {
-            key: key.clone(),
-            prior: prior[k],
-            value,
-            sigma: sigma.filter(|s| s.is_finite()),
-            determined,
-        });
+    Held {
+        best,
+        held,
+        jacobian,
     }
-
-    // The report's rows.
-    let fitted = problem
-        .scenario_at(&best.0)
-        .unwrap_or_else(|| scenario.clone());
-    let evaluation = problem.evaluate(&best.0);
-    let mut events = Vec::new();
-    let mut bounce_count = None;
-    let mut time_offset = None;
-    let mut event_rms = None;
-    if let (Some(measured), Some(e)) = (&problem.measured, &evaluation) {
-        let (m, model) = problem.matched(e, candidate);
-        let (rows, offset) = event_residuals(&m, &model);
-        time_offset = Some(offset);
-        let k = m.len().min(model.len());
-        event_rms = Some((rows.iter().map(|x| x * x).sum::<f64>() / m.len() as f64).sqrt());
-        let skipped = match candidate {
-            Candidate::DropMeasured(j) => Some(j),
-            _ => None,
-        };
-        let mut mi = 0;
-        for (i, ev) in measured.iter().enumerate() {
-            if skipped.is_some_and(|j| i == j || i == j + 1) {
-                events.push(EventRow {
-                    kind: ev.kind,
-                    measured: Some(ev.time),
-                    model: None,
-                    residual: None,
-                    dropped: true,
-                });
-                continue;
-            }
-            let model_time = (mi < k).then(|| model[mi].time - offset);
-            events.push(EventRow {
-                kind: ev.kind,
-                measured: Some(ev.time),
-                model: model_time,
-                residual: model_time.map(|t| t - ev.time),
-                dropped: false,
-            });
-            mi += 1;
-        }
-        for extra in model.iter().skip(m.len()) {
-            events.push(EventRow {
-                kind: extra.kind,
-                measured: None,
-                model: Some(extra.time - offset),
-                residual: None,
-                dropped: false,
-            });
-        }
-        let bounces = |ev: &[Event]| ev.iter().filter(|e| e.kind == EventKind::Break).count();
-        bounce_count = Some(BounceCount {
-            measured: bounces(&m),
-            model: bounces(&e.model),
-        });
-    }
-    let mut datasheet_rows = Vec::new();
-    let mut pick_up_binds = None;
-    if let (Some(d), Some(e)) = (&problem.datasheet, &evaluation) {
-        let pick = pick_up_of(&fitted);
-        for ((figure, target), (_, model)) in figures(d).into_iter().zip(&e.figures) {
-            datasheet_rows.push(FigureRow {
-                figure,
-                target,
-                model: *model,
-                residual: model.map(|m| (m - target) / target),
-                binds: false,
-                position: pick.and_then(|(pu, line)| match figure {
-                    "pick_up_voltage" => Some(pu.binding_position),
-                    "drop_out_voltage" => Some(line.closed_position()),
-                    _ => None,
-                }),
-            });
-        }
-        if let (Some(_), Some(c), Some((pu, line))) = (d.pick_up_voltage, &fitted.coil, pick) {
-            let text = pu.binding_text(&line);
-            notes.push(if pu.at_rest() {
-                format!("the pick-up binds {text}: the pull at rest against the preload")
-            } else {
-                let coil = Coil::from(c);
-                let lift = coil.resistance * (2.0 * line.preload / coil.d_inductance(0.0)).sqrt();
-                format!(
-                    "the pick-up binds {text}: the armature lifts off at {lift:.4} V but stalls there below {:.4} V",
-                    pu.voltage
-                )
-            });
-            pick_up_binds = Some(text);
-        }
-        let worst = datasheet_rows
-            .iter()
-            .enumerate()
-            .filter(|(_, r)| r.figure != "release_time")
-            .map(|(i, r)| (i, r.residual.map_or(f64::INFINITY, f64::abs)))
-            .fold(
-                (usize::MAX, -1.0),
-                |acc, (i, v)| if v > acc.1 { (i, v) } else { acc },
-            );
-        if let Some(row) = datasheet_rows.get_mut(worst.0) {
-            row.binds = true;
-        }
-    }
-    let rms_residual = match event_rms {
-        Some(r) => r,
-        None => {
-            let rel: Vec<f64> = datasheet_rows
-                .iter()
-                .filter(|r| r.figure != "release_time")
-                .map(|r| r.residual.unwrap_or(1.0))
-                .collect();
-            (rel.iter().map(|x| x * x).sum::<f64>() / rel.len().max(1) as f64).sqrt()
-        }
-    };
-    let mut fitted_to = Vec::new();
-    if let Some(r) = &request.record {
-        fitted_to.push(r.name.clone());
-    }
-    if problem.datasheet.is_some() {
-        fitted_to.push("datasheet".to_owned());
-    }
-    let mut fitted = fitted;
-    let report = FitReport {
-        parameters,
-        events,
-        bounce_count,
-        datasheet: datasheet_rows,
-        time_offset,
-        rms_residual,
-        evaluations: problem.evaluations.get(),
-        elapsed: started.elapsed().as_secs_f64(),
-        pick_up_binds,
-        notes,
-        fitted: scenario.clone(),
-        fitted_to: fitted_to.join(" + "),
-    };
-    fitted.provenance = Some(report.provenance());
-    Ok(FitReport { fitted, ..report })
 }
 
 /// The fitted scenario as TOML: the prior file's text with the fitted

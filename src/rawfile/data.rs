@@ -14,78 +14,22 @@ pub(super) fn read_binary(
         lengths,
         ..
     } = header;
-    let complex = plot.flags.complex;
-    let width = if complex { 16 } else { 8 };
-    let declared = plot.declared_points;
+    let shape = Shape::of(&plot, nvars, &lengths);
     let rest = cur.rest();
     let start = cur.pos;
-
-    let uniform = plot.flags.padded || lengths.iter().all(|&l| l == declared);
-    let row = nvars * width;
-    let open_ended = declared == 0;
-    if open_ended && (rest.is_empty() || next_is_header(rest)) {
+    if shape.open_ended && (rest.is_empty() || next_is_header(rest)) {
         // A plot that legitimately has no points (or a run that failed
         // before its first point): nothing to read, nothing lost.
         plot.columns = empty_columns(&plot);
         cur.line = None;
         return Ok((plot, Vec::new()));
     }
+    check_flags(cur, rest, &shape)?;
 
-    // Data that end exactly where the other kind of value would put them:
-    // the `Flags:` line is wrong (8 bytes a value for real, 16 for complex).
-    if uniform && !open_ended && declared > 0 {
-        let other = if complex { 8 } else { 16 };
-        let ends_there = |end: usize| {
-            rest.len() == end
-                || rest
-                    .get(end..)
-                    .is_some_and(|r| next_is_header(r.trim_ascii_start()))
-        };
-        let theirs = declared.checked_mul(nvars * other);
-        // Flagged real with twice the data: extra real points (ngspice's
-        // interpolation writes some) are told from complex values by the
-        // scale, which does not increase when read with the wrong size.
-        // Flagged complex with half the data: real values.
-        if theirs.is_some_and(ends_there)
-            && !declared.checked_mul(row).is_some_and(ends_there)
-            && (complex
-                || (!scale_increases(rest, row, declared)
-                    && scale_increases(rest, nvars * other, declared)))
-        {
-            return Err(RawError::FlagMismatch {
-                at: cur.at(),
-                flagged: if complex { "complex" } else { "real" },
-                found: if complex { "real" } else { "complex" },
-                bytes: other,
-            });
-        }
-    }
-    // A file whose data do not end where the header says, at the end of
-    // the file or at the next plot's header, went through `.options
-    // interp`: walk it point by point (restarts, extra points).
-    let irregular = uniform
-        && !open_ended
-        && row > 0
-        && declared
-            .checked_mul(row)
-            .is_some_and(|end| rest.len() > end && !next_is_header(&rest[end..]));
-    let sections = if irregular {
-        // Less than a whole point past the declared ones, and no restart:
-        // not ngspice's doing; the garbage is reported where it starts.
-        Some(sections(rest, row, &plot.variables))
-            .filter(|s| s.restarts > 0 || s.points > declared)
-            .unwrap_or_default()
-    } else {
-        Sections::default()
-    };
-    let irregular = irregular && sections.points > 0;
-    let sections = if irregular {
-        sections
-    } else {
-        Sections::default()
-    };
-    let extra = sections.points.saturating_sub(declared);
-    let (skip, tail) = (sections.skip, sections.tail);
+    let interpolated = interpolated_sections(rest, &shape, &plot.variables);
+    let irregular = interpolated.is_some();
+    let sections = interpolated.unwrap_or_default();
+    let extra = sections.points.saturating_sub(shape.declared);
     let mut warnings = Vec::new();
     if sections.restarts > 0 {
         warnings.push(RawWarning::Restarted {
@@ -94,92 +38,217 @@ pub(super) fn read_binary(
             dropped: sections.dropped,
         });
     }
-    let (read, used) = if uniform {
+    let (columns, read, used) = if shape.uniform {
+        let row = shape.row;
         // Whole points the bytes hold, whatever the header claims.
-        let whole = if open_ended {
+        let whole = if shape.open_ended {
             rest.len() / row
         } else if irregular {
             sections.points
         } else {
-            declared.min(rest.len() / row)
+            shape.declared.min(rest.len() / row)
         };
+        let skip = sections.skip;
         let data = &rest[skip..skip + whole * row];
-        let lens: Vec<usize> = if open_ended || extra > 0 {
+        let lens: Vec<usize> = if shape.open_ended || extra > 0 {
             vec![whole; nvars]
         } else {
             lengths.iter().map(|&l| l.min(whole)).collect()
         };
-        // One pass over the rows, each value written straight to its place
-        // in its column (sized up front, so no capacity checks): the input
-        // is read once, and the output pages are touched in order.
-        let columns = if !complex {
-            let mut cols: Vec<Vec<f64>> = lens.iter().map(|&l| vec![0.0; l]).collect();
-            for (i, r) in data.chunks_exact(row).enumerate() {
-                for (col, cell) in cols.iter_mut().zip(r.chunks_exact(8)) {
-                    if let Some(d) = col.get_mut(i) {
-                        *d = le_f64(cell, 0);
-                    }
-                }
-            }
-            cols.into_iter().map(Column::Real).collect()
-        } else {
-            let mut cols: Vec<Column> = plot
-                .variables
-                .iter()
-                .enumerate()
-                .map(|(j, v)| {
-                    if real_in_complex_plot(v, j) {
-                        Column::Real(vec![0.0; lens[j]])
-                    } else {
-                        Column::Complex(vec![Complex64::new(0.0, 0.0); lens[j]])
-                    }
-                })
-                .collect();
-            for (i, r) in data.chunks_exact(row).enumerate() {
-                for (col, cell) in cols.iter_mut().zip(r.chunks_exact(16)) {
-                    match col {
-                        Column::Real(v) => {
-                            if let Some(d) = v.get_mut(i) {
-                                *d = le_f64(cell, 0);
-                            }
-                        }
-                        Column::Complex(v) => {
-                            if let Some(d) = v.get_mut(i) {
-                                *d = Complex64::new(le_f64(cell, 0), le_f64(cell, 8));
-                            }
-                        }
-                    }
-                }
-            }
-            cols
-        };
-        plot.columns = columns;
-        (whole, skip + whole * row)
+        let columns = read_rows(data, &plot, &lens, &shape);
+        (columns, whole, skip + whole * row)
     } else {
-        let (columns, read, used) = read_binary_unpadded(rest, &plot, &lengths, width);
-        plot.columns = columns;
-        (read, used)
+        read_binary_unpadded(rest, &plot, &lengths, shape.width)
     };
-    cur.pos = start + used + tail;
+    plot.columns = columns;
+    cur.pos = start + used + sections.tail;
     cur.line = None;
+    warnings.extend(count_warning(cur, &shape, index, extra, read));
+    Ok((plot, warnings))
+}
 
+/// The layout of a binary plot's data, as its header declares it.
+struct Shape {
+    /// Variables a point.
+    nvars: usize,
+    /// Whether the values are complex (16 bytes) or real (8 bytes).
+    complex: bool,
+    /// Bytes a value.
+    width: usize,
+    /// The points the header declares; 0 for a run still writing.
+    declared: usize,
+    /// Bytes a point, all variables.
+    row: usize,
+    /// Every point has every variable: padded, or all vectors full length.
+    uniform: bool,
+    /// No point count declared: read what is there.
+    open_ended: bool,
+}
+
+impl Shape {
+    /// The shape of `plot`'s data, with `nvars` variables of `lengths`
+    /// points each.
+    fn of(plot: &Plot, nvars: usize, lengths: &[usize]) -> Shape {
+        let complex = plot.flags.complex;
+        let width = if complex { 16 } else { 8 };
+        let declared = plot.declared_points;
+        Shape {
+            nvars,
+            complex,
+            width,
+            declared,
+            row: nvars * width,
+            uniform: plot.flags.padded || lengths.iter().all(|&l| l == declared),
+            open_ended: declared == 0,
+        }
+    }
+}
+
+/// An error for data that end exactly where the other kind of value would
+/// put them: the `Flags:` line is wrong (8 bytes a value for real, 16 for
+/// complex).
+fn check_flags(cur: &Cursor<'_>, rest: &[u8], shape: &Shape) -> Result<(), RawError> {
+    let Shape {
+        nvars,
+        complex,
+        declared,
+        row,
+        ..
+    } = *shape;
+    if !(shape.uniform && !shape.open_ended && declared > 0) {
+        return Ok(());
+    }
+    let other = if complex { 8 } else { 16 };
+    let ends_there = |end: usize| {
+        rest.len() == end
+            || rest
+                .get(end..)
+                .is_some_and(|r| next_is_header(r.trim_ascii_start()))
+    };
+    let theirs = declared.checked_mul(nvars * other);
+    // Flagged real with twice the data: extra real points (ngspice's
+    // interpolation writes some) are told from complex values by the
+    // scale, which does not increase when read with the wrong size.
+    // Flagged complex with half the data: real values.
+    if theirs.is_some_and(ends_there)
+        && !declared.checked_mul(row).is_some_and(ends_there)
+        && (complex
+            || (!scale_increases(rest, row, declared)
+                && scale_increases(rest, nvars * other, declared)))
+    {
+        return Err(RawError::FlagMismatch {
+            at: cur.at(),
+            flagged: if complex { "complex" } else { "real" },
+            found: if complex { "real" } else { "complex" },
+            bytes: other,
+        });
+    }
+    Ok(())
+}
+
+/// The sections of data that do not end where the header says, at the end
+/// of the file or at the next plot's header: a file that went through
+/// `.options interp`, walked point by point (restarts, extra points).
+/// `None` for data read as declared.
+fn interpolated_sections(rest: &[u8], shape: &Shape, variables: &[Variable]) -> Option<Sections> {
+    let Shape { declared, row, .. } = *shape;
+    let overrun = shape.uniform
+        && !shape.open_ended
+        && row > 0
+        && declared
+            .checked_mul(row)
+            .is_some_and(|end| rest.len() > end && !next_is_header(&rest[end..]));
+    if !overrun {
+        return None;
+    }
+    // Less than a whole point past the declared ones, and no restart:
+    // not ngspice's doing; the garbage is reported where it starts.
+    Some(sections(rest, row, variables))
+        .filter(|s| s.restarts > 0 || s.points > declared)
+        .filter(|s| s.points > 0)
+}
+
+/// The columns of whole points `data` (`shape.row` bytes each), `lens`
+/// values in each column.
+fn read_rows(data: &[u8], plot: &Plot, lens: &[usize], shape: &Shape) -> Vec<Column> {
+    let row = shape.row;
+    // One pass over the rows, each value written straight to its place
+    // in its column (sized up front, so no capacity checks): the input
+    // is read once, and the output pages are touched in order.
+    if !shape.complex {
+        let mut cols: Vec<Vec<f64>> = lens.iter().map(|&l| vec![0.0; l]).collect();
+        for (i, r) in data.chunks_exact(row).enumerate() {
+            for (col, cell) in cols.iter_mut().zip(r.chunks_exact(8)) {
+                if let Some(d) = col.get_mut(i) {
+                    *d = le_f64(cell, 0);
+                }
+            }
+        }
+        cols.into_iter().map(Column::Real).collect()
+    } else {
+        let mut cols: Vec<Column> = plot
+            .variables
+            .iter()
+            .enumerate()
+            .map(|(j, v)| {
+                if real_in_complex_plot(v, j) {
+                    Column::Real(vec![0.0; lens[j]])
+                } else {
+                    Column::Complex(vec![Complex64::new(0.0, 0.0); lens[j]])
+                }
+            })
+            .collect();
+        for (i, r) in data.chunks_exact(row).enumerate() {
+            for (col, cell) in cols.iter_mut().zip(r.chunks_exact(16)) {
+                match col {
+                    Column::Real(v) => {
+                        if let Some(d) = v.get_mut(i) {
+                            *d = le_f64(cell, 0);
+                        }
+                    }
+                    Column::Complex(v) => {
+                        if let Some(d) = v.get_mut(i) {
+                            *d = Complex64::new(le_f64(cell, 0), le_f64(cell, 8));
+                        }
+                    }
+                }
+            }
+        }
+        cols
+    }
+}
+
+/// The warning for a plot of `read` points where the header declares
+/// another count: more (interpolation's `extra` points), or fewer (the run
+/// was cut: only the last plot of a file can be, so `cur` moves to the end
+/// past the partial point).
+fn count_warning(
+    cur: &mut Cursor<'_>,
+    shape: &Shape,
+    index: usize,
+    extra: usize,
+    read: usize,
+) -> Option<RawWarning> {
+    let declared = shape.declared;
     if extra > 0 {
-        warnings.push(RawWarning::ExtraPoints {
+        Some(RawWarning::ExtraPoints {
             plot: index,
             declared,
             read,
-        });
-    } else if open_ended || read < declared {
-        warnings.push(RawWarning::Truncated {
+        })
+    } else if shape.open_ended || read < declared {
+        let warning = RawWarning::Truncated {
             plot: index,
             declared,
             read,
             offset: cur.pos,
-        });
+        };
         // Only the last plot of a file can be cut: the rest is the partial point.
         cur.pos = cur.bytes.len();
+        Some(warning)
+    } else {
+        None
     }
-    Ok((plot, warnings))
 }
 
 pub(super) fn empty_columns(plot: &Plot) -> Vec<Column> {

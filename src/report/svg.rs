@@ -194,54 +194,92 @@ const AXIS_COLOR: &str = "#333333";
 
 /// The SVG document for `plot`.
 pub fn render(plot: &SvgPlot) -> Result<String, SvgError> {
-    let (t0, t1) = plot.window;
-    if !(t0.is_finite() && t1.is_finite() && t0 < t1) {
-        return Err(SvgError::Window { start: t0, end: t1 });
-    }
-    if plot.contact.is_none() && plot.probes.is_empty() {
-        return Err(SvgError::Empty);
-    }
-    let contact = match plot.contact {
-        Some(trace) => Some(contact_points(trace, t0, t1)?),
-        None => None,
-    };
-    let mut probes = Vec::with_capacity(plot.probes.len());
-    for p in &plot.probes {
-        check(&p.name, p.series)?;
-        probes.push(decimate(p.series.time, p.series.value, t0, t1, COLUMNS));
-    }
-
-    let panels = usize::from(contact.is_some()) as f64 * (CONTACT_HEIGHT + GAP)
-        + plot.probes.len() as f64 * (PROBE_HEIGHT + GAP);
-    let height = TOP + panels - GAP + BOTTOM;
-    let time = Axis::linear(t0, t1, 8).with_unit("s");
-    let x = |t: f64| LEFT + (t - t0) / (t1 - t0) * PLOT_WIDTH;
-    let bands = match plot.contact {
-        Some(ContactTrace::States(intervals)) => closed_bands(intervals, t0, t1),
-        _ => Vec::new(),
-    };
-
+    let layout = Layout::of(plot)?;
     let mut out = String::new();
-    let _ = writeln!(
-        out,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="Helvetica, Arial, sans-serif" font-size="12">"#,
-        w = num(WIDTH),
-        h = num(height),
-    );
-    let _ = writeln!(out, "<title>{}</title>", escape(&plot.title));
-    let _ = writeln!(out, r#"<rect width="100%" height="100%" fill="white"/>"#);
-    let _ = writeln!(
-        out,
-        r#"<text x="{}" y="24" font-size="16" font-weight="bold">{}</text>"#,
-        num(LEFT),
-        escape(&plot.title)
-    );
+    heading(&mut out, &plot.title, layout.height);
     legend(&mut out, plot.probes.is_empty());
 
     let mut top = TOP;
     let mut clip = 0;
-    let mut frame = |out: &mut String, top: f64, height: f64| {
-        clip += 1;
+    if let Some(points) = &layout.contact {
+        contact_panel(&mut out, plot, &layout, points, top, &mut clip);
+        top += CONTACT_HEIGHT + GAP;
+    }
+    for (p, points) in plot.probes.iter().zip(&layout.probes) {
+        probe_panel(&mut out, p, &layout, points, top, &mut clip);
+        top += PROBE_HEIGHT + GAP;
+    }
+    // The shared time axis under the last panel.
+    time_axis(&mut out, &layout, top - GAP);
+    out.push_str("</svg>\n");
+    Ok(out)
+}
+
+/// What the panels share: the window, the time axis and the picture's
+/// height, with the data checked and decimated to the plot's columns.
+struct Layout {
+    /// s, the time axis from `.0` to `.1`.
+    window: (f64, f64),
+    /// The time axis's ticks and labels.
+    time: Axis,
+    /// px, the whole picture.
+    height: f64,
+    /// The contact trace's points, when there is a contact panel.
+    contact: Option<Vec<(f64, f64)>>,
+    /// Each probe's points, in panel order.
+    probes: Vec<Vec<(f64, f64)>>,
+    /// px, the closed intervals shaded behind the probes.
+    bands: Vec<(f64, f64)>,
+}
+
+impl Layout {
+    /// The layout of `plot`, or why it cannot be drawn.
+    fn of(plot: &SvgPlot) -> Result<Layout, SvgError> {
+        let (t0, t1) = plot.window;
+        if !(t0.is_finite() && t1.is_finite() && t0 < t1) {
+            return Err(SvgError::Window { start: t0, end: t1 });
+        }
+        if plot.contact.is_none() && plot.probes.is_empty() {
+            return Err(SvgError::Empty);
+        }
+        let contact = match plot.contact {
+            Some(trace) => Some(contact_points(trace, t0, t1)?),
+            None => None,
+        };
+        let mut probes = Vec::with_capacity(plot.probes.len());
+        for p in &plot.probes {
+            check(&p.name, p.series)?;
+            probes.push(decimate(p.series.time, p.series.value, t0, t1, COLUMNS));
+        }
+
+        let panels = usize::from(contact.is_some()) as f64 * (CONTACT_HEIGHT + GAP)
+            + plot.probes.len() as f64 * (PROBE_HEIGHT + GAP);
+        let height = TOP + panels - GAP + BOTTOM;
+        let time = Axis::linear(t0, t1, 8).with_unit("s");
+        let bands = match plot.contact {
+            Some(ContactTrace::States(intervals)) => closed_bands(intervals, t0, t1),
+            _ => Vec::new(),
+        };
+        Ok(Layout {
+            window: (t0, t1),
+            time,
+            height,
+            contact,
+            probes,
+            bands,
+        })
+    }
+
+    /// px, the abscissa of time `t` (s).
+    fn x(&self, t: f64) -> f64 {
+        let (t0, t1) = self.window;
+        LEFT + (t - t0) / (t1 - t0) * PLOT_WIDTH
+    }
+
+    /// A panel's clip path (numbered on from `clip`, the number returned)
+    /// and its vertical grid lines at the time ticks.
+    fn frame(&self, out: &mut String, clip: &mut usize, top: f64, height: f64) -> usize {
+        *clip += 1;
         let _ = writeln!(
             out,
             r#"<clipPath id="panel{clip}"><rect x="{}" y="{}" width="{}" height="{}"/></clipPath>"#,
@@ -250,169 +288,211 @@ pub fn render(plot: &SvgPlot) -> Result<String, SvgError> {
             num(PLOT_WIDTH),
             num(height)
         );
-        for &t in &time.ticks {
+        for &t in &self.time.ticks {
             let _ = writeln!(
                 out,
                 r#"<line x1="{x}" y1="{}" x2="{x}" y2="{}" stroke="{GRID_COLOR}"/>"#,
                 num(top),
                 num(top + height),
-                x = num(x(t))
+                x = num(self.x(t))
             );
         }
-        clip
+        *clip
+    }
+}
+
+/// The document's opening: the `<svg>` element `height` px high, its
+/// title, the white background and the title line over the picture.
+fn heading(out: &mut String, title: &str, height: f64) {
+    let _ = writeln!(
+        out,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="Helvetica, Arial, sans-serif" font-size="12">"#,
+        w = num(WIDTH),
+        h = num(height),
+    );
+    let _ = writeln!(out, "<title>{}</title>", escape(title));
+    let _ = writeln!(out, r#"<rect width="100%" height="100%" fill="white"/>"#);
+    let _ = writeln!(
+        out,
+        r#"<text x="{}" y="24" font-size="16" font-weight="bold">{}</text>"#,
+        num(LEFT),
+        escape(title)
+    );
+}
+
+/// The contact panel at `top`: the trace (`points`) with its arcs and
+/// breakdowns behind it and the pole-face impacts over it.
+fn contact_panel(
+    out: &mut String,
+    plot: &SvgPlot,
+    layout: &Layout,
+    points: &[(f64, f64)],
+    top: f64,
+    clip: &mut usize,
+) {
+    let (t0, t1) = layout.window;
+    let x = |t: f64| layout.x(t);
+    let _ = writeln!(out, "<g>");
+    let id = layout.frame(out, clip, top, CONTACT_HEIGHT);
+    let (axis, label, values): (Axis, &str, Vec<(f64, f64)>) = match plot.contact {
+        Some(ContactTrace::Resistance(_)) => {
+            let (lo, hi) = extent(points).unwrap_or((0.0, 1.0));
+            (Axis::decades(lo, hi), "contact resistance", points.to_vec())
+        }
+        _ => (
+            Axis::states(),
+            match (plot.arcs.is_empty(), plot.pole_face.is_empty()) {
+                (true, true) => "contact",
+                (true, false) => "contact (▼ pole-face impacts)",
+                (false, true) => "contact (arcs shaded, breakdowns low)",
+                (false, false) => "contact (arcs shaded, breakdowns low, ▼ pole-face impacts)",
+            },
+            points.to_vec(),
+        ),
     };
-
-    if let Some(points) = &contact {
-        let _ = writeln!(out, "<g>");
-        let id = frame(&mut out, top, CONTACT_HEIGHT);
-        let (axis, label, values): (Axis, &str, Vec<(f64, f64)>) = match plot.contact {
-            Some(ContactTrace::Resistance(_)) => {
-                let (lo, hi) = extent(points).unwrap_or((0.0, 1.0));
-                (Axis::decades(lo, hi), "contact resistance", points.clone())
-            }
-            _ => (
-                Axis::states(),
-                match (plot.arcs.is_empty(), plot.pole_face.is_empty()) {
-                    (true, true) => "contact",
-                    (true, false) => "contact (▼ pole-face impacts)",
-                    (false, true) => "contact (arcs shaded, breakdowns low)",
-                    (false, false) => "contact (arcs shaded, breakdowns low, ▼ pole-face impacts)",
-                },
-                points.clone(),
-            ),
+    let y = |v: f64| top + CONTACT_HEIGHT * (1.0 - axis.fraction(v));
+    y_ticks(out, &axis, top, CONTACT_HEIGHT);
+    // Arcs as bands behind the trace (at least 2 px wide, so a
+    // microsecond arc in a 10 ms window shows), breakdowns as ticks.
+    let _ = writeln!(out, r#"<g clip-path="url(#panel{id})">"#);
+    for &(a, b, arc) in plot.arcs.iter().filter(|m| m.1 >= t0 && m.0 <= t1) {
+        let (xa, xb) = (x(a.max(t0)), x(b.min(t1)));
+        let (color, what, h0, h1) = if arc {
+            (ARC_COLOR, "arc", top, CONTACT_HEIGHT)
+        } else {
+            (
+                BREAKDOWN_COLOR,
+                "breakdown",
+                top + 0.75 * CONTACT_HEIGHT,
+                0.25 * CONTACT_HEIGHT,
+            )
         };
-        let y = |v: f64| top + CONTACT_HEIGHT * (1.0 - axis.fraction(v));
-        y_ticks(&mut out, &axis, top, CONTACT_HEIGHT);
-        // Arcs as bands behind the trace (at least 2 px wide, so a
-        // microsecond arc in a 10 ms window shows), breakdowns as ticks.
-        let _ = writeln!(out, r#"<g clip-path="url(#panel{id})">"#);
-        for &(a, b, arc) in plot.arcs.iter().filter(|m| m.1 >= t0 && m.0 <= t1) {
-            let (xa, xb) = (x(a.max(t0)), x(b.min(t1)));
-            let (color, what, h0, h1) = if arc {
-                (ARC_COLOR, "arc", top, CONTACT_HEIGHT)
-            } else {
-                (
-                    BREAKDOWN_COLOR,
-                    "breakdown",
-                    top + 0.75 * CONTACT_HEIGHT,
-                    0.25 * CONTACT_HEIGHT,
-                )
-            };
-            let _ = writeln!(
-                out,
-                r#"<rect x="{}" y="{}" width="{}" height="{}" fill="{color}" fill-opacity="0.35"><title>{what} {} to {} s</title></rect>"#,
-                num(xa.min(xb - 2.0)),
-                num(h0),
-                num((xb - xa).max(2.0)),
-                num(h1),
-                num(a),
-                num(b)
-            );
-        }
         let _ = writeln!(
             out,
-            r#"<polyline fill="none" stroke="{CONTACT_COLOR}" stroke-width="1.5" stroke-linejoin="round" points="{}"/></g>"#,
-            polyline(&values, x, y)
+            r#"<rect x="{}" y="{}" width="{}" height="{}" fill="{color}" fill-opacity="0.35"><title>{what} {} to {} s</title></rect>"#,
+            num(xa.min(xb - 2.0)),
+            num(h0),
+            num((xb - xa).max(2.0)),
+            num(h1),
+            num(a),
+            num(b)
         );
-        pole_face_marks(&mut out, &plot.pole_face, (t0, t1), &x, top);
-        panel_frame(&mut out, top, CONTACT_HEIGHT);
-        let _ = writeln!(
-            out,
-            r#"<text x="{}" y="{}" font-weight="bold">{}</text>"#,
-            num(LEFT),
-            num(top - 8.0),
-            label
-        );
-        let _ = writeln!(out, "</g>");
-        top += CONTACT_HEIGHT + GAP;
     }
+    let _ = writeln!(
+        out,
+        r#"<polyline fill="none" stroke="{CONTACT_COLOR}" stroke-width="1.5" stroke-linejoin="round" points="{}"/></g>"#,
+        polyline(&values, x, y)
+    );
+    pole_face_marks(out, &plot.pole_face, (t0, t1), &x, top);
+    panel_frame(out, top, CONTACT_HEIGHT);
+    let _ = writeln!(
+        out,
+        r#"<text x="{}" y="{}" font-weight="bold">{}</text>"#,
+        num(LEFT),
+        num(top - 8.0),
+        label
+    );
+    let _ = writeln!(out, "</g>");
+}
 
-    for (p, points) in plot.probes.iter().zip(&probes) {
-        let _ = writeln!(out, "<g>");
-        let id = frame(&mut out, top, PROBE_HEIGHT);
-        for &(a, b) in &bands {
-            let _ = writeln!(
-                out,
-                r#"<rect x="{}" y="{}" width="{}" height="{}" fill="{CONTACT_COLOR}" fill-opacity="0.08"/>"#,
-                num(a),
-                num(top),
-                num(b - a),
-                num(PROBE_HEIGHT)
-            );
-        }
-        let (lo, hi) =
-            extent(points).map_or((p.low, p.high), |(lo, hi)| (lo.min(p.low), hi.max(p.high)));
-        let pad = 0.08 * (hi - lo);
-        let axis = Axis::linear(lo - pad, hi + pad, 6).with_unit(&p.unit);
-        let y = |v: f64| top + PROBE_HEIGHT * (1.0 - axis.fraction(v));
-        y_ticks(&mut out, &axis, top, PROBE_HEIGHT);
-        let _ = writeln!(out, r#"<g clip-path="url(#panel{id})">"#);
-        for (name, level) in [("high", p.high), ("low", p.low)] {
-            let _ = writeln!(
-                out,
-                r#"<line x1="{}" y1="{y}" x2="{}" y2="{y}" stroke="{THRESHOLD_COLOR}" stroke-dasharray="6 4" stroke-opacity="0.8"/>"#,
-                num(LEFT),
-                num(LEFT + PLOT_WIDTH),
-                y = num(y(level))
-            );
-            let _ = writeln!(
-                out,
-                r#"<text x="{}" y="{}" text-anchor="end" font-size="10" fill="{THRESHOLD_COLOR}">{name} {}</text>"#,
-                num(LEFT + PLOT_WIDTH - 4.0),
-                num(y(level) - 3.0),
-                escape(&axis.precise(level))
-            );
-        }
+/// Probe `p`'s panel at `top`: the closures shaded, the thresholds
+/// dashed, the signal (`points`) and its edges marked.
+fn probe_panel(
+    out: &mut String,
+    p: &ProbePanel,
+    layout: &Layout,
+    points: &[(f64, f64)],
+    top: f64,
+    clip: &mut usize,
+) {
+    let (t0, t1) = layout.window;
+    let x = |t: f64| layout.x(t);
+    let _ = writeln!(out, "<g>");
+    let id = layout.frame(out, clip, top, PROBE_HEIGHT);
+    for &(a, b) in &layout.bands {
         let _ = writeln!(
             out,
-            r#"<polyline fill="none" stroke="{SIGNAL_COLOR}" stroke-width="1.5" stroke-linejoin="round" points="{}"/>"#,
-            polyline(points, x, y)
+            r#"<rect x="{}" y="{}" width="{}" height="{}" fill="{CONTACT_COLOR}" fill-opacity="0.08"/>"#,
+            num(a),
+            num(top),
+            num(b - a),
+            num(PROBE_HEIGHT)
         );
-        for e in p.edges.iter().filter(|e| e.time >= t0 && e.time <= t1) {
-            let (level, tip) = match e.direction {
-                Direction::Rising => (p.high, -5.0),
-                Direction::Falling => (p.low, 5.0),
-            };
-            let (cx, cy) = (x(e.time), y(level));
-            let _ = writeln!(
-                out,
-                r#"<path d="M{} {}L{} {}L{} {}Z" fill="{EDGE_COLOR}"/>"#,
-                num(cx),
-                num(cy + tip),
-                num(cx - 4.0),
-                num(cy - tip),
-                num(cx + 4.0),
-                num(cy - tip)
-            );
-        }
-        let _ = writeln!(out, "</g>");
-        panel_frame(&mut out, top, PROBE_HEIGHT);
-        let _ = writeln!(
-            out,
-            r#"<text x="{}" y="{}"><tspan font-weight="bold">{}</tspan>  {}</text>"#,
-            num(LEFT),
-            num(top - 8.0),
-            escape(&p.name),
-            escape(&edge_summary(&p.edges))
-        );
-        let _ = writeln!(out, "</g>");
-        top += PROBE_HEIGHT + GAP;
     }
+    let (lo, hi) =
+        extent(points).map_or((p.low, p.high), |(lo, hi)| (lo.min(p.low), hi.max(p.high)));
+    let pad = 0.08 * (hi - lo);
+    let axis = Axis::linear(lo - pad, hi + pad, 6).with_unit(&p.unit);
+    let y = |v: f64| top + PROBE_HEIGHT * (1.0 - axis.fraction(v));
+    y_ticks(out, &axis, top, PROBE_HEIGHT);
+    let _ = writeln!(out, r#"<g clip-path="url(#panel{id})">"#);
+    for (name, level) in [("high", p.high), ("low", p.low)] {
+        let _ = writeln!(
+            out,
+            r#"<line x1="{}" y1="{y}" x2="{}" y2="{y}" stroke="{THRESHOLD_COLOR}" stroke-dasharray="6 4" stroke-opacity="0.8"/>"#,
+            num(LEFT),
+            num(LEFT + PLOT_WIDTH),
+            y = num(y(level))
+        );
+        let _ = writeln!(
+            out,
+            r#"<text x="{}" y="{}" text-anchor="end" font-size="10" fill="{THRESHOLD_COLOR}">{name} {}</text>"#,
+            num(LEFT + PLOT_WIDTH - 4.0),
+            num(y(level) - 3.0),
+            escape(&axis.precise(level))
+        );
+    }
+    let _ = writeln!(
+        out,
+        r#"<polyline fill="none" stroke="{SIGNAL_COLOR}" stroke-width="1.5" stroke-linejoin="round" points="{}"/>"#,
+        polyline(points, x, y)
+    );
+    for e in p.edges.iter().filter(|e| e.time >= t0 && e.time <= t1) {
+        let (level, tip) = match e.direction {
+            Direction::Rising => (p.high, -5.0),
+            Direction::Falling => (p.low, 5.0),
+        };
+        let (cx, cy) = (x(e.time), y(level));
+        let _ = writeln!(
+            out,
+            r#"<path d="M{} {}L{} {}L{} {}Z" fill="{EDGE_COLOR}"/>"#,
+            num(cx),
+            num(cy + tip),
+            num(cx - 4.0),
+            num(cy - tip),
+            num(cx + 4.0),
+            num(cy - tip)
+        );
+    }
+    let _ = writeln!(out, "</g>");
+    panel_frame(out, top, PROBE_HEIGHT);
+    let _ = writeln!(
+        out,
+        r#"<text x="{}" y="{}"><tspan font-weight="bold">{}</tspan>  {}</text>"#,
+        num(LEFT),
+        num(top - 8.0),
+        escape(&p.name),
+        escape(&edge_summary(&p.edges))
+    );
+    let _ = writeln!(out, "</g>");
+}
 
-    // The shared time axis under the last panel.
-    let bottom = top - GAP;
+/// The shared time axis along `bottom` (px): ticks, their labels and the
+/// axis's name.
+fn time_axis(out: &mut String, layout: &Layout, bottom: f64) {
+    let time = &layout.time;
     for &t in &time.ticks {
         let _ = writeln!(
             out,
             r#"<line x1="{x}" y1="{}" x2="{x}" y2="{}" stroke="{AXIS_COLOR}"/>"#,
             num(bottom),
             num(bottom + 5.0),
-            x = num(x(t))
+            x = num(layout.x(t))
         );
         let _ = writeln!(
             out,
             r#"<text x="{}" y="{}" text-anchor="middle">{}</text>"#,
-            num(x(t)),
+            num(layout.x(t)),
             num(bottom + 18.0),
             escape(&time.label(t))
         );
@@ -423,8 +503,6 @@ pub fn render(plot: &SvgPlot) -> Result<String, SvgError> {
         num(LEFT + PLOT_WIDTH / 2.0),
         num(bottom + 38.0)
     );
-    out.push_str("</svg>\n");
-    Ok(out)
 }
 
 /// The key at the top right: what the line styles mean.

@@ -14,7 +14,7 @@ use crate::arc::ArcReport;
 use crate::chatter::{Chatter, Impact, Outcome};
 use crate::check::{Bound, Verdict, quantity};
 use crate::coil::{Closing, Operation};
-use crate::pipeline::RunResult;
+use crate::pipeline::{ProbeResult, RunResult};
 
 /// Summary and impact table, `\n`-terminated.
 pub fn render(chatter: &Chatter) -> String {
@@ -119,9 +119,66 @@ pub fn pole_face(impacts: &[crate::chatter::Impact]) -> String {
 /// table of their closures.
 pub fn render_run(run: &RunResult) -> String {
     let mut out = String::new();
+    for (label, value) in run_lines(run) {
+        let _ = writeln!(out, "{label:<8} {value}");
+    }
+
+    out.push('\n');
+    let mut rows = vec![PROBE_HEADER.map(String::from)];
+    for p in &run.probes {
+        rows.push(probe_row(&p.analysis.signal, &p.analysis));
+        if let Some(ideal) = &p.ideal {
+            rows.push(probe_row("  ideal contact", ideal));
+        }
+    }
+    out.push_str(&align(&rows, 1));
+
+    for p in &run.probes {
+        out.push('\n');
+        probe_paragraph(&mut out, p);
+    }
+    if let Some(report) = &run.arcs {
+        out.push('\n');
+        out.push_str(&render_arcs(report));
+    }
+    // Warnings are not part of the table: the CLI prints them on stderr.
+    out
+}
+
+/// The head of the run table, as (label, text): the relay, its pole face,
+/// the contact, the circuit, the coil's coupling and each operation.
+fn run_lines(run: &RunResult) -> Vec<(&'static str, String)> {
+    let mut lines = vec![("relay", relay_line(run))];
+    if let Some(impacts) = &run.pole_face {
+        lines.push(("pole", pole_face_line(impacts)));
+    }
+    lines.extend([
+        ("contact", contact_line(run)),
+        ("circuit", circuit_line(run)),
+    ]);
+    if let Some(passes) = &run.coupling {
+        let last = passes.last().map_or(f64::NAN, |p| p.change);
+        lines.push((
+            "coil",
+            format!(
+                "coupled to the circuit in {} iterations, last change {}",
+                passes.len(),
+                engineering(last, "s")
+            ),
+        ));
+    }
+    for (k, op) in run.operations.iter().enumerate() {
+        lines.push(("", operation_line(k + 1, op)));
+    }
+    lines
+}
+
+/// The relay in one line: its bounces and outcome, and the first
+/// closing's operate, bounce and settle times when it closed for good.
+fn relay_line(run: &RunResult) -> String {
     let c = &run.chatter;
     let closing = Closing::first(c, &run.operations);
-    let relay = match (closing.operate_time, closing.settle_time) {
+    match (closing.operate_time, closing.settle_time) {
         (Some(operate), Some(settle)) => format!(
             "{} bounce{}, {} ({}); operate {}, bounce time {}, closed for good {}{}",
             c.bounce_count,
@@ -139,7 +196,32 @@ pub fn render_run(run: &RunResult) -> String {
             explain(c.outcome),
             c.bounce_count
         ),
-    };
+    }
+}
+
+/// The contact element in one line: its kind, points, edges, and what the
+/// waveform merged or widened.
+fn contact_line(run: &RunResult) -> String {
+    let w = &run.waveform;
+    let mut contact = format!(
+        "{} element, {} points, {} makes, {} breaks",
+        run.include.element,
+        run.include.points,
+        w.make_edges(),
+        w.break_edges()
+    );
+    if w.merged_openings() > 0 {
+        let _ = write!(contact, ", {} openings merged", w.merged_openings());
+    }
+    if w.widened_closures() > 0 {
+        let _ = write!(contact, ", {} touches widened", w.widened_closures());
+    }
+    contact
+}
+
+/// The circuit run in one line: the netlist, the ngspice version, the
+/// points and the wall-clock times (the ideal contact's too).
+fn circuit_line(run: &RunResult) -> String {
     let sim = &run.simulation;
     let mut circuit = format!(
         "{}: ngspice {}, {} points in {:.3} s",
@@ -155,131 +237,82 @@ pub fn render_run(run: &RunResult) -> String {
             ideal.elapsed.as_secs_f64()
         );
     }
-    let w = &run.waveform;
-    let mut contact = format!(
-        "{} element, {} points, {} makes, {} breaks",
-        run.include.element,
-        run.include.points,
-        w.make_edges(),
-        w.break_edges()
-    );
-    if w.merged_openings() > 0 {
-        let _ = write!(contact, ", {} openings merged", w.merged_openings());
-    }
-    if w.widened_closures() > 0 {
-        let _ = write!(contact, ", {} touches widened", w.widened_closures());
-    }
-    let mut lines = vec![("relay", relay)];
-    if let Some(impacts) = &run.pole_face {
-        lines.push(("pole", pole_face_line(impacts)));
-    }
-    lines.extend([("contact", contact), ("circuit", circuit)]);
-    if let Some(passes) = &run.coupling {
-        let last = passes.last().map_or(f64::NAN, |p| p.change);
-        lines.push((
-            "coil",
-            format!(
-                "coupled to the circuit in {} iterations, last change {}",
-                passes.len(),
-                engineering(last, "s")
-            ),
-        ));
-    }
-    for (k, op) in run.operations.iter().enumerate() {
-        lines.push(("", operation_line(k + 1, op)));
-    }
-    for (label, value) in lines {
-        let _ = writeln!(out, "{label:<8} {value}");
-    }
+    circuit
+}
 
-    out.push('\n');
-    let mut rows = vec![PROBE_HEADER.map(String::from)];
-    for p in &run.probes {
-        rows.push(probe_row(&p.analysis.signal, &p.analysis));
-        if let Some(ideal) = &p.ideal {
-            rows.push(probe_row("  ideal contact", ideal));
-        }
-    }
-    out.push_str(&align(&rows, 1));
-
-    for p in &run.probes {
-        let a = &p.analysis;
-        let unit = a.kind.unit();
-        out.push('\n');
-        let _ = write!(out, "{}: ", a.signal);
-        match &p.comparison {
-            Some(cmp) => {
-                let added = match cmp.extra_edges {
-                    0 => "the bounce adds no edge".to_owned(),
-                    1 => "the bounce adds 1 edge".to_owned(),
-                    n if n > 0 => format!("the bounce adds {n} edges"),
-                    n => format!("the bounce removes {} edges", -n),
-                };
-                out.push_str(&added);
-                if let Some(delay) = cmp.settle_delay {
-                    if delay != 0.0 {
-                        let _ = write!(
-                            out,
-                            "; the last edge comes {} {} the ideal contact's",
-                            engineering(delay.abs(), "s"),
-                            if delay > 0.0 { "after" } else { "before" }
-                        );
-                    }
+/// One probe's sentence: what the bounce did to it against the ideal
+/// contact (or its edges and range alone), then for a current probe its
+/// pulses, charge and a table of its closures.
+fn probe_paragraph(out: &mut String, p: &ProbeResult) {
+    let a = &p.analysis;
+    let unit = a.kind.unit();
+    let _ = write!(out, "{}: ", a.signal);
+    match &p.comparison {
+        Some(cmp) => {
+            let added = match cmp.extra_edges {
+                0 => "the bounce adds no edge".to_owned(),
+                1 => "the bounce adds 1 edge".to_owned(),
+                n if n > 0 => format!("the bounce adds {n} edges"),
+                n => format!("the bounce removes {} edges", -n),
+            };
+            out.push_str(&added);
+            if let Some(delay) = cmp.settle_delay {
+                if delay != 0.0 {
+                    let _ = write!(
+                        out,
+                        "; the last edge comes {} {} the ideal contact's",
+                        engineering(delay.abs(), "s"),
+                        if delay > 0.0 { "after" } else { "before" }
+                    );
                 }
-                if !cmp.same_final_state {
-                    out.push_str("; it ends at a different level than with an ideal contact");
-                }
-                let _ = writeln!(
-                    out,
-                    "; range {} to {} (ideal: {} to {})",
-                    engineering(a.min, unit),
-                    engineering(a.max, unit),
-                    engineering(a.min - cmp.min_difference, unit),
-                    engineering(a.max - cmp.max_difference, unit),
-                );
             }
-            None => {
-                let _ = writeln!(
-                    out,
-                    "{} edge{}; range {} to {}",
-                    a.edges,
-                    if a.edges == 1 { "" } else { "s" },
-                    engineering(a.min, unit),
-                    engineering(a.max, unit)
-                );
+            if !cmp.same_final_state {
+                out.push_str("; it ends at a different level than with an ideal contact");
             }
-        }
-        if let Some(current) = &a.current {
-            let pulses = a.pulses.unwrap_or(0);
             let _ = writeln!(
                 out,
-                "  {pulses} pulse{} (2 edges each; glitches count the pulses after the first), \
-                 peak {} at {}, charge {} ({} while closed)",
-                if pulses == 1 { "" } else { "s" },
-                engineering(current.peak, "A"),
-                ms(Some(current.peak_time)),
-                engineering(current.charge, "C"),
-                engineering(current.closed_charge, "C"),
+                "; range {} to {} (ideal: {} to {})",
+                engineering(a.min, unit),
+                engineering(a.max, unit),
+                engineering(a.min - cmp.min_difference, unit),
+                engineering(a.max - cmp.max_difference, unit),
             );
-            let mut rows = vec![["closure", "from", "to", "peak", "charge"].map(String::from)];
-            for (n, k) in current.per_closure.iter().enumerate() {
-                rows.push([
-                    format!("  {}", n + 1),
-                    ms(Some(k.start)),
-                    ms(Some(k.end)),
-                    engineering(k.peak, "A"),
-                    engineering(k.charge, "C"),
-                ]);
-            }
-            out.push_str(&align(&rows, 1));
+        }
+        None => {
+            let _ = writeln!(
+                out,
+                "{} edge{}; range {} to {}",
+                a.edges,
+                if a.edges == 1 { "" } else { "s" },
+                engineering(a.min, unit),
+                engineering(a.max, unit)
+            );
         }
     }
-    if let Some(report) = &run.arcs {
-        out.push('\n');
-        out.push_str(&render_arcs(report));
+    if let Some(current) = &a.current {
+        let pulses = a.pulses.unwrap_or(0);
+        let _ = writeln!(
+            out,
+            "  {pulses} pulse{} (2 edges each; glitches count the pulses after the first), \
+             peak {} at {}, charge {} ({} while closed)",
+            if pulses == 1 { "" } else { "s" },
+            engineering(current.peak, "A"),
+            ms(Some(current.peak_time)),
+            engineering(current.charge, "C"),
+            engineering(current.closed_charge, "C"),
+        );
+        let mut rows = vec![["closure", "from", "to", "peak", "charge"].map(String::from)];
+        for (n, k) in current.per_closure.iter().enumerate() {
+            rows.push([
+                format!("  {}", n + 1),
+                ms(Some(k.start)),
+                ms(Some(k.end)),
+                engineering(k.peak, "A"),
+                engineering(k.charge, "C"),
+            ]);
+        }
+        out.push_str(&align(&rows, 1));
     }
-    // Warnings are not part of the table: the CLI prints them on stderr.
-    out
 }
 
 /// The arcs of a run: the totals line, then one row per arc and per
