@@ -1153,7 +1153,7 @@ fn merge(args: &MergeArgs) -> Result<()> {
     for input in &args.inputs {
         report::protect_input(input);
     }
-    let report = sweep::table::merge_files(
+    let report = sweep::merge::merge_files(
         &args.output,
         &args.inputs,
         args.samples,

@@ -28,6 +28,7 @@
 //! byte.
 
 mod error;
+pub mod merge;
 pub mod plot;
 mod record;
 pub mod resume;
