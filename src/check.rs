@@ -588,26 +588,8 @@ pub fn relay_only(scenario: &Scenario) -> Result<(Verdict, Evidence), CheckError
 pub fn relay_chatter(scenario: &Scenario) -> Result<Chatter, CheckError> {
     let path = || scenario.origin.clone();
     let build = scenario.two_stage();
-    if let Some(section) = &scenario.coil {
-        let voltage = scenario
-            .dc_step_voltage()
-            .ok_or_else(|| CheckError::NoDriveVoltage { path: path() })?;
-        let (chatter, _) = crate::coil::direct::direct_closing(
-            &crate::coil::Coil::from(section),
-            &crate::coil::Source {
-                voltage,
-                series_resistance: 0.0,
-            },
-            &scenario.armature(),
-            &build,
-            &scenario.surface(),
-            &scenario.settings(),
-        )
-        .map_err(|source| CheckError::Motion {
-            path: path(),
-            source,
-        })?;
-        return Ok(chatter);
+    if scenario.coil.is_some() {
+        return dc_step(scenario).map(|(chatter, _)| chatter);
     }
     let mechanics = scenario.mechanics()?;
     if build.is_one_mass() {
@@ -625,6 +607,37 @@ pub fn relay_chatter(scenario: &Scenario) -> Result<Chatter, CheckError> {
         &scenario.settings(),
     )
     .map(crate::mechanics::Trajectory::into_chatter)
+    .map_err(|source| CheckError::Motion {
+        path: path(),
+        source,
+    })
+}
+
+/// A coil-driven relay without its driver circuit: the ideal DC step of
+/// `coil.drive_voltage` (else `datasheet.coil_voltage`) on its coil from
+/// t = 0, as a datasheet measures. The closing's chatter, and the
+/// two-stage record when the relay has a blade (or releases by force).
+pub fn dc_step(
+    scenario: &Scenario,
+) -> Result<(Chatter, Option<crate::mechanics::two_stage::TwoStageRun>), CheckError> {
+    let path = || scenario.origin.clone();
+    let Some(section) = &scenario.coil else {
+        return Err(CheckError::NoDriveVoltage { path: path() });
+    };
+    let voltage = scenario
+        .dc_step_voltage()
+        .ok_or_else(|| CheckError::NoDriveVoltage { path: path() })?;
+    crate::coil::direct::direct_closing(
+        &crate::coil::Coil::from(section),
+        &crate::coil::Source {
+            voltage,
+            series_resistance: 0.0,
+        },
+        &scenario.armature(),
+        &scenario.two_stage(),
+        &scenario.surface(),
+        &scenario.settings(),
+    )
     .map_err(|source| CheckError::Motion {
         path: path(),
         source,

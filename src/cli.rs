@@ -376,7 +376,7 @@ fn bounce(args: &BounceArgs) -> Result<()> {
         )
     };
     let text = if scenario.coil.is_some() {
-        let (chatter, run) = coil_step(&scenario).with_context(failed)?;
+        let (chatter, run) = check::dc_step(&scenario).with_context(failed)?;
         let pole_face = build
             .pole_face
             .is_some()
@@ -409,38 +409,6 @@ fn bounce(args: &BounceArgs) -> Result<()> {
         )
     };
     emit(&text, args.output.as_deref(), args.force)
-}
-
-/// A coil-driven relay without its driver circuit: the ideal DC step of
-/// `coil.drive_voltage` (else `datasheet.coil_voltage`) on the coil from
-/// t = 0, as a datasheet measures it. The closing's chatter, and the
-/// two-stage record when the relay has a blade.
-fn coil_step(
-    scenario: &Scenario,
-) -> Result<(
-    chatterspice::Chatter,
-    Option<chatterspice::mechanics::two_stage::TwoStageRun>,
-)> {
-    let section = scenario.coil.as_ref().expect("a coil-driven scenario");
-    let voltage = scenario.dc_step_voltage().with_context(|| {
-        format!(
-            "{}: a coil-driven relay without its driver circuit is simulated on an ideal DC \
-             step of its coil voltage: give `coil.drive_voltage` (V) or \
-             `datasheet.coil_voltage`",
-            scenario.origin.display()
-        )
-    })?;
-    Ok(chatterspice::coil::direct::direct_closing(
-        &chatterspice::coil::Coil::from(section),
-        &chatterspice::coil::Source {
-            voltage,
-            series_resistance: 0.0,
-        },
-        &scenario.armature(),
-        &scenario.two_stage(),
-        &scenario.surface(),
-        &scenario.settings(),
-    )?)
 }
 
 fn run(args: &RunArgs) -> Result<()> {
@@ -595,7 +563,7 @@ fn pwl(args: &PwlArgs) -> Result<()> {
             (Waveform::from_intervals(&intervals, &model)?, gap)
         }
         None if scenario.coil.is_some() => {
-            let (chatter, _) = coil_step(&scenario).with_context(|| {
+            let (chatter, _) = check::dc_step(&scenario).with_context(|| {
                 format!(
                     "{}: the mechanics simulation failed",
                     scenario.origin.display()

@@ -79,7 +79,7 @@ use crate::chatter::{ContactState, Interval};
 use crate::coil::direct::direct_closing;
 use crate::coil::pick_up::{LoadLine, PickUp, drop_out, pick_up};
 use crate::coil::{Coil, Source};
-use crate::mechanics::{Mechanics, simulate};
+use crate::mechanics::simulate;
 use crate::scenario::{Scenario, ScenarioError};
 
 #[path = "fit_report.rs"]
@@ -442,22 +442,6 @@ fn figures(d: &DatasheetSection) -> Vec<(&'static str, f64)> {
     .collect()
 }
 
-/// The relay's mechanics as the engines take them (the force of a
-/// coil-driven relay is made by the coil).
-fn mechanics_of(s: &Scenario) -> Mechanics {
-    let m = &s.mechanics;
-    Mechanics {
-        mass: m.mass,
-        stiffness: m.stiffness,
-        damping: m.damping,
-        force: m.force.unwrap_or(0.0),
-        gap: m.gap,
-        initial_position: m.initial_position,
-        initial_velocity: m.initial_velocity,
-        preload: m.preload,
-    }
-}
-
 /// The modelled events of one closing: the step-force engine, or with a
 /// coil the direct engine on an ideal `voltage` step.
 pub fn model_events(s: &Scenario, voltage: Option<f64>) -> Result<Vec<Event>, String> {
@@ -469,7 +453,7 @@ pub fn model_events(s: &Scenario, voltage: Option<f64>) -> Result<Vec<Event>, St
                     voltage: v,
                     series_resistance: 0.0,
                 },
-                &mechanics_of(s),
+                &s.armature(),
                 &s.two_stage(),
                 &s.surface(),
                 &s.settings(),
@@ -479,10 +463,10 @@ pub fn model_events(s: &Scenario, voltage: Option<f64>) -> Result<Vec<Event>, St
         }
         (Some(_), None) => return Err("a coil-driven relay needs [datasheet] coil_voltage".into()),
         (None, _) if s.two_stage().is_one_mass() => {
-            simulate(&mechanics_of(s), &s.surface(), &s.settings()).map_err(|e| e.to_string())?
+            simulate(&s.armature(), &s.surface(), &s.settings()).map_err(|e| e.to_string())?
         }
         (None, _) => crate::mechanics::two_stage::step_closing(
-            &mechanics_of(s),
+            &s.armature(),
             &s.two_stage(),
             &s.surface(),
             &s.settings(),
@@ -501,7 +485,7 @@ pub fn datasheet_figures(s: &Scenario, d: &DatasheetSection) -> Vec<(&'static st
         return figures(d).into_iter().map(|(n, _)| (n, None)).collect();
     };
     let coil = Coil::from(section);
-    let m = mechanics_of(s);
+    let m = s.armature();
     let build = s.two_stage();
     let line = LoadLine::of_relay(&m, &build);
     let wants = |f: Option<f64>| f.is_some();
@@ -545,7 +529,7 @@ pub fn datasheet_figures(s: &Scenario, d: &DatasheetSection) -> Vec<(&'static st
 /// `None` without a coil.
 pub fn pick_up_of(s: &Scenario) -> Option<(PickUp, LoadLine)> {
     let coil = Coil::from(s.coil.as_ref()?);
-    let line = LoadLine::of_relay(&mechanics_of(s), &s.two_stage());
+    let line = LoadLine::of_relay(&s.armature(), &s.two_stage());
     Some((pick_up(&coil, &line), line))
 }
 

@@ -3,7 +3,7 @@
 //! ([`crate::coil::pick_up`]), so that the rest of the fit (the times)
 //! starts from a point that already meets them.
 
-use super::{Problem, mechanics_of};
+use super::Problem;
 use crate::coil::Coil;
 use crate::coil::pick_up::{LoadLine, pick_up};
 
@@ -21,7 +21,7 @@ pub(super) fn closed_form_start(problem: &Problem, u_prior: &[f64]) -> Vec<f64> 
     let coil = Coil::from(c);
     let key = |name: &str| problem.keys.iter().position(|k| k == name);
     let (kp, ks) = (key("mechanics.preload"), key("mechanics.stiffness"));
-    let line = LoadLine::of_relay(&mechanics_of(&s), &s.two_stage());
+    let line = LoadLine::of_relay(&s.armature(), &s.two_stage());
     let solved = solve_spring(
         &coil,
         &line,

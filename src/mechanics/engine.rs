@@ -40,24 +40,27 @@ pub fn simulate(
     Engine::new(mechanics, surface, settings).run()
 }
 
+/// `value` of key `name` is finite and `ok`, or the error naming the key
+/// and what it must satisfy.
+pub(crate) fn check(
+    name: &'static str,
+    value: f64,
+    ok: bool,
+    requirement: &'static str,
+) -> Result<(), MechanicsError> {
+    if value.is_finite() && ok {
+        Ok(())
+    } else {
+        Err(MechanicsError::InvalidParameter {
+            name,
+            value,
+            requirement,
+        })
+    }
+}
+
 /// Check every parameter the engine relies on.
 pub fn validate(m: &Mechanics, surface: &Surface, s: &Settings) -> Result<(), MechanicsError> {
-    fn check(
-        name: &'static str,
-        value: f64,
-        ok: bool,
-        requirement: &'static str,
-    ) -> Result<(), MechanicsError> {
-        if value.is_finite() && ok {
-            Ok(())
-        } else {
-            Err(MechanicsError::InvalidParameter {
-                name,
-                value,
-                requirement,
-            })
-        }
-    }
     check("mechanics.mass", m.mass, m.mass > 0.0, "a mass in kg, > 0")?;
     check(
         "mechanics.stiffness",

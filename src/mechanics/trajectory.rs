@@ -564,14 +564,14 @@ impl Trajectory {
             events.push(Event {
                 time: p.impact_time,
                 kind: EventKind::PoleFace,
-                position: g + run.state(p.impact_time, 0.0).0,
+                position: run.state(p.impact_time, g).0,
                 velocity: p.impact_velocity,
             });
             if let (Some(t), Some(v)) = (p.release_time, p.release_velocity) {
                 events.push(Event {
                     time: t,
                     kind: EventKind::PoleFaceRelease,
-                    position: g + run.state(t, 0.0).0,
+                    position: run.state(t, g).0,
                     velocity: v,
                 });
             }

@@ -275,19 +275,15 @@ impl Scenario {
     /// scenario, which the engine does not simulate yet: silently running
     /// it with some other force would give a plausible but wrong answer.
     pub fn mechanics(&self) -> Result<Mechanics, ScenarioError> {
-        let m = &self.mechanics;
-        let force = m.force.ok_or_else(|| ScenarioError::CoilDriveUnsupported {
-            path: self.origin.clone(),
-        })?;
+        let force = self
+            .mechanics
+            .force
+            .ok_or_else(|| ScenarioError::CoilDriveUnsupported {
+                path: self.origin.clone(),
+            })?;
         Ok(Mechanics {
-            mass: m.mass,
-            stiffness: m.stiffness,
-            damping: m.damping,
             force,
-            gap: m.gap,
-            initial_position: m.initial_position,
-            initial_velocity: m.initial_velocity,
-            preload: m.preload,
+            ..self.armature()
         })
     }
 

@@ -44,12 +44,12 @@ pub(crate) struct EnergyBound {
 }
 
 impl EnergyBound {
-    pub(crate) fn new<D: Drive>(_model: &Relay<'_, D>) -> EnergyBound {
+    pub(crate) fn new() -> EnergyBound {
         EnergyBound { steps: 0 }
     }
 
     /// Whether to check at this step: every fourth accepted step.
-    pub(crate) fn due(&mut self, _t: f64) -> bool {
+    pub(crate) fn due(&mut self) -> bool {
         self.steps += 1;
         self.steps % 4 == 0
     }

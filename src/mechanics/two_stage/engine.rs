@@ -523,7 +523,7 @@ fn start<D: Drive>(model: &Relay<'_, D>, e0: f64) -> Progress {
         rec,
         pieces: Vec::new(),
         steps: 0,
-        bound: EnergyBound::new(model),
+        bound: EnergyBound::new(),
         ending: None,
     }
 }
@@ -537,7 +537,6 @@ fn integrate<D: Drive>(
 ) -> Result<(), DriveError> {
     let tol = tolerance(model);
     let mut h = 0.05 / fastest(model);
-    let mut track = Tracker;
     while p.t < settings.t_end && p.ending.is_none() {
         let modes = p.modes;
         let f = |t: f64, y: &Y| model.rate(t, y, modes);
@@ -559,7 +558,7 @@ fn integrate<D: Drive>(
             }
             match model.first_event(&dense, step.t1, modes) {
                 None => {
-                    track.sample(model, &dense, step.t1, modes, &mut p.rec);
+                    sample(model, &dense, step.t1, modes, &mut p.rec);
                     p.pieces.push(Span::dense(dense, step.t1, step.y1, modes));
                     p.t = step.t1;
                     p.y = step.y1;
@@ -575,7 +574,7 @@ fn integrate<D: Drive>(
                 }
                 Some((te, which)) => {
                     let ye = dense.at(te);
-                    track.sample(model, &dense, te, modes, &mut p.rec);
+                    sample(model, &dense, te, modes, &mut p.rec);
                     p.pieces.push(Span::dense(dense, te, ye, modes));
                     p.event(model, settings, which, te, ye);
                     break;
@@ -722,7 +721,7 @@ pub(crate) fn decided<D: Drive>(
     modes: Modes,
     rec: &Tally,
 ) -> Option<Outcome> {
-    if rec.contact.is_empty() || !bound.due(t) {
+    if rec.contact.is_empty() || !bound.due() {
         return None;
     }
     match modes.contact {
@@ -924,52 +923,25 @@ fn rigid<D: Drive>(
 }
 
 /// Peak and minimum contact forces and the largest opening after each
-/// release, sampled on the dense output.
-struct Tracker;
-
-impl Tracker {
-    fn sample<D: Drive>(
-        &mut self,
-        model: &Relay<'_, D>,
-        dense: &Dense<5>,
-        t1: f64,
-        modes: Modes,
-        rec: &mut Tally,
-    ) {
-        let t0 = dense.t0;
-        for k in 0..=SAMPLES {
-            let t = t0 + (t1 - t0) * k as f64 / SAMPLES as f64;
-            let y = dense.at(t);
-            match modes.contact {
-                Stop::Engaged => {
-                    let mut f = law(&model.contact, y[2], y[3]);
-                    if model.build.release == Release::Force {
-                        // F_c = max(0, ·): zero, not a rounding below it,
-                        // where the contact lets go.
-                        f = f.max(0.0);
-                    }
-                    if let Some(last) = rec.contact.last_mut() {
-                        last.peak_force = Some(last.peak_force.map_or(f, |p: f64| p.max(f)));
-                        last.min_force = Some(last.min_force.map_or(f, |p: f64| p.min(f)));
-                    }
-                }
-                Stop::Pressed => {
-                    let f = model.blade_force(&y);
-                    if let Some(last) = rec.contact.last_mut() {
-                        last.peak_force = Some(last.peak_force.map_or(f, |p: f64| p.max(f)));
-                        last.min_force = Some(last.min_force.map_or(f, |p: f64| p.min(f)));
-                    }
-                }
-                Stop::Open => match rec.contact.last_mut() {
-                    Some(last) => {
-                        let opening = (-y[2]).max(0.0);
-                        last.max_gap_after =
-                            Some(last.max_gap_after.map_or(opening, |p: f64| p.max(opening)));
-                    }
-                    None => rec.reach = rec.reach.max(model.g() + y[2]),
-                },
-            }
-        }
+/// release, sampled on the dense output of a step up to `t1`.
+fn sample<D: Drive>(
+    model: &Relay<'_, D>,
+    dense: &Dense<5>,
+    t1: f64,
+    modes: Modes,
+    rec: &mut Tally,
+) {
+    let t0 = dense.t0;
+    for k in 0..=SAMPLES {
+        let t = t0 + (t1 - t0) * k as f64 / SAMPLES as f64;
+        rec.observe(model.g(), modes, &dense.at(t), |y| match modes.contact {
+            // Pressed on a rigid contact: the blade's spring is the force.
+            Stop::Pressed => model.blade_force(y),
+            // F_c = max(0, ·) released by force: zero, not a rounding
+            // below it, where the contact lets go.
+            _ if model.build.release == Release::Force => law(&model.contact, y[2], y[3]).max(0.0),
+            _ => law(&model.contact, y[2], y[3]),
+        });
     }
 }
 

@@ -55,20 +55,9 @@ pub(crate) struct LinearMode {
 }
 
 impl LinearMode {
-    /// `w(τ)` from `w0`, by the Taylor series of `exp(a τ)` (for
-    /// `‖a τ‖ ≤ 1`).
+    /// `w(τ)` from `w0` (τ within a step), by the step's Taylor series.
     pub(crate) fn at(&self, w0: &W, tau: f64) -> W {
-        let mut term = *w0;
-        let mut sum = *w0;
-        let scale = w0.amax();
-        for k in 1..=60 {
-            term = self.a * term * (tau / k as f64);
-            sum += term;
-            if term.amax() <= 1e-18 * scale {
-                break;
-            }
-        }
-        sum
+        Taylor::new(self, w0).at(tau)
     }
 
     /// The state of `w`.
@@ -579,7 +568,7 @@ pub(crate) fn propagate<D: Drive>(
             let w1 = if h == mode.h {
                 mode.phi * w
             } else {
-                Taylor::new(&mode, &w).at(h)
+                mode.at(&w, h)
             };
             let mut series = None;
             let aw1 = mode.a * w1;

@@ -108,22 +108,7 @@ impl TwoStage {
 
     /// Check the blade and the pole face, naming the scenario key at fault.
     pub fn validate(&self, contact: &Surface) -> Result<(), MechanicsError> {
-        fn check(
-            name: &'static str,
-            value: f64,
-            ok: bool,
-            requirement: &'static str,
-        ) -> Result<(), MechanicsError> {
-            if value.is_finite() && ok {
-                Ok(())
-            } else {
-                Err(MechanicsError::InvalidParameter {
-                    name,
-                    value,
-                    requirement,
-                })
-            }
-        }
+        use super::engine::check;
         if let Some(b) = &self.blade {
             check("blade.mass", b.mass, b.mass > 0.0, "a mass in kg, > 0")?;
             check(
@@ -239,9 +224,6 @@ impl TwoStageRun {
         (gap + y[0], y[1], gap + y[2], y[3])
     }
 }
-
-/// The drive errors a two-stage run can end with are the driven engine's.
-pub type TwoStageError = DriveError;
 
 /// A mechanics and its two-stage parts, checked together.
 pub(crate) fn validate_all(
