@@ -74,13 +74,13 @@ use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use serde::Serialize;
 use thiserror::Error;
 
-use super::sections::{DatasheetSection, FittedParameter, ProvenanceSection};
+use super::sections::{DatasheetSection, Determined, FittedParameter, ProvenanceSection};
 use crate::chatter::{ContactState, Interval};
 use crate::coil::direct::direct_closing;
 use crate::coil::pick_up::{LoadLine, PickUp, drop_out, pick_up};
 use crate::coil::{Coil, Source};
 use crate::mechanics::simulate;
-use crate::scenario::{Scenario, ScenarioError};
+use crate::scenario::{PrintedFigure, Scenario, ScenarioError};
 
 #[path = "fit_report.rs"]
 mod report;
@@ -92,7 +92,7 @@ use start::closed_form_start;
 /// squared, so that they weigh like relative datasheet misfits.
 const TIME_SCALE: f64 = 1e-6;
 /// Datasheet residuals are relative, divided by this (0.1 %).
-const RELATIVE_SCALE: f64 = 1e-3;
+pub(super) const RELATIVE_SCALE: f64 = 1e-3;
 /// s, the cost of each event the model lacks or adds, on top of its
 /// distance.
 const COUNT_PENALTY: f64 = 50e-6;
@@ -293,8 +293,10 @@ pub struct ParameterRow {
     /// 1σ; `None` for a key held at its prior.
     pub sigma: Option<f64>,
     /// Whether the evidence fixes the key: not held at its prior, and its
-    /// 1σ smaller than its value.
-    pub determined: bool,
+    /// 1σ smaller than its value; `"exactly"` when as many datasheet
+    /// figures as free keys fix it (its σ then comes from their
+    /// tolerances).
+    pub determined: Determined,
 }
 
 /// One measured event against the model's.
@@ -330,14 +332,27 @@ pub struct BounceCount {
 pub struct FigureRow {
     /// The `[datasheet]` key, e.g. `pick_up_voltage`.
     pub figure: &'static str,
-    /// The datasheet's value (V for a voltage, s for a time).
+    /// The datasheet's value that stands for the figure (V for a voltage,
+    /// Ω for a resistance, s for a time): the typical value, else the
+    /// maximum, else the minimum.
     pub target: f64,
+    /// The figure as printed: a number (typical) or `{typ, min, max,
+    /// tolerance}`.
+    pub printed: PrintedFigure,
+    /// How the fit used it: `"target"` (a typical value, matched) or
+    /// `"bound"` (a minimum, maximum or tolerance only, held).
+    pub role: &'static str,
+    /// Whether the model meets the figure as printed (inside its bounds;
+    /// a typical value alone within ±20 %); `None` when the model does not
+    /// show it.
+    pub met: Option<bool>,
     /// The model's value, same unit; `None` when the model does not show
     /// it (it never closes, say) or does not model it (`release_time`).
     pub model: Option<f64>,
     /// (model − target)/target.
     pub residual: Option<f64>,
-    /// This figure limits the fit: the largest relative misfit.
+    /// This figure limits the fit: a bound the model sits on (or crosses),
+    /// or the target with the largest relative misfit.
     pub binds: bool,
     /// m, for `pick_up_voltage`: where along the travel the model's pull
     /// only just beats the load (0 at rest); for `drop_out_voltage`: the
@@ -429,17 +444,8 @@ fn drop_pair(events: &[Event], j: usize) -> Vec<Event> {
 }
 
 /// The datasheet figures that were given, in a fixed order.
-fn figures(d: &DatasheetSection) -> Vec<(&'static str, f64)> {
-    [
-        ("pick_up_voltage", d.pick_up_voltage),
-        ("drop_out_voltage", d.drop_out_voltage),
-        ("operate_time", d.operate_time),
-        ("bounce_time", d.bounce_time),
-        ("release_time", d.release_time),
-    ]
-    .into_iter()
-    .filter_map(|(name, v)| v.map(|v| (name, v)))
-    .collect()
+fn figures(d: &DatasheetSection) -> Vec<(&'static str, PrintedFigure)> {
+    d.figures()
 }
 
 /// The modelled events of one closing: the step-force engine, or with a
@@ -488,7 +494,7 @@ pub fn datasheet_figures(s: &Scenario, d: &DatasheetSection) -> Vec<(&'static st
     let m = s.armature();
     let build = s.two_stage();
     let line = LoadLine::of_relay(&m, &build);
-    let wants = |f: Option<f64>| f.is_some();
+    let wants = |f: Option<PrintedFigure>| f.is_some();
     let closing = match d.coil_voltage {
         Some(v) if wants(d.operate_time) || wants(d.bounce_time) => direct_closing(
             &coil,
@@ -510,6 +516,7 @@ pub fn datasheet_figures(s: &Scenario, d: &DatasheetSection) -> Vec<(&'static st
     let mut out = Vec::new();
     for (name, _) in figures(d) {
         let value = match name {
+            "coil_resistance" => Some(coil.resistance),
             "pick_up_voltage" => Some(pick_up(&coil, &line).voltage),
             "drop_out_voltage" => Some(drop_out(&coil, &line).voltage),
             "operate_time" => operate,
@@ -611,9 +618,9 @@ impl Problem<'_> {
             r.resize(self.measured.as_ref().map_or(0, |m| m.len() + 1), 0.0);
         }
         if let Some(d) = &self.datasheet {
-            for ((name, target), (_, model)) in figures(d).iter().zip(&e.figures) {
+            for ((name, figure), (_, model)) in figures(d).iter().zip(&e.figures) {
                 r.push(match model {
-                    Some(m) => (m - target) / target / RELATIVE_SCALE,
+                    Some(m) => figure.misfit(*m) / RELATIVE_SCALE,
                     // Shown, not fitted (see `datasheet_figures`).
                     None if *name == "release_time" => 0.0,
                     None => 1.0 / RELATIVE_SCALE,
@@ -943,7 +950,7 @@ fn evidence(scenario: &Scenario, request: &FitRequest, path: &str) -> Result<Evi
     if let Some(d) = &scenario.datasheet {
         let all = [("coil_voltage", d.coil_voltage)]
             .into_iter()
-            .chain(figures(d).into_iter().map(|(n, v)| (n, Some(v))));
+            .chain(figures(d).into_iter().map(|(n, f)| (n, Some(f.nominal()))));
         for (figure, v) in all {
             if let Some(value) = v
                 && !(value > 0.0 && value.is_finite())

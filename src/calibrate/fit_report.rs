@@ -4,15 +4,24 @@
 
 use std::time::Instant;
 
+use nalgebra::DMatrix;
+
 use super::{
-    BounceCount, Candidate, Evaluation, Event, EventKind, EventRow, FigureRow, FitReport,
-    FitRequest, Held, ParameterRow, Problem, event_residuals, figures, pick_up_of,
+    BounceCount, Candidate, DatasheetSection, Determined, Evaluation, Event, EventKind, EventRow,
+    FigureRow, FitReport, FitRequest, Held, ParameterRow, Problem, RELATIVE_SCALE,
+    event_residuals, figures, pick_up_of,
 };
 use crate::coil::Coil;
 use crate::scenario::Scenario;
 
 /// One row per free key: its fitted value and, unless it is held, its
-/// 1σ from the covariance `(JᵀJ)⁻¹·rms²` at the fitted point.
+/// 1σ. With a record, from the covariance `(JᵀJ)⁻¹·rms²` at the fitted
+/// point. From a datasheet alone, from the figures' own spreads
+/// ([`PrintedFigure::relative_sigma`]): `(JwᵀJw)⁻¹` with each figure's
+/// row weighted by its spread, scaled up by the misfit per degree of
+/// freedom when there are more figures than keys and they disagree; a
+/// key fixed by as many figures as free keys with no misfit left is
+/// determined `"exactly"`, its σ the figures' tolerances carried through.
 pub(super) fn uncertainties(
     problem: &Problem,
     held: &Held,
@@ -28,12 +37,10 @@ pub(super) fn uncertainties(
     let data = problem
         .data_residuals(&best.0, candidate)
         .unwrap_or_default();
-    let ssr: f64 = data.iter().map(|x| x * x).sum();
-    let dof = problem.data_len().saturating_sub(active.len()).max(1);
-    let rms2 = ssr / dof as f64;
-    let covariance = jacobian
-        .as_ref()
-        .and_then(|j| (j.transpose() * j).try_inverse());
+    let (covariance, exactly) = match (&problem.datasheet, &problem.measured) {
+        (Some(d), None) => figure_covariance(d, jacobian.as_ref(), &data, active.len()),
+        _ => (residual_covariance(problem, jacobian.as_ref(), &data, active.len()), false),
+    };
     let mut parameters = Vec::new();
     for (k, key) in problem.keys.iter().enumerate() {
         let prior = problem.prior[k];
@@ -47,11 +54,17 @@ pub(super) fn uncertainties(
         } else {
             let col = active.iter().position(|&a| a == k);
             Some(match (&covariance, col) {
-                (Some(c), Some(col)) => value * (c[(col, col)] * rms2).sqrt(),
+                (Some(c), Some(col)) => value * c[(col, col)].sqrt(),
                 _ => f64::INFINITY,
             })
         };
-        let determined = sigma.is_some_and(|s| s.is_finite() && s < value);
+        // Fixed exactly is said whatever the σ: the figures fix the key,
+        // and its σ says how well their tolerances let them.
+        let determined = match sigma {
+            Some(s) if s.is_finite() && exactly => Determined::Exactly,
+            Some(s) if s.is_finite() && s < value => Determined::Yes,
+            _ => Determined::No,
+        };
         parameters.push(ParameterRow {
             key: key.clone(),
             prior,
@@ -62,6 +75,71 @@ pub(super) fn uncertainties(
     }
     parameters
 }
+
+/// The covariance of the log parameters from the residual misfit:
+/// `(JᵀJ)⁻¹·rms²`, rms² the data's mean square per degree of freedom.
+fn residual_covariance(
+    problem: &Problem,
+    jacobian: Option<&DMatrix<f64>>,
+    data: &[f64],
+    active: usize,
+) -> Option<DMatrix<f64>> {
+    let ssr: f64 = data.iter().map(|x| x * x).sum();
+    let dof = problem.data_len().saturating_sub(active).max(1);
+    let rms2 = ssr / dof as f64;
+    jacobian
+        .and_then(|j| (j.transpose() * j).try_inverse())
+        .map(|c| c * rms2)
+}
+
+/// The covariance of the log parameters from the datasheet figures'
+/// spreads, and whether the keys are fixed exactly (as many figures that
+/// see them as keys, and no misfit left).
+fn figure_covariance(
+    d: &DatasheetSection,
+    jacobian: Option<&DMatrix<f64>>,
+    data: &[f64],
+    active: usize,
+) -> (Option<DMatrix<f64>>, bool) {
+    let Some(j) = jacobian else {
+        return (None, false);
+    };
+    let figures = d.figures();
+    let mut weighted = j.clone();
+    let (mut chi2, mut seen) = (0.0, 0usize);
+    for (row, (_, figure)) in figures.iter().enumerate().take(j.nrows()) {
+        // The rows are misfits over RELATIVE_SCALE; back to relative
+        // misfits, over the figure's own spread.
+        let w = RELATIVE_SCALE / figure.relative_sigma();
+        for col in 0..j.ncols() {
+            weighted[(row, col)] *= w;
+        }
+        let misfit = data.get(row).copied().unwrap_or(0.0) * w;
+        chi2 += misfit * misfit;
+        if j.row(row).iter().any(|x| *x != 0.0) {
+            seen += 1;
+        }
+    }
+    let dof = seen.saturating_sub(active);
+    let scale = if dof > 0 {
+        (chi2 / dof as f64).max(1.0)
+    } else {
+        1.0
+    };
+    let worst = data
+        .iter()
+        .take(figures.len())
+        .map(|x| (x * RELATIVE_SCALE).abs())
+        .fold(0.0, f64::max);
+    let exactly = seen == active && active > 0 && worst < EXACT_MISFIT;
+    let covariance = (weighted.transpose() * &weighted)
+        .try_inverse()
+        .map(|c| c * scale);
+    (covariance, exactly)
+}
+
+/// Relative misfit below which the figures are met exactly.
+const EXACT_MISFIT: f64 = 1e-6;
 
 /// The report of the fit that ended at `best` (log parameters) with
 /// `candidate`'s events: the rows, the misfit, the fitted scenario with
@@ -208,10 +286,18 @@ fn datasheet_rows(
         return (datasheet_rows, pick_up_binds);
     };
     let pick = pick_up_of(fitted);
-    for ((figure, target), (_, model)) in figures(d).into_iter().zip(&e.figures) {
+    for ((figure, printed), (_, model)) in figures(d).into_iter().zip(&e.figures) {
+        let target = printed.nominal();
         datasheet_rows.push(FigureRow {
             figure,
             target,
+            printed,
+            role: if printed.typ.is_some() {
+                "target"
+            } else {
+                "bound"
+            },
+            met: model.map(|m| printed.met_by_nominal(m)),
             model: *model,
             residual: model.map(|m| (m - target) / target),
             binds: false,
@@ -222,7 +308,7 @@ fn datasheet_rows(
             }),
         });
     }
-    if let (Some(_), Some(c), Some((pu, line))) = (d.pick_up_voltage, &fitted.coil, pick) {
+    if let (Some(_), Some(c), Some((pu, line))) = (&d.pick_up_voltage, &fitted.coil, pick) {
         let text = pu.binding_text(&line);
         notes.push(if pu.at_rest() {
             format!("the pick-up binds {text}: the pull at rest against the preload")
@@ -236,19 +322,34 @@ fn datasheet_rows(
         });
         pick_up_binds = Some(text);
     }
-    let worst = datasheet_rows
+    mark_binding(&mut datasheet_rows);
+    (datasheet_rows, pick_up_binds)
+}
+
+/// Mark the figures that limit the fit: every bound the model sits on
+/// (within 0.1 %) or crosses, and the target with the largest misfit;
+/// `release_time` is shown, not fitted.
+fn mark_binding(rows: &mut [FigureRow]) {
+    let fitted = |r: &FigureRow| r.figure != "release_time" && r.figure != "coil_resistance";
+    for r in rows.iter_mut().filter(|r| fitted(r) && r.role == "bound") {
+        let (lo, hi) = r.printed.band();
+        r.binds = r.model.is_none_or(|m| {
+            let near = |b: f64| b.is_finite() && ((m - b) / b).abs() < 1e-3;
+            near(lo) || near(hi) || !r.printed.holds(m)
+        });
+    }
+    let worst = rows
         .iter()
         .enumerate()
-        .filter(|(_, r)| r.figure != "release_time")
+        .filter(|(_, r)| fitted(r) && r.role == "target")
         .map(|(i, r)| (i, r.residual.map_or(f64::INFINITY, f64::abs)))
         .fold(
             (usize::MAX, -1.0),
             |acc, (i, v)| if v > acc.1 { (i, v) } else { acc },
         );
-    if let Some(row) = datasheet_rows.get_mut(worst.0) {
+    if let Some(row) = rows.get_mut(worst.0) {
         row.binds = true;
     }
-    (datasheet_rows, pick_up_binds)
 }
 
 /// The rms of the relative misfits of the fitted figures (`release_time`
@@ -257,7 +358,7 @@ fn relative_rms(rows: &[FigureRow]) -> f64 {
     let rel: Vec<f64> = rows
         .iter()
         .filter(|r| r.figure != "release_time")
-        .map(|r| r.residual.unwrap_or(1.0))
+        .map(|r| r.model.map_or(1.0, |m| r.printed.misfit(m)))
         .collect();
     (rel.iter().map(|x| x * x).sum::<f64>() / rel.len().max(1) as f64).sqrt()
 }

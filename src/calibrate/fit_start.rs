@@ -5,7 +5,8 @@
 
 use super::Problem;
 use crate::coil::Coil;
-use crate::coil::pick_up::{LoadLine, pick_up};
+use crate::coil::pick_up::{LoadLine, drop_out, pick_up};
+use crate::scenario::PrintedFigure;
 
 /// The prior, with the preload and the spring stiffness (those of them
 /// that are free) solved from the pick-up and drop-out voltages; a key
@@ -26,8 +27,10 @@ pub(super) fn closed_form_start(problem: &Problem, u_prior: &[f64]) -> Vec<f64> 
         &coil,
         &line,
         Currents {
-            pick_up: d.pick_up_voltage.map(|v| v / coil.resistance),
-            drop_out: d.drop_out_voltage.map(|v| v / coil.resistance),
+            pick_up: start_voltage(d.pick_up_voltage, pick_up(&coil, &line).voltage)
+                .map(|v| v / coil.resistance),
+            drop_out: start_voltage(d.drop_out_voltage, drop_out(&coil, &line).voltage)
+                .map(|v| v / coil.resistance),
         },
         kp.is_some(),
         ks.is_some(),
@@ -44,6 +47,24 @@ pub(super) fn closed_form_start(problem: &Problem, u_prior: &[f64]) -> Vec<f64> 
     }
     problem.clamp(&mut u);
     u
+}
+
+/// V, the voltage to solve the spring for: a typical figure's value; a
+/// bound's only when the prior's `model` voltage crosses it (a prior
+/// inside the bound needs no moving); `None` otherwise.
+fn start_voltage(figure: Option<PrintedFigure>, model: f64) -> Option<f64> {
+    let figure = figure?;
+    if let Some(t) = figure.typ {
+        return Some(t);
+    }
+    let (lo, hi) = figure.band();
+    if model > hi {
+        Some(hi)
+    } else if model < lo {
+        Some(lo)
+    } else {
+        None
+    }
 }
 
 /// A, the coil currents of the datasheet's pick-up and drop-out voltages.

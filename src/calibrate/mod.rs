@@ -10,5 +10,8 @@ pub mod render;
 /// `[fit]`, `[provenance]`), defined with the other sections in
 /// [`crate::scenario`].
 pub mod sections {
-    pub use crate::scenario::{DatasheetSection, FitSection, FittedParameter, ProvenanceSection};
+    pub use crate::scenario::{
+        DatasheetSection, Determined, FitSection, FittedParameter, PrintedFigure,
+        ProvenanceSection,
+    };
 }

@@ -14,11 +14,14 @@
 
 use std::path::Path;
 
+use std::collections::BTreeMap;
+
 use serde::Serialize;
 use thiserror::Error;
 
 use super::fit::{datasheet_figures, pick_up_of};
-use crate::scenario::{Scenario, ScenarioError};
+use crate::scenario::{PrintedFigure, Scenario, ScenarioError};
+use crate::report::units::engineering;
 
 /// No bundled part of that name.
 #[derive(Debug, Error)]
@@ -125,23 +128,6 @@ pub fn find(name: &str) -> Result<Part, UnknownPart> {
         })
 }
 
-/// A datasheet figure as listed: the printed value and what the fitted
-/// scenario gives, or "not given".
-#[derive(Debug, Clone, Serialize)]
-#[serde(untagged)]
-pub enum Figure {
-    /// The datasheet prints it.
-    Given {
-        /// The printed value (V, Ω or s).
-        value: f64,
-        /// The fitted scenario's value, same unit; `None` when it does not
-        /// model it.
-        model: Option<f64>,
-    },
-    /// The datasheet does not print it: the text to show instead.
-    NotGiven(&'static str),
-}
-
 /// One part as `parts --format json` lists it.
 #[derive(Debug, Clone, Serialize)]
 pub struct Listing {
@@ -149,9 +135,16 @@ pub struct Listing {
     pub name: &'static str,
     /// As [`Part::class`].
     pub class: &'static str,
-    /// Every datasheet figure (`coil_voltage`, `pick_up_voltage`, …), by
-    /// key, printed or not.
-    pub datasheet: std::collections::BTreeMap<&'static str, Figure>,
+    /// Every figure the datasheet prints, by key, as printed: a number
+    /// (typical) or `{typ, min, max, tolerance}`. `coil_voltage` is the
+    /// nominal voltage.
+    pub datasheet: BTreeMap<&'static str, PrintedFigure>,
+    /// The nominal relay's value of each printed figure, same unit;
+    /// `null` for a figure the model does not show (`release_time`).
+    pub model: BTreeMap<&'static str, Option<f64>>,
+    /// Whether the nominal relay meets each printed figure it shows
+    /// (inside its bounds; a typical value alone within ±20 %).
+    pub met: BTreeMap<&'static str, bool>,
     /// As [`Part::contact_rating`].
     pub contact_rating: &'static str,
     /// As [`Part::source`].
@@ -163,59 +156,31 @@ pub struct Listing {
     pub pick_up_binds: Option<String>,
 }
 
-const FIGURES: [&str; 7] = [
-    "coil_voltage",
-    "coil_resistance",
-    "pick_up_voltage",
-    "drop_out_voltage",
-    "operate_time",
-    "bounce_time",
-    "release_time",
-];
-
 /// The listing of `part`: its datasheet figures against its scenario's.
 pub fn listing(part: &Part) -> Listing {
     let scenario = part.load().expect("a bundled part's scenario is valid");
     let d = scenario.datasheet.clone().unwrap_or_default();
     let modelled = datasheet_figures(&scenario, &d);
-    let model = |name: &str| {
-        modelled
-            .iter()
-            .find(|(n, _)| *n == name)
-            .and_then(|(_, v)| *v)
-    };
-    let mut datasheet = std::collections::BTreeMap::new();
-    for name in FIGURES {
-        let printed = match name {
-            "coil_voltage" => d.coil_voltage,
-            "coil_resistance" => scenario.coil.as_ref().map(|c| c.resistance),
-            "pick_up_voltage" => d.pick_up_voltage,
-            "drop_out_voltage" => d.drop_out_voltage,
-            "operate_time" => d.operate_time,
-            "bounce_time" => d.bounce_time,
-            "release_time" => d.release_time,
-            _ => None,
-        };
-        datasheet.insert(
-            name,
-            match printed {
-                Some(value) => Figure::Given {
-                    value,
-                    // The coil's voltage and resistance are the model's
-                    // own inputs.
-                    model: match name {
-                        "coil_voltage" | "coil_resistance" => Some(value),
-                        _ => model(name),
-                    },
-                },
-                None => Figure::NotGiven("not given"),
-            },
-        );
+    let mut datasheet = BTreeMap::new();
+    let mut model = BTreeMap::new();
+    let mut met = BTreeMap::new();
+    if let Some(v) = d.coil_voltage {
+        datasheet.insert("coil_voltage", PrintedFigure::typical(v));
+        model.insert("coil_voltage", Some(v));
+    }
+    for ((name, printed), (_, value)) in d.figures().into_iter().zip(modelled) {
+        datasheet.insert(name, printed);
+        model.insert(name, value);
+        if let Some(v) = value {
+            met.insert(name, printed.met_by_nominal(v));
+        }
     }
     Listing {
         name: part.name,
         class: part.class,
         datasheet,
+        model,
+        met,
         contact_rating: part.contact_rating,
         source: part.source,
         remark: part.remark,
@@ -255,15 +220,22 @@ pub fn table() -> String {
     for part in PARTS {
         let l = listing(part);
         let _ = writeln!(out, "{}  ({})", l.name, l.class);
-        for (name, figure) in &l.datasheet {
-            let text = match figure {
-                Figure::Given { value, model } => format!(
-                    "{value:.4e}  (model {})",
-                    model.map_or_else(|| "not modelled".to_owned(), |m| format!("{m:.4e}"))
-                ),
-                Figure::NotGiven(t) => (*t).to_owned(),
+        for (name, printed) in &l.datasheet {
+            let unit = unit_of(name);
+            let model = match l.model.get(name).copied().flatten() {
+                Some(m) => format!("model {}", engineering(m, unit)),
+                None => "not modelled".to_owned(),
             };
-            let _ = writeln!(out, "  {name:<17} {text}");
+            let verdict = match l.met.get(name) {
+                Some(true) => ", met",
+                Some(false) => ", NOT MET",
+                None => "",
+            };
+            let _ = writeln!(
+                out,
+                "  {name:<17} {}  ({model}{verdict})",
+                printed_text(printed, unit)
+            );
         }
         if let Some(binds) = &l.pick_up_binds {
             let _ = writeln!(out, "  pick-up binds     {binds}");
@@ -273,4 +245,38 @@ pub fn table() -> String {
         let _ = writeln!(out, "  note              {}\n", l.remark);
     }
     out
+}
+
+/// The unit of a datasheet figure.
+pub(super) fn unit_of(name: &str) -> &'static str {
+    if name.ends_with("_voltage") {
+        "V"
+    } else if name.ends_with("_resistance") {
+        "Ω"
+    } else {
+        "s"
+    }
+}
+
+/// A printed figure in engineering units: `≤ 10 ms`, `63 Ω ±10 %`,
+/// `1 ms typ., ≤ 5 ms`.
+pub(super) fn printed_text(f: &PrintedFigure, unit: &str) -> String {
+    let mut parts = Vec::new();
+    if let Some(t) = f.typ {
+        let mut text = engineering(t, unit);
+        if let Some(tol) = f.tolerance {
+            text.push_str(&format!(" ±{} %", (tol * 1e5).round() / 1e3));
+        }
+        if f.min.is_some() || f.max.is_some() {
+            text.push_str(" typ.");
+        }
+        parts.push(text);
+    }
+    if let Some(v) = f.min {
+        parts.push(format!("≥ {}", engineering(v, unit)));
+    }
+    if let Some(v) = f.max {
+        parts.push(format!("≤ {}", engineering(v, unit)));
+    }
+    parts.join(", ")
 }

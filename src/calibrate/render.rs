@@ -4,6 +4,8 @@
 use std::fmt::Write;
 
 use super::fit::{EventKind, FitReport};
+use crate::report::units::engineering;
+use crate::scenario::unit_of;
 use crate::chatter::{ContactState, Interval};
 
 /// `fit --format json`: the report's fields (see the calibration guide).
@@ -13,8 +15,14 @@ pub fn json(report: &FitReport) -> String {
     text
 }
 
-fn number(v: Option<f64>) -> String {
-    v.map_or_else(|| "-".to_owned(), |v| format!("{v:.6e}"))
+/// `v` in engineering units (`63 Ω`, `10 ms`), or `-` when absent; a
+/// key without a unit keeps four significant digits.
+fn number(v: Option<f64>, unit: &str) -> String {
+    match v {
+        None => "-".to_owned(),
+        Some(v) if unit.is_empty() => format!("{v:.4}"),
+        Some(v) => engineering(v, unit),
+    }
 }
 
 /// `fit --format table`: parameters, then events, then datasheet figures,
@@ -31,10 +39,14 @@ pub fn table(report: &FitReport) -> String {
             out,
             "{:<24} {:>13} {:>13} {:>13}  {}",
             p.key,
-            number(Some(p.prior)),
-            number(Some(p.value)),
-            number(p.sigma),
-            if p.determined { "yes" } else { "no" }
+            number(Some(p.prior), unit_of(&p.key)),
+            number(Some(p.value), unit_of(&p.key)),
+            number(p.sigma, unit_of(&p.key)),
+            match p.determined {
+                crate::scenario::Determined::No => "no",
+                crate::scenario::Determined::Yes => "yes",
+                crate::scenario::Determined::Exactly => "exactly",
+            }
         );
     }
     if !report.events.is_empty() {
@@ -42,16 +54,16 @@ pub fn table(report: &FitReport) -> String {
         let _ = writeln!(
             out,
             "{:<6} {:>13} {:>13} {:>13}",
-            "event", "measured s", "model s", "residual s"
+            "event", "measured", "model", "residual"
         );
         for e in &report.events {
             let _ = writeln!(
                 out,
                 "{:<6} {:>13} {:>13} {:>13}{}",
                 e.kind.as_str(),
-                number(e.measured),
-                number(e.model),
-                number(e.residual),
+                number(e.measured, "s"),
+                number(e.model, "s"),
+                number(e.residual, "s"),
                 if e.dropped { "  (set aside)" } else { "" }
             );
         }
@@ -62,23 +74,25 @@ pub fn table(report: &FitReport) -> String {
     if let Some(t) = report.time_offset {
         let _ = writeln!(
             out,
-            "time offset: {t:.6e} s (model time of the record's zero)"
+            "time offset: {} (model time of the record's zero)",
+            engineering(t, "s")
         );
     }
     if !report.datasheet.is_empty() {
         let _ = writeln!(out);
         let _ = writeln!(
             out,
-            "{:<18} {:>13} {:>13} {:>10}",
+            "{:<18} {:>22} {:>10} {:>10}",
             "figure", "datasheet", "model", "misfit"
         );
         for f in &report.datasheet {
+            let unit = super::parts::unit_of(f.figure);
             let _ = writeln!(
                 out,
-                "{:<18} {:>13} {:>13} {:>10}{}",
+                "{:<18} {:>22} {:>10} {:>10}{}",
                 f.figure,
-                number(Some(f.target)),
-                number(f.model),
+                super::parts::printed_text(&f.printed, unit),
+                number(f.model, unit),
                 f.residual
                     .map_or_else(|| "-".to_owned(), |r| format!("{:+.3}%", r * 100.0)),
                 if f.binds { "  (binds)" } else { "" }

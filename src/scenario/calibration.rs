@@ -7,30 +7,55 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
+use super::figure::PrintedFigure;
+
 /// `[datasheet]`: a relay's published figures, in their IEC 61810
 /// meanings, measured as a datasheet measures them (an ideal DC step on
-/// the coil, no driver circuit). Any subset may be given.
+/// the coil, no driver circuit). Any subset may be given. Each figure is
+/// written as printed: a number (typical) or a table
+/// `{ typ, min, max, tolerance }` ([`PrintedFigure`]).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DatasheetSection {
     /// V, the nominal coil voltage (the step the times are measured with).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub coil_voltage: Option<f64>,
-    /// V, must-operate voltage.
+    /// Ω, the coil's resistance, usually with a tolerance (±10 %).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub pick_up_voltage: Option<f64>,
-    /// V, must-release voltage.
+    pub coil_resistance: Option<PrintedFigure>,
+    /// V, must-operate voltage (usually a maximum).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub drop_out_voltage: Option<f64>,
+    pub pick_up_voltage: Option<PrintedFigure>,
+    /// V, must-release voltage (usually a minimum).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub drop_out_voltage: Option<PrintedFigure>,
     /// s, coil energized → first make (bounce excluded).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub operate_time: Option<f64>,
+    pub operate_time: Option<PrintedFigure>,
     /// s, first make → closed for good.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub bounce_time: Option<f64>,
+    pub bounce_time: Option<PrintedFigure>,
     /// s, coil de-energized → the normally-open contact opens.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub release_time: Option<f64>,
+    pub release_time: Option<PrintedFigure>,
+}
+
+impl DatasheetSection {
+    /// The figures given, by key, in a fixed order: coil resistance,
+    /// pick-up, drop-out, operate, bounce, release.
+    pub fn figures(&self) -> Vec<(&'static str, PrintedFigure)> {
+        [
+            ("coil_resistance", self.coil_resistance),
+            ("pick_up_voltage", self.pick_up_voltage),
+            ("drop_out_voltage", self.drop_out_voltage),
+            ("operate_time", self.operate_time),
+            ("bounce_time", self.bounce_time),
+            ("release_time", self.release_time),
+        ]
+        .into_iter()
+        .filter_map(|(name, f)| f.map(|f| (name, f)))
+        .collect()
+    }
 }
 
 /// `[fit]`: the keys a fit may move (scenario number keys such as
@@ -87,6 +112,89 @@ pub struct FittedParameter {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sigma: Option<f64>,
     /// `determined`: whether the evidence determined the key (its 1σ is
-    /// smaller than its value); `false` for a key held at its prior.
-    pub determined: bool,
+    /// smaller than its value), `"exactly"` when as many figures as free
+    /// keys fix it; `false` for a key held at its prior.
+    pub determined: Determined,
+}
+
+/// Whether the evidence determined a fitted key: written `false`, `true`
+/// or `"exactly"`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Determined {
+    /// Not determined: held at its prior, or its 1σ exceeds its value.
+    #[default]
+    No,
+    /// Determined by more evidence than free keys: its 1σ comes from the
+    /// residual misfit.
+    Yes,
+    /// Fixed exactly by as many figures as free keys: the misfit is zero,
+    /// and its 1σ comes from the figures' tolerances.
+    Exactly,
+}
+
+impl Determined {
+    /// Determined, exactly or not.
+    pub fn is_determined(self) -> bool {
+        self != Determined::No
+    }
+}
+
+impl From<bool> for Determined {
+    fn from(b: bool) -> Determined {
+        if b { Determined::Yes } else { Determined::No }
+    }
+}
+
+impl Serialize for Determined {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        match self {
+            Determined::No => serializer.serialize_bool(false),
+            Determined::Yes => serializer.serialize_bool(true),
+            Determined::Exactly => serializer.serialize_str("exactly"),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Determined {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Raw {
+            Flag(bool),
+            Word(String),
+        }
+        match Raw::deserialize(deserializer)? {
+            Raw::Flag(b) => Ok(b.into()),
+            Raw::Word(w) if w == "exactly" => Ok(Determined::Exactly),
+            Raw::Word(w) => Err(serde::de::Error::custom(format!(
+                "`determined` is true, false or \"exactly\", not \"{w}\""
+            ))),
+        }
+    }
+}
+
+impl super::check::Check<'_> {
+    /// Every figure of `[datasheet]` says something and does not
+    /// contradict itself; the coil voltage is positive.
+    pub(super) fn datasheet(&self, d: &DatasheetSection) -> Result<(), super::ScenarioError> {
+        if let Some(v) = d.coil_voltage {
+            self.number(
+                "datasheet.coil_voltage",
+                v,
+                v > 0.0,
+                "must be > 0: the nominal coil voltage, in V",
+            )?;
+        }
+        for (name, figure) in d.figures() {
+            if let Err((field, value, requirement)) = figure.check() {
+                let key = if field.is_empty() {
+                    format!("datasheet.{name}")
+                } else {
+                    format!("datasheet.{name}.{field}")
+                };
+                return Err(self.invalid(&key, value, requirement));
+            }
+        }
+        Ok(())
+    }
 }

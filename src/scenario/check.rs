@@ -132,6 +132,9 @@ impl Check<'_> {
         if let Some(arc) = &d.arc {
             self.arc(arc)?;
         }
+        if let Some(datasheet) = &d.datasheet {
+            self.datasheet(datasheet)?;
+        }
         if let Some(limits) = d.limits.as_ref().filter(|_| d.arc.is_none()) {
             let given = [
                 ("limits.max_arc_energy", limits.max_arc_energy.is_some()),

@@ -21,6 +21,7 @@ mod circuit;
 mod coil;
 mod contact;
 mod error;
+mod figure;
 mod keys;
 mod limits;
 mod mechanics;
@@ -34,14 +35,17 @@ mod tests;
 mod two_stage;
 
 pub use builder::ScenarioBuilder;
-pub use calibration::{DatasheetSection, FitSection, FittedParameter, ProvenanceSection};
+pub use calibration::{
+    DatasheetSection, Determined, FitSection, FittedParameter, ProvenanceSection,
+};
 pub use circuit::CircuitSection;
 pub use coil::CoilSection;
 pub use contact::{ContactSection, HolmSection};
 pub use error::{Location, ScenarioError};
+pub use figure::{FigureKind, PRINTED_PRECISION, PrintedFigure, TYPICAL_BAND};
 pub use limits::LimitsSection;
 pub use mechanics::MechanicsSection;
-pub use numbers::{ENVELOPE, NUMBER_KEYS};
+pub use numbers::{ENVELOPE, NUMBER_KEYS, unit_of};
 pub use probes::Probe;
 pub use simulation::SimulationSection;
 pub use surface::{SurfaceLaw, SurfaceSection};

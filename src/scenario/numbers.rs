@@ -56,6 +56,35 @@ pub const NUMBER_KEYS: &[&str] = &[
     "arc.opening_speed",
 ];
 
+/// The unit of number key `key` (one of [`NUMBER_KEYS`] or `probe[N].low`
+/// / `.high`), for tables in engineering units; `""` for a pure number
+/// (restitution, exponents) or a key it does not know.
+pub fn unit_of(key: &str) -> &'static str {
+    let name = key.rsplit('.').next().unwrap_or(key);
+    match name {
+        "mass" => "kg",
+        "force" | "preload" | "f_ref" => "N",
+        "gap" | "initial_position" | "overtravel" | "pole_area" | "air_gap" | "iron_gap"
+        | "min_gap" => "m",
+        "initial_velocity" | "reference_velocity" | "opening_speed" => "m/s",
+        "resistance" | "r_closed" | "r_open" | "r_film" | "r_ref" => "Ω",
+        "t_end" | "min_open_time" | "edge_time" => "s",
+        "damping" => "N·s/m",
+        "chi" => "s/m",
+        "v_min" | "low" | "high" => "V",
+        "i_min" => "A",
+        "field" => "V/m",
+        "stiffness" if key.starts_with("surface.")
+            || key.starts_with("back_stop.")
+            || key.starts_with("pole_face.") =>
+        {
+            "N/mⁿ"
+        }
+        "stiffness" => "N/m",
+        _ => "",
+    }
+}
+
 /// Every number key, for messages.
 pub(super) fn number_keys_described() -> String {
     let mut known = NUMBER_KEYS.join(", ");

@@ -87,7 +87,7 @@ fn value(report: &chatterspice::calibrate::fit::FitReport, key: &str) -> (f64, f
         .iter()
         .find(|p| p.key == key)
         .unwrap_or_else(|| panic!("no {key}"));
-    (p.prior, p.value, p.determined)
+    (p.prior, p.value, p.determined.is_determined())
 }
 
 fn assert_recovered(
@@ -107,7 +107,7 @@ fn assert_recovered(
         "{key}: fitted {v}, truth {truth} (prior {prior}); notes {:?}",
         report.notes
     );
-    assert!(determined, "{key} should be determined");
+    assert!(determined, "{key} should be determined: {:?}", report.parameters);
 }
 
 #[test]
