@@ -8,8 +8,8 @@ use nalgebra::DMatrix;
 
 use super::{
     BounceCount, Candidate, DatasheetSection, Determined, Evaluation, Event, EventKind, EventRow,
-    FigureRow, FitReport, FitRequest, Held, ParameterRow, Problem, RELATIVE_SCALE,
-    event_residuals, figures, pick_up_of,
+    FigureRow, FitReport, FitRequest, Held, ParameterRow, Problem, RELATIVE_SCALE, event_residuals,
+    figures, pick_up_of,
 };
 use crate::coil::Coil;
 use crate::scenario::Scenario;
@@ -39,7 +39,10 @@ pub(super) fn uncertainties(
         .unwrap_or_default();
     let (covariance, exactly) = match (&problem.datasheet, &problem.measured) {
         (Some(d), None) => figure_covariance(d, jacobian.as_ref(), &data, active.len()),
-        _ => (residual_covariance(problem, jacobian.as_ref(), &data, active.len()), false),
+        _ => (
+            residual_covariance(problem, jacobian.as_ref(), &data, active.len()),
+            false,
+        ),
     };
     let mut parameters = Vec::new();
     for (k, key) in problem.keys.iter().enumerate() {

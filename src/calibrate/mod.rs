@@ -11,7 +11,6 @@ pub mod render;
 /// [`crate::scenario`].
 pub mod sections {
     pub use crate::scenario::{
-        DatasheetSection, Determined, FitSection, FittedParameter, PrintedFigure,
-        ProvenanceSection,
+        DatasheetSection, Determined, FitSection, FittedParameter, PrintedFigure, ProvenanceSection,
     };
 }

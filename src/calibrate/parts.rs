@@ -20,8 +20,8 @@ use serde::Serialize;
 use thiserror::Error;
 
 use super::fit::{datasheet_figures, pick_up_of};
-use crate::scenario::{PrintedFigure, Scenario, ScenarioError};
 use crate::report::units::engineering;
+use crate::scenario::{PrintedFigure, Scenario, ScenarioError};
 
 /// No bundled part of that name.
 #[derive(Debug, Error)]

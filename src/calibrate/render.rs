@@ -4,9 +4,9 @@
 use std::fmt::Write;
 
 use super::fit::{EventKind, FitReport};
+use crate::chatter::{ContactState, Interval};
 use crate::report::units::engineering;
 use crate::scenario::unit_of;
-use crate::chatter::{ContactState, Interval};
 
 /// `fit --format json`: the report's fields (see the calibration guide).
 pub fn json(report: &FitReport) -> String {

@@ -179,6 +179,18 @@ pub enum ScenarioError {
         /// What is wrong, and what to change.
         problem: String,
     },
+    /// `base =` names a scenario that cannot be used: an unknown part, a
+    /// file that cannot be read, or a chain of bases that comes back to
+    /// itself.
+    #[error("{at}: `base` = {base:?}: {problem}")]
+    Base {
+        /// Where `base` is.
+        at: Location,
+        /// The value of `base`.
+        base: String,
+        /// What is wrong, and what to write instead.
+        problem: String,
+    },
     /// The netlist named by `circuit.netlist` could not be read.
     #[error(
         "{}: cannot read the netlist named by `circuit.netlist` in {} ({})",
@@ -203,6 +215,25 @@ pub enum ScenarioError {
 }
 
 impl ScenarioError {
+    /// The place the error points at, for the errors that point at a key
+    /// of the file.
+    pub(super) fn location_mut(&mut self) -> Option<&mut Location> {
+        match self {
+            ScenarioError::UnknownKey { at, .. }
+            | ScenarioError::MissingKey { at, .. }
+            | ScenarioError::BadValue { at, .. }
+            | ScenarioError::Invalid { at, .. }
+            | ScenarioError::Empty { at, .. }
+            | ScenarioError::Conflict { at, .. }
+            | ScenarioError::NotForLaw { at, .. }
+            | ScenarioError::UnknownNumber { at, .. }
+            | ScenarioError::Sweep { at, .. }
+            | ScenarioError::Syntax { at, .. }
+            | ScenarioError::Base { at, .. } => Some(at),
+            _ => None,
+        }
+    }
+
     /// The dotted key the error is about, if it is about one.
     pub fn key(&self) -> Option<&str> {
         match self {
@@ -215,6 +246,7 @@ impl ScenarioError {
             | ScenarioError::NotForLaw { key, .. }
             | ScenarioError::UnknownNumber { key, .. }
             | ScenarioError::Sweep { key, .. } => Some(key),
+            ScenarioError::Base { .. } => Some("base"),
             ScenarioError::Read { .. }
             | ScenarioError::Syntax { .. }
             | ScenarioError::CoilDriveUnsupported { .. } => None,

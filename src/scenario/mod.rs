@@ -14,6 +14,9 @@
 //! [`Scenario::mechanics`], [`Scenario::surface`], [`Scenario::settings`].
 
 mod arc;
+mod base;
+#[cfg(test)]
+mod base_tests;
 mod builder;
 mod calibration;
 mod check;
@@ -34,6 +37,7 @@ mod sweep;
 mod tests;
 mod two_stage;
 
+pub use base::{BUNDLED_PARTS, bundled_part};
 pub use builder::ScenarioBuilder;
 pub use calibration::{
     DatasheetSection, Determined, FitSection, FittedParameter, ProvenanceSection,
@@ -81,6 +85,9 @@ const DEFAULT_SCENARIO_ORIGIN: &str =
 /// The built-in scenario's circuit (`netlists/mcu_input.cir`), compiled in
 /// so that `run` with no scenario works wherever the binary is.
 pub const DEFAULT_NETLIST: &str = include_str!("../../netlists/mcu_input.cir");
+
+/// The built-in scenario's `circuit.netlist`, relative to its file.
+const DEFAULT_NETLIST_PATH: &str = "../netlists/mcu_input.cir";
 
 /// The file as serde sees it; [`Scenario`] adds the origin and the
 /// resolved surface law.
@@ -179,30 +186,42 @@ impl Scenario {
     /// relative paths in it (`circuit.netlist`) are resolved against
     /// `origin`'s directory.
     pub fn parse(text: &str, origin: &Path) -> Result<Scenario, ScenarioError> {
-        let tree = DeTable::parse(text).map_err(|source| {
-            let start = source.span().map_or(0, |s| s.start);
-            let (line, column) = line_column(text, start);
-            let mut message = source.message().trim_end().to_owned();
-            if message == "duplicate key" {
-                // Name the key, and the line that set it first.
-                let name = source
-                    .span()
-                    .and_then(|s| text.get(s))
-                    .unwrap_or("")
-                    .trim()
-                    .to_owned();
-                message = duplicate_message(text, &name, line);
-            }
-            ScenarioError::Syntax {
-                at: Location {
-                    path: origin.to_owned(),
-                    line: Some(line),
-                },
-                column,
-                message,
-                source: Box::new(source),
-            }
-        })?;
+        let tree = syntax(text, origin)?;
+        if tree.get_ref().get("base").is_none() {
+            return Scenario::parse_tree(tree, text, origin);
+        }
+        let Some(expanded) = base::expand(text, origin)? else {
+            return Scenario::parse_tree(tree, text, origin);
+        };
+        let merged = &expanded.text;
+        let scenario = syntax(merged, origin)
+            .and_then(|tree| Scenario::parse_tree(tree, merged, origin))
+            .map_err(|e| expanded.relocate(e))?;
+        // A circuit that is the built-in default's keeps its compiled-in
+        // text, so that it runs wherever the binary is.
+        let default_netlist = lexically_normal(
+            &Path::new(DEFAULT_SCENARIO_ORIGIN)
+                .parent()
+                .unwrap_or(Path::new(""))
+                .join(DEFAULT_NETLIST_PATH),
+        );
+        let embedded = scenario
+            .circuit
+            .as_ref()
+            .filter(|c| c.netlist == default_netlist)
+            .map(|_| DEFAULT_NETLIST);
+        Ok(Scenario {
+            embedded_netlist: embedded,
+            ..scenario
+        })
+    }
+
+    /// Shape and physics of a scenario whose syntax is already checked.
+    fn parse_tree(
+        tree: toml::Spanned<DeTable<'_>>,
+        text: &str,
+        origin: &Path,
+    ) -> Result<Scenario, ScenarioError> {
         let index = KeyIndex::new(&tree, text);
         let document = Document::deserialize(toml::de::Deserializer::from(tree))
             .map_err(|e| index.shape_error(e, origin))?;
@@ -360,6 +379,35 @@ impl Scenario {
             min_gap: s.min_gap,
         }
     }
+}
+
+/// The scenario text's TOML syntax, with the place of the first error
+/// (a duplicate key names the line that set it first).
+fn syntax<'t>(text: &'t str, origin: &Path) -> Result<toml::Spanned<DeTable<'t>>, ScenarioError> {
+    DeTable::parse(text).map_err(|source| {
+        let start = source.span().map_or(0, |s| s.start);
+        let (line, column) = line_column(text, start);
+        let mut message = source.message().trim_end().to_owned();
+        if message == "duplicate key" {
+            // Name the key, and the line that set it first.
+            let name = source
+                .span()
+                .and_then(|s| text.get(s))
+                .unwrap_or("")
+                .trim()
+                .to_owned();
+            message = duplicate_message(text, &name, line);
+        }
+        ScenarioError::Syntax {
+            at: Location {
+                path: origin.to_owned(),
+                line: Some(line),
+            },
+            column,
+            message,
+            source: Box::new(source),
+        }
+    })
 }
 
 /// `path` with `.` dropped and `dir/..` folded, without touching the file

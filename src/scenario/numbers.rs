@@ -74,9 +74,10 @@ pub fn unit_of(key: &str) -> &'static str {
         "v_min" | "low" | "high" => "V",
         "i_min" => "A",
         "field" => "V/m",
-        "stiffness" if key.starts_with("surface.")
-            || key.starts_with("back_stop.")
-            || key.starts_with("pole_face.") =>
+        "stiffness"
+            if key.starts_with("surface.")
+                || key.starts_with("back_stop.")
+                || key.starts_with("pole_face.") =>
         {
             "N/mⁿ"
         }

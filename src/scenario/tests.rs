@@ -69,7 +69,8 @@ fn line_of(err: &ScenarioError) -> Option<usize> {
         | ScenarioError::Conflict { at, .. }
         | ScenarioError::NotForLaw { at, .. }
         | ScenarioError::UnknownNumber { at, .. }
-        | ScenarioError::Sweep { at, .. } => at.line,
+        | ScenarioError::Sweep { at, .. }
+        | ScenarioError::Base { at, .. } => at.line,
         ScenarioError::Read { .. }
         | ScenarioError::CoilDriveUnsupported { .. }
         | ScenarioError::NetlistRead { .. } => None,

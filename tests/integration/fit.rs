@@ -107,7 +107,11 @@ fn assert_recovered(
         "{key}: fitted {v}, truth {truth} (prior {prior}); notes {:?}",
         report.notes
     );
-    assert!(determined, "{key} should be determined: {:?}", report.parameters);
+    assert!(
+        determined,
+        "{key} should be determined: {:?}",
+        report.parameters
+    );
 }
 
 #[test]

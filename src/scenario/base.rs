@@ -1,0 +1,290 @@
+//! `base =`: a scenario that starts from another one (`"default"`, a
+//! bundled part `"part:NAME"`, or a file) and overrides it key by key.
+//!
+//! The bases are read first, each with its own `base` (a chain of them
+//! is followed, a loop refused), and the tables are merged from the
+//! bottom up: a section of the file replaces the base's keys one by one,
+//! an array (`[[probe]]`) replaces the base's whole array, and a surface
+//! section whose `law` changes starts afresh (the keys of one law mean
+//! nothing to another). Relative paths (`circuit.netlist`) keep meaning
+//! what they meant in the file that wrote them. An error about a key
+//! names the file and line the key came from.
+
+use super::keys::KeyIndex;
+use super::*;
+
+/// How deep a chain of bases may go before it is taken for a loop.
+const MAX_DEPTH: usize = 16;
+
+/// One file of a chain of bases, as read.
+pub(super) struct Layer {
+    /// Where it came from: a file, `part:NAME` or the built-in default.
+    pub(super) origin: PathBuf,
+    /// Its text.
+    pub(super) text: String,
+}
+
+/// A scenario with its bases merged in: the merged TOML text and the
+/// layers it came from, the base first and the file itself last.
+pub(super) struct Expanded {
+    pub(super) text: String,
+    pub(super) layers: Vec<Layer>,
+}
+
+/// The scenario `text` (from `origin`) with its bases merged in; `None`
+/// when it has no `base`.
+pub(super) fn expand(text: &str, origin: &Path) -> Result<Option<Expanded>, ScenarioError> {
+    let table = table_of(text, origin)?;
+    if !table.contains_key("base") {
+        return Ok(None);
+    }
+    let mut layers = Vec::new();
+    let merged = resolve(
+        text.to_owned(),
+        origin.to_owned(),
+        table,
+        &mut layers,
+        &mut Vec::new(),
+    )?;
+    let text = toml::to_string(&merged).map_err(|e| ScenarioError::Base {
+        at: Location {
+            path: origin.to_owned(),
+            line: None,
+        },
+        base: String::new(),
+        problem: format!("the merged scenario cannot be written as TOML: {e}"),
+    })?;
+    Ok(Some(Expanded { text, layers }))
+}
+
+/// The layers of `origin`'s scenario merged into one table, its bases
+/// pushed on `layers` before it.
+fn resolve(
+    text: String,
+    origin: PathBuf,
+    mut table: toml::Table,
+    layers: &mut Vec<Layer>,
+    chain: &mut Vec<PathBuf>,
+) -> Result<toml::Table, ScenarioError> {
+    absolute_paths(&mut table, &origin);
+    let merged = match table.remove("base") {
+        None => table,
+        Some(value) => {
+            let at = Location {
+                path: origin.clone(),
+                line: line_of(&text, "base"),
+            };
+            let toml::Value::String(base) = value else {
+                return Err(ScenarioError::Base {
+                    at,
+                    base: value.to_string(),
+                    problem: "must be text: \"default\", \"part:NAME\" or a file path".into(),
+                });
+            };
+            let fail = |problem: String| ScenarioError::Base {
+                at: at.clone(),
+                base: base.clone(),
+                problem,
+            };
+            if chain.len() >= MAX_DEPTH {
+                return Err(fail(format!(
+                    "the chain of bases is more than {MAX_DEPTH} deep; does it come back to itself?"
+                )));
+            }
+            let (base_origin, base_text) = source_of(&base, &origin).map_err(&fail)?;
+            if base_origin == origin || chain.contains(&base_origin) {
+                return Err(fail(format!(
+                    "the chain of bases comes back to {}",
+                    base_origin.display()
+                )));
+            }
+            let base_table = table_of(&base_text, &base_origin)?;
+            chain.push(origin.clone());
+            let below = resolve(base_text, base_origin, base_table, layers, chain);
+            chain.pop();
+            let mut below = below?;
+            merge(&mut below, table);
+            below
+        }
+    };
+    layers.push(Layer { origin, text });
+    Ok(merged)
+}
+
+/// The text and the origin `base` names, seen from the file at `origin`.
+fn source_of(base: &str, origin: &Path) -> Result<(PathBuf, String), String> {
+    if base == "default" {
+        return Ok((
+            PathBuf::from(DEFAULT_SCENARIO_ORIGIN),
+            DEFAULT_SCENARIO_TOML.to_owned(),
+        ));
+    }
+    if let Some(name) = base.strip_prefix("part:") {
+        return match bundled_part(name) {
+            Some(text) => Ok((PathBuf::from(format!("part:{name}")), text.to_owned())),
+            None => Err(format!(
+                "no bundled part `{name}`; the parts are: {}",
+                BUNDLED_PARTS
+                    .iter()
+                    .map(|(n, _)| *n)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )),
+        };
+    }
+    let dir = origin.parent().unwrap_or(Path::new(""));
+    let path = lexically_normal(&dir.join(base));
+    match crate::input::read_to_string(&path) {
+        Ok(text) => Ok((path, text)),
+        Err(e) => Err(format!(
+            "cannot read {} ({e}); a base is \"default\", \"part:NAME\" or a file path \
+             relative to this file",
+            path.display()
+        )),
+    }
+}
+
+/// The bundled parts' scenarios by name, for `base = "part:NAME"`.
+pub const BUNDLED_PARTS: &[(&str, &str)] = &[
+    (
+        "omron-g5le-1-dc5",
+        include_str!("../../parts/omron-g5le-1-dc5.toml"),
+    ),
+    (
+        "songle-srd-05vdc-sl-c",
+        include_str!("../../parts/songle-srd-05vdc-sl-c.toml"),
+    ),
+    (
+        "panasonic-tq4-5v",
+        include_str!("../../parts/panasonic-tq4-5v.toml"),
+    ),
+    (
+        "finder-40.52-12vdc",
+        include_str!("../../parts/finder-40.52-12vdc.toml"),
+    ),
+    (
+        "coto-9104-05",
+        include_str!("../../parts/coto-9104-05.toml"),
+    ),
+    (
+        "te-v23145-12v",
+        include_str!("../../parts/te-v23145-12v.toml"),
+    ),
+];
+
+/// The scenario text of bundled part `name`.
+pub fn bundled_part(name: &str) -> Option<&'static str> {
+    BUNDLED_PARTS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, text)| *text)
+}
+
+/// `text` as a TOML table; a syntax error names `origin`.
+fn table_of(text: &str, origin: &Path) -> Result<toml::Table, ScenarioError> {
+    toml::from_str::<toml::Table>(text).map_err(|source| {
+        let start = source.span().map_or(0, |s| s.start);
+        let (line, column) = line_column(text, start);
+        ScenarioError::Syntax {
+            at: Location {
+                path: origin.to_owned(),
+                line: Some(line),
+            },
+            column,
+            message: source.message().trim_end().to_owned(),
+            source: Box::new(source),
+        }
+    })
+}
+
+/// A relative `circuit.netlist` made absolute against `origin`'s
+/// directory, so that it keeps naming the same file once merged into a
+/// scenario elsewhere.
+fn absolute_paths(table: &mut toml::Table, origin: &Path) {
+    let Some(toml::Value::Table(circuit)) = table.get_mut("circuit") else {
+        return;
+    };
+    let Some(toml::Value::String(netlist)) = circuit.get_mut("netlist") else {
+        return;
+    };
+    let dir = origin.parent().unwrap_or(Path::new(""));
+    let joined = dir.join(&*netlist);
+    let absolute = std::path::absolute(&joined).unwrap_or(joined);
+    *netlist = lexically_normal(&absolute).display().to_string();
+}
+
+/// `over` merged into `into`, key by key: tables merge, anything else
+/// (values, arrays) replaces; a table whose `law` changes is replaced.
+fn merge(into: &mut toml::Table, over: toml::Table) {
+    for (key, value) in over {
+        match (into.get_mut(&key), value) {
+            (Some(toml::Value::Table(below)), toml::Value::Table(above))
+                if !law_changes(below, &above) =>
+            {
+                merge(below, above)
+            }
+            (_, value) => {
+                into.insert(key, value);
+            }
+        }
+    }
+}
+
+fn law_changes(below: &toml::Table, above: &toml::Table) -> bool {
+    above
+        .get("law")
+        .is_some_and(|law| below.get("law") != Some(law))
+}
+
+/// The 1-based line of top-level or dotted `key` in `text`, if it is there.
+fn line_of(text: &str, key: &str) -> Option<usize> {
+    let tree = DeTable::parse(text).ok()?;
+    KeyIndex::new(&tree, text).line_of_key(key)
+}
+
+impl Expanded {
+    /// `error`, found in the merged text, made to point at the file (and
+    /// line) its key came from: the topmost layer that gives the key or,
+    /// failing that, the closest enclosing table.
+    pub(super) fn relocate(&self, mut error: ScenarioError) -> ScenarioError {
+        let key = error.key().map(str::to_owned);
+        let Some(at) = error.location_mut() else {
+            return error;
+        };
+        let top = self.layers.last().map(|l| l.origin.clone());
+        *at = Location {
+            path: top.unwrap_or_default(),
+            line: None,
+        };
+        let Some(key) = key else { return error };
+        let mut best: Option<(usize, &Layer, usize)> = None;
+        for layer in self.layers.iter().rev() {
+            let Ok(tree) = DeTable::parse(&layer.text) else {
+                continue;
+            };
+            let index = KeyIndex::new(&tree, &layer.text);
+            let mut probe = key.as_str();
+            loop {
+                if let Some(e) = index.entries.iter().find(|e| e.path == probe) {
+                    let depth = probe.len();
+                    if best.is_none_or(|(d, ..)| depth > d) {
+                        let line = line_column(&layer.text, e.key_span.start).0;
+                        best = Some((depth, layer, line));
+                    }
+                    break;
+                }
+                match probe.rfind(['.', '[']) {
+                    Some(cut) => probe = &probe[..cut],
+                    None => break,
+                }
+            }
+        }
+        if let Some((_, layer, line)) = best {
+            *at = Location {
+                path: layer.origin.clone(),
+                line: Some(line),
+            };
+        }
+        error
+    }
+}
