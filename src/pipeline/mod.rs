@@ -127,6 +127,27 @@ pub enum RunError {
         #[source]
         source: crate::mechanics::DriveError,
     },
+    /// A coil-driven relay in a circuit without its coil has no DC step to
+    /// close on.
+    #[error(
+        "{}: the netlist does not instantiate the coil subcircuit, so the relay closes on the \
+         ideal DC step of its coil voltage: give `coil.drive_voltage` (V) or \
+         `datasheet.coil_voltage`, or instantiate the coil (X2 a b COIL) in the netlist",
+        path.display()
+    )]
+    NoDriveVoltage {
+        /// The scenario file.
+        path: PathBuf,
+    },
+    /// The closing on the ideal DC step of the coil could not be simulated.
+    #[error("{}: the closing on the coil's DC step failed", path.display())]
+    DcStep {
+        /// The scenario file.
+        path: PathBuf,
+        /// Why it failed.
+        #[source]
+        source: crate::coil::CoilError,
+    },
     /// The contact conductance over time could not be built from the
     /// chatter.
     #[error("{}: cannot build the contact waveform", path.display())]
@@ -266,7 +287,10 @@ pub fn run_plan(
     let scenario = plan.scenario();
     check_circuit(scenario)?;
     if scenario.coil.is_some() {
-        return run_coil(plan, runner, options);
+        if drives_its_coil(plan) {
+            return run_coil(plan, runner, options);
+        }
+        return run_dc_step(plan, runner, options);
     }
     let mechanics = plan.mechanics()?;
     let (surface, settings) = (plan.surface(), plan.settings());
@@ -288,6 +312,65 @@ pub fn run_plan(
         .then(|| trajectory.pole_face_impacts().to_vec());
     let chatter = trajectory.into_chatter();
     let (waveform, model) = contact_waveform_of(scenario, surface, &chatter)?;
+    let mut result = run_chatter(plan, chatter, waveform, &model, gap, runner, options)?;
+    result.pole_face = pole_face;
+    Ok(result)
+}
+
+/// Whether the circuit drives the relay's coil: its netlist instantiates
+/// the coil subcircuit, or it wants the normally-closed contact (which
+/// follows the coil's release). Otherwise the circuit holds the contact
+/// only, and the relay closes on the ideal DC step of its coil.
+fn drives_its_coil(plan: &Plan) -> bool {
+    let Some(circuit) = &plan.scenario().circuit else {
+        return false;
+    };
+    circuit.nc_subckt.is_some()
+        || plan
+            .netlist()
+            .is_none_or(|n| !netlist::instances_of(&n.text, &circuit.coil_subckt).is_empty())
+}
+
+/// A coil-driven relay whose circuit holds only its contact: the closing
+/// on the ideal DC step of `coil.drive_voltage` (else
+/// `datasheet.coil_voltage`) from t = 0, as a datasheet measures it, then
+/// the contact through the circuit.
+fn run_dc_step(
+    plan: &Plan,
+    runner: &dyn Runner,
+    options: &RunOptions,
+) -> Result<RunResult, RunError> {
+    let scenario = plan.scenario();
+    let path = || scenario.origin.clone();
+    let section = scenario
+        .coil
+        .as_ref()
+        .ok_or_else(|| RunError::NoDriveVoltage { path: path() })?;
+    let voltage = scenario
+        .dc_step_voltage()
+        .ok_or_else(|| RunError::NoDriveVoltage { path: path() })?;
+    let (chatter, two_stage) = crate::coil::direct::direct_closing(
+        &crate::coil::Coil::from(section),
+        &crate::coil::Source {
+            voltage,
+            series_resistance: 0.0,
+        },
+        &scenario.armature(),
+        &plan.two_stage(),
+        &plan.surface(),
+        &plan.settings(),
+    )
+    .map_err(|source| RunError::DcStep {
+        path: path(),
+        source,
+    })?;
+    // The opening gap of an arc at a DC step's contact: each opening at
+    // the arc's opening speed, as for a measured record.
+    let gap = record_gap(scenario, &chatter.intervals);
+    let pole_face = two_stage
+        .filter(|_| plan.two_stage().pole_face.is_some())
+        .map(|run| run.pole_face);
+    let (waveform, model) = contact_waveform_of(scenario, plan.surface(), &chatter)?;
     let mut result = run_chatter(plan, chatter, waveform, &model, gap, runner, options)?;
     result.pole_face = pole_face;
     Ok(result)

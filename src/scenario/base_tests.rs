@@ -88,7 +88,10 @@ fn a_base_file_keeps_its_relative_netlist_and_its_errors_name_it() {
     );
     let err = Scenario::load(&top).unwrap_err();
     let text = err.to_string();
-    assert!(text.contains("top.toml:4") && text.contains("mass"), "{text}");
+    assert!(
+        text.contains("top.toml:4") && text.contains("mass"),
+        "{text}"
+    );
 
     // A bad value the base brings names the base file and its line.
     let line = base_text
