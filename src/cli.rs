@@ -21,6 +21,7 @@ mod raw;
 use chatterspice::arc::GapProfile;
 use chatterspice::chatter::Chatter;
 use chatterspice::check;
+use chatterspice::envelope;
 use chatterspice::mechanics::Dimensionless;
 use chatterspice::netlist::{self, ContactElement};
 use chatterspice::pipeline::CouplingOptions;
@@ -182,6 +183,46 @@ pub struct RunArgs {
     /// Keep ngspice's work directories and print where they are.
     #[arg(long)]
     pub keep_workdir: bool,
+
+    #[command(flatten)]
+    pub envelope: EnvelopeArgs,
+}
+
+/// `--envelope` and its sampling: the options `run` and `check` share.
+#[derive(Debug, Args)]
+pub struct EnvelopeArgs {
+    /// Run every relay the datasheet allows: sample the scenario's
+    /// [envelope] (and its printed tolerances), keep the relays that meet
+    /// every printed figure, and report each quantity as a band (min,
+    /// median, p95, max); `check` holds each limit against the worst kept
+    /// relay.
+    #[arg(long)]
+    pub envelope: bool,
+
+    /// Relays drawn from the envelope.
+    #[arg(long, value_name = "N", default_value_t = 32, requires = "envelope")]
+    pub samples: usize,
+
+    /// Seed of the quasi-random draw: the same seed draws the same relays.
+    #[arg(long, value_name = "S", default_value_t = 1, requires = "envelope")]
+    pub seed: u64,
+
+    /// Relays run at once [default: one per core].
+    #[arg(short = 'j', long, value_name = "J", requires = "envelope")]
+    pub jobs: Option<NonZeroUsize>,
+}
+
+impl EnvelopeArgs {
+    fn options(&self, run: RunOptions) -> chatterspice::envelope::EnvelopeOptions {
+        chatterspice::envelope::EnvelopeOptions {
+            samples: self.samples,
+            seed: self.seed,
+            jobs: self
+                .jobs
+                .unwrap_or_else(|| std::thread::available_parallelism().unwrap_or(NonZeroUsize::MIN)),
+            run,
+        }
+    }
 }
 
 /// How ngspice is run: the options `run`, `check` and `sweep` share.
@@ -286,8 +327,11 @@ pub struct CheckArgs {
 
     /// Check a measured chatter sequence instead of the mechanics: a CSV
     /// `time,state` with one row per state change (open/closed or 0/1).
-    #[arg(long, value_name = "CSV")]
+    #[arg(long, value_name = "CSV", conflicts_with = "envelope")]
     pub measured: Option<PathBuf>,
+
+    #[command(flatten)]
+    pub envelope: EnvelopeArgs,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -450,10 +494,20 @@ fn run(args: &RunArgs) -> Result<()> {
             eprintln!("ngspice work directory kept: {}", dir.display());
         }
     }
-    let text = match args.format {
+    let mut text = match args.format {
         RunFormat::Json => report::json::render_run(&result, dimensionless.as_ref()),
         RunFormat::Table => report::table::render_run(&result),
     };
+    if args.envelope.envelope {
+        if args.measured.is_some() {
+            bail!("--envelope samples the relay's mechanics, which --measured replaces");
+        }
+        let env = envelope::run(&scenario, Some(&ngspice), &args.envelope.options(options))?;
+        text = match args.format {
+            RunFormat::Json => envelope::json_with_envelope(&text, &env.report),
+            RunFormat::Table => format!("{text}\n{}", envelope::band_table(&env.report)),
+        };
+    }
     for warning in &result.warnings {
         eprintln!("warning: {warning}");
     }
@@ -471,6 +525,9 @@ fn check(args: &CheckArgs) -> Result<Status> {
     let needs_ngspice =
         (scenario.coil.is_some() && scenario.circuit.is_some()) || check::needs_circuit(&scenario);
     let options = args.simulator.run_options();
+    if args.envelope.envelope {
+        return check_envelope(args, &scenario, needs_ngspice, options);
+    }
     let (verdict, evidence) = if let Some(csv) = &args.measured {
         let intervals = read_measured(csv)?;
         if check::needs_circuit(&scenario) {
@@ -501,6 +558,48 @@ fn check(args: &CheckArgs) -> Result<Status> {
             eprintln!("warning: {warning}");
         }
     }
+    emit(&text, None, false)?;
+    Ok(if verdict.passed {
+        Status::Success
+    } else {
+        Status::CheckFailed
+    })
+}
+
+/// `check --envelope`: every limit against the worst relay the envelope
+/// keeps.
+fn check_envelope(
+    args: &CheckArgs,
+    scenario: &Scenario,
+    needs_ngspice: bool,
+    options: RunOptions,
+) -> Result<Status> {
+    let ngspice = if needs_ngspice {
+        Some(args.simulator.ngspice()?)
+    } else {
+        None
+    };
+    let runner = ngspice.as_ref().map(|n| n as &dyn chatterspice::spice::Runner);
+    let env = envelope::run(scenario, runner, &args.envelope.options(options))?;
+    let worst = env
+        .worst()
+        .expect("an envelope that kept a relay has a worst one");
+    let verdict = &env.verdict;
+    let text = match args.format {
+        RunFormat::Json => envelope::json_with_envelope(
+            &report::json::render_check(verdict, &worst.evidence, None),
+            &env.report,
+        ),
+        RunFormat::Table => format!(
+            "{}\n{}",
+            report::table::render_check(
+                verdict,
+                worst.evidence.chatter(),
+                worst.evidence.operations()
+            ),
+            envelope::band_table(&env.report)
+        ),
+    };
     emit(&text, None, false)?;
     Ok(if verdict.passed {
         Status::Success

@@ -20,6 +20,7 @@ pub mod capture;
 pub mod chatter;
 pub mod check;
 pub mod coil;
+pub mod envelope;
 pub mod input;
 pub mod interrupt;
 pub mod mechanics;

@@ -19,6 +19,10 @@ pub(crate) fn prefix(exponent: i32) -> &'static str {
 
 /// `value` with three significant digits and an SI prefix: "12.5 µs".
 pub fn engineering(value: f64, unit: &str) -> String {
+    // A mass reads in grams: "2.2 g", not "2.2 mkg".
+    if unit == "kg" {
+        return engineering(value * 1e3, "g");
+    }
     if value == 0.0 || !value.is_finite() {
         return format!("0 {unit}");
     }

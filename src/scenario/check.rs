@@ -135,6 +135,9 @@ impl Check<'_> {
         if let Some(datasheet) = &d.datasheet {
             self.datasheet(datasheet)?;
         }
+        if let Some(envelope) = &d.envelope {
+            self.envelope_ranges(envelope)?;
+        }
         if let Some(limits) = d.limits.as_ref().filter(|_| d.arc.is_none()) {
             let given = [
                 ("limits.max_arc_energy", limits.max_arc_energy.is_some()),

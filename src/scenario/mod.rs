@@ -23,6 +23,7 @@ mod check;
 mod circuit;
 mod coil;
 mod contact;
+mod envelope;
 mod error;
 mod figure;
 mod keys;
@@ -45,6 +46,7 @@ pub use calibration::{
 pub use circuit::CircuitSection;
 pub use coil::CoilSection;
 pub use contact::{ContactSection, HolmSection};
+pub use envelope::{EnvelopeRange, EnvelopeSection};
 pub use error::{Location, ScenarioError};
 pub use figure::{FigureKind, PRINTED_PRECISION, PrintedFigure, TYPICAL_BAND};
 pub use limits::LimitsSection;
@@ -113,6 +115,7 @@ struct Document {
     fit: Option<FitSection>,
     provenance: Option<ProvenanceSection>,
     arc: Option<ArcSection>,
+    envelope: Option<EnvelopeSection>,
 }
 
 /// A loaded and validated scenario file.
@@ -162,6 +165,9 @@ pub struct Scenario {
     pub provenance: Option<ProvenanceSection>,
     /// `[arc]`: the contact arcs at every opening (docs/arcs.md).
     pub arc: Option<ArcSection>,
+    /// `[envelope]`: the ranges of the keys the datasheet does not fix,
+    /// for `run --envelope` and `check --envelope`.
+    pub envelope: Option<EnvelopeSection>,
     /// Computed once during validation: converting a Hunt–Crossley
     /// restitution into χ is a root solve that can fail.
     resolved_surface: Surface,
@@ -256,6 +262,7 @@ impl Scenario {
             // The material's numbers filled in, so that every arc number
             // has a value to sweep or fit around.
             arc: document.arc.map(|a| a.resolved()),
+            envelope: document.envelope,
             resolved_surface,
             resolved_back_stop,
             embedded_netlist: None,

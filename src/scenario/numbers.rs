@@ -445,6 +445,7 @@ impl Scenario {
         if let Some(sweep) = &self.sweep {
             check.sweep(sweep, &self)?;
         }
+        self.check_envelope(check)?;
         Ok(self)
     }
 }
