@@ -217,9 +217,9 @@ impl EnvelopeArgs {
         chatterspice::envelope::EnvelopeOptions {
             samples: self.samples,
             seed: self.seed,
-            jobs: self
-                .jobs
-                .unwrap_or_else(|| std::thread::available_parallelism().unwrap_or(NonZeroUsize::MIN)),
+            jobs: self.jobs.unwrap_or_else(|| {
+                std::thread::available_parallelism().unwrap_or(NonZeroUsize::MIN)
+            }),
             run,
         }
     }
@@ -579,7 +579,9 @@ fn check_envelope(
     } else {
         None
     };
-    let runner = ngspice.as_ref().map(|n| n as &dyn chatterspice::spice::Runner);
+    let runner = ngspice
+        .as_ref()
+        .map(|n| n as &dyn chatterspice::spice::Runner);
     let env = envelope::run(scenario, runner, &args.envelope.options(options))?;
     let worst = env
         .worst()

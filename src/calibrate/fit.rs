@@ -351,6 +351,11 @@ pub struct FigureRow {
     pub model: Option<f64>,
     /// (model − target)/target.
     pub residual: Option<f64>,
+    /// For a pick-up maximum or drop-out minimum with a printed coil
+    /// tolerance: the model's voltage with its coil at the far end of that
+    /// tolerance, which is what the bound is held against (V).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub at_coil_tolerance: Option<f64>,
     /// This figure limits the fit: a bound the model sits on (or crosses),
     /// or the target with the largest relative misfit.
     pub binds: bool,
@@ -446,6 +451,32 @@ fn drop_pair(events: &[Event], j: usize) -> Vec<Event> {
 /// The datasheet figures that were given, in a fixed order.
 fn figures(d: &DatasheetSection) -> Vec<(&'static str, PrintedFigure)> {
     d.figures()
+}
+
+/// V, a pick-up or drop-out voltage `v` as the relay at the far end of
+/// its coil's printed resistance tolerance shows it, when the figure is a
+/// bound: the currents are the relay's, so the voltages scale with the
+/// resistance (`v·(1 + t)` for a pick-up maximum, `v·(1 − t)` for a
+/// drop-out minimum). A printed bound holds for every relay of the type,
+/// whatever its coil, so the nominal relay must meet it with that room.
+/// Any other figure: `v`.
+pub fn coil_tolerance_corner(
+    d: &DatasheetSection,
+    name: &str,
+    figure: &PrintedFigure,
+    v: f64,
+) -> f64 {
+    let Some(t) = d.coil_resistance.and_then(|r| r.tolerance) else {
+        return v;
+    };
+    if figure.typ.is_some() {
+        return v;
+    }
+    match name {
+        "pick_up_voltage" if figure.max.is_some() => v * (1.0 + t),
+        "drop_out_voltage" if figure.min.is_some() => v * (1.0 - t),
+        _ => v,
+    }
 }
 
 /// The modelled events of one closing: the step-force engine, or with a
@@ -620,7 +651,9 @@ impl Problem<'_> {
         if let Some(d) = &self.datasheet {
             for ((name, figure), (_, model)) in figures(d).iter().zip(&e.figures) {
                 r.push(match model {
-                    Some(m) => figure.misfit(*m) / RELATIVE_SCALE,
+                    Some(m) => {
+                        figure.misfit(coil_tolerance_corner(d, name, figure, *m)) / RELATIVE_SCALE
+                    }
                     // Shown, not fitted (see `datasheet_figures`).
                     None if *name == "release_time" => 0.0,
                     None => 1.0 / RELATIVE_SCALE,

@@ -301,6 +301,9 @@ fn datasheet_rows(
                 "bound"
             },
             met: model.map(|m| printed.met_by_nominal(m)),
+            at_coil_tolerance: model
+                .map(|m| super::coil_tolerance_corner(d, figure, &printed, m))
+                .filter(|c| Some(*c) != *model),
             model: *model,
             residual: model.map(|m| (m - target) / target),
             binds: false,
@@ -336,7 +339,7 @@ fn mark_binding(rows: &mut [FigureRow]) {
     let fitted = |r: &FigureRow| r.figure != "release_time" && r.figure != "coil_resistance";
     for r in rows.iter_mut().filter(|r| fitted(r) && r.role == "bound") {
         let (lo, hi) = r.printed.band();
-        r.binds = r.model.is_none_or(|m| {
+        r.binds = r.at_coil_tolerance.or(r.model).is_none_or(|m| {
             let near = |b: f64| b.is_finite() && ((m - b) / b).abs() < 1e-3;
             near(lo) || near(hi) || !r.printed.holds(m)
         });

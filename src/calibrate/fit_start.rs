@@ -4,9 +4,10 @@
 //! starts from a point that already meets them.
 
 use super::Problem;
+use super::coil_tolerance_corner;
 use crate::coil::Coil;
 use crate::coil::pick_up::{LoadLine, drop_out, pick_up};
-use crate::scenario::PrintedFigure;
+use crate::scenario::{DatasheetSection, PrintedFigure};
 
 /// The prior, with the preload and the spring stiffness (those of them
 /// that are free) solved from the pick-up and drop-out voltages; a key
@@ -27,10 +28,20 @@ pub(super) fn closed_form_start(problem: &Problem, u_prior: &[f64]) -> Vec<f64> 
         &coil,
         &line,
         Currents {
-            pick_up: start_voltage(d.pick_up_voltage, pick_up(&coil, &line).voltage)
-                .map(|v| v / coil.resistance),
-            drop_out: start_voltage(d.drop_out_voltage, drop_out(&coil, &line).voltage)
-                .map(|v| v / coil.resistance),
+            pick_up: start_voltage(
+                d,
+                "pick_up_voltage",
+                d.pick_up_voltage,
+                pick_up(&coil, &line).voltage,
+            )
+            .map(|v| v / coil.resistance),
+            drop_out: start_voltage(
+                d,
+                "drop_out_voltage",
+                d.drop_out_voltage,
+                drop_out(&coil, &line).voltage,
+            )
+            .map(|v| v / coil.resistance),
         },
         kp.is_some(),
         ks.is_some(),
@@ -52,16 +63,25 @@ pub(super) fn closed_form_start(problem: &Problem, u_prior: &[f64]) -> Vec<f64> 
 /// V, the voltage to solve the spring for: a typical figure's value; a
 /// bound's only when the prior's `model` voltage crosses it (a prior
 /// inside the bound needs no moving); `None` otherwise.
-fn start_voltage(figure: Option<PrintedFigure>, model: f64) -> Option<f64> {
+fn start_voltage(
+    d: &DatasheetSection,
+    name: &str,
+    figure: Option<PrintedFigure>,
+    model: f64,
+) -> Option<f64> {
     let figure = figure?;
     if let Some(t) = figure.typ {
         return Some(t);
     }
+    // The bound as the nominal relay must meet it (see
+    // `coil_tolerance_corner`): the corner's voltage over the nominal's.
+    let scale = coil_tolerance_corner(d, name, &figure, 1.0);
     let (lo, hi) = figure.band();
-    if model > hi {
-        Some(hi)
-    } else if model < lo {
-        Some(lo)
+    let corner = model * scale;
+    if corner > hi {
+        Some(hi / scale)
+    } else if corner < lo {
+        Some(lo / scale)
     } else {
         None
     }

@@ -109,6 +109,46 @@ const PARTS: &[Part] = &[
         remark: "no operate, bounce or release time printed in the coil data: the mass is the prior's",
         scenario: include_str!("../../parts/te-v23145-12v.toml"),
     },
+    Part {
+        name: "te-axicom-im-5v",
+        class: "signal relay (telecom, 2 form C)",
+        source: "TE Connectivity AXICOM IM, standard 5 VDC 140 mW; TE datasheet \"AXICOM Signal Relays IM Relay\" Rev. 0917 (operate time typ. 1 ms, max. 3 ms; release time typ. 1 ms, max. 3 ms; bounce time typ. 1 ms, max. 5 ms) and catalog 1308242 (max. operate 3.5 V for 5 V)",
+        contact_rating: "2 A, 60 W / 62.5 VA, 220 VDC / 250 VAC (PdRu, gold covered, twin contacts)",
+        remark: "fitted to the typical operate and bounce times (1 ms each); the coil resistance is 5 V squared over 140 mW, not a printed figure",
+        scenario: include_str!("../../parts/te-axicom-im-5v.toml"),
+    },
+    Part {
+        name: "te-rt1-rt314012",
+        class: "power PCB relay 16 A (industrial)",
+        source: "TE Connectivity Schrack RT1 RT314012 (12 VDC); TE datasheet \"Power PCB Relay RT1\" F0144-C Rev. HK1 (operate/release time max. 8/6 ms, bounce time NO/NC max. 4/6 ms) and coil table F0144-B (12 V: pull-in 8.4 V, release 1.2 V, 360 Ω ±10 %)",
+        contact_rating: "1 CO 12 A / 16 A, 250 VAC (AgNi 90/10)",
+        remark: "every time is a maximum: the nominal relay is the prior inside them, with the spring moved up to the printed release voltage; the NO contact's bounce time is the one held",
+        scenario: include_str!("../../parts/te-rt1-rt314012.toml"),
+    },
+    Part {
+        name: "omron-g8h-1c4t-r-12v",
+        class: "automotive Micro ISO plug-in relay",
+        source: "Omron G8H-1C4T-R (12 VDC); Omron datasheet \"Micro ISO Automotive Relay G8H\" (coil 100 Ω ±10 %, 1440 mW, pull-in < 7.0 V, drop-out > 0.7 V; operate time 20 ms max., release time 10 ms max., bounce time at operate 5 ms max.)",
+        contact_rating: "20 A (NO) / 10 A (NC) steady, 60 A inrush, 16 V max. (AgSnO2)",
+        remark: "every figure is a bound and the prior meets them all, so the fit held every key: the nominal relay is an assumption inside the datasheet, and the envelope is the honest answer",
+        scenario: include_str!("../../parts/omron-g8h-1c4t-r-12v.toml"),
+    },
+    Part {
+        name: "te-card-e-v23057-12v",
+        class: "industrial I/O relay (Card E)",
+        source: "TE Connectivity Schrack Card E V23057, coil code 002 (12 VDC); TE datasheet \"Power PCB Relay Card E\" F0151-B Rev. 0411 (operate 8.0 V, release 1.2 V, 330 Ω ±10 %; operate/release time typ. 7/3 ms; bounce time typ. form A/form B 0.5/3 ms)",
+        contact_rating: "1 CO 8 A, 250 VAC (AgCdO / AgNi20)",
+        remark: "fitted to the typical operate time and the form A (closing) contact's typical bounce time",
+        scenario: include_str!("../../parts/te-card-e-v23057-12v.toml"),
+    },
+    Part {
+        name: "te-rel-5v",
+        class: "miniature PCB relay (white goods, industrial)",
+        source: "TE Connectivity Schrack REL, 5 VDC; TE datasheet \"Miniature PCB Relay REL\" Rev. 0511 (5 V: operate 3.75 V, release 0.5 V, 70 Ω ±10 %, 357 mW; operate/release time max. 10/5 ms; bounce time max. 4 ms)",
+        contact_rating: "1 form A 5 A, 250 VAC (AgNi 90/10, AgCdO)",
+        remark: "every time is a maximum: the nominal relay is the prior inside them, with the spring moved up to the printed release voltage",
+        scenario: include_str!("../../parts/te-rel-5v.toml"),
+    },
 ];
 
 /// Every bundled part, in a fixed order.
@@ -154,6 +194,9 @@ pub struct Listing {
     /// Where the part's pick-up binds along the armature's travel (at rest,
     /// or part-way at which position), computed from its scenario.
     pub pick_up_binds: Option<String>,
+    /// The ranges of the keys its datasheet does not fix, with their
+    /// source, for `run --envelope` and `check --envelope`.
+    pub envelope: Option<crate::scenario::EnvelopeSection>,
 }
 
 /// The listing of `part`: its datasheet figures against its scenario's.
@@ -185,6 +228,7 @@ pub fn listing(part: &Part) -> Listing {
         source: part.source,
         remark: part.remark,
         pick_up_binds: pick_up_of(&scenario).map(|(pu, line)| pu.binding_text(&line)),
+        envelope: scenario.envelope.clone(),
     }
 }
 

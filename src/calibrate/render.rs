@@ -93,8 +93,11 @@ pub fn table(report: &FitReport) -> String {
                 f.figure,
                 super::parts::printed_text(&f.printed, unit),
                 number(f.model, unit),
-                f.residual
-                    .map_or_else(|| "-".to_owned(), |r| format!("{:+.3}%", r * 100.0)),
+                match (f.role, f.model) {
+                    (_, None) => "-".to_owned(),
+                    ("bound", Some(m)) if f.printed.holds(m) => "met".to_owned(),
+                    (_, Some(m)) => format!("{:+.3}%", f.printed.misfit(m) * 100.0),
+                },
                 if f.binds { "  (binds)" } else { "" }
             );
         }

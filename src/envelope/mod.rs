@@ -27,8 +27,8 @@ use serde::Serialize;
 use thiserror::Error;
 
 use crate::calibrate::fit::datasheet_figures;
-use crate::check::{self, Evidence, LimitCheck, Verdict};
 use crate::chatter::Chatter;
+use crate::check::{self, Evidence, LimitCheck, Verdict};
 use crate::coil::timing::Closing;
 use crate::pipeline::{self, RunOptions, RunResult};
 use crate::plan::Plan;
@@ -420,7 +420,10 @@ fn relay(
     }
     let (verdict, evidence) = match runner {
         Some(runner) => match pipeline::run_plan(plan, runner, options) {
-            Ok(result) => (check::evaluate(scenario, &result), Evidence::Run(Box::new(result))),
+            Ok(result) => (
+                check::evaluate(scenario, &result),
+                Evidence::Run(Box::new(result)),
+            ),
             Err(_) => return Err(vec!["failed".to_owned()]),
         },
         None => match check::relay_only(scenario) {
