@@ -40,3 +40,13 @@ def test_a_relative_scenario_path_is_relative_to_the_working_directory(tmp_path,
     result = chatterspice.run("relay.toml", ideal=False)
     assert result.report["probes"][0]["edges"] == 7
     assert result.report["netlist"] == os.path.join("netlists", "mcu_input.cir")
+
+
+def test_the_example_notebook_runs(tmp_path):
+    example = ROOT / "examples" / "python" / "bounce_and_run.py"
+    done = subprocess.run(
+        [sys.executable, str(example)], cwd=tmp_path, capture_output=True, text=True
+    )
+    assert done.returncode == 0, done.stderr
+    assert "5 bounces, stuck" in done.stdout
+    assert "v(in): 7 edges" in done.stdout
