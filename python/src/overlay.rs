@@ -191,7 +191,8 @@ fn line_at(text: &str, offset: usize) -> usize {
 
 /// The built-in scenario's netlist on disk: the source tree's, or, when
 /// the package runs where that is gone, a copy of the text compiled in,
-/// written once per process into a temporary directory.
+/// written once per process into a temporary directory (left behind when
+/// the process ends: statics are not dropped).
 fn default_netlist() -> Result<PathBuf, Failure> {
     let in_tree = Scenario::builtin_default()
         .circuit
