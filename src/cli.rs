@@ -22,13 +22,11 @@ use chatterspice::arc::GapProfile;
 use chatterspice::chatter::Chatter;
 use chatterspice::check;
 use chatterspice::envelope;
-use chatterspice::mechanics::Dimensionless;
 use chatterspice::netlist::{self, ContactElement};
 use chatterspice::pipeline::CouplingOptions;
 use chatterspice::pipeline::{self, RunOptions};
 use chatterspice::report::{self, Format};
 use chatterspice::scenario::Scenario;
-use chatterspice::simulate;
 use chatterspice::spice::Ngspice;
 use chatterspice::sweep::{self, Mode, Sampler, Shard, SweepOptions};
 use chatterspice::waveform::{ContactModel, Waveform, read_state_csv};
@@ -411,47 +409,7 @@ fn bounce(args: &BounceArgs) -> Result<()> {
         return emit(&text, args.output.as_deref(), args.force);
     }
     let scenario = load_scenario(args.scenario.as_deref())?;
-    let surface = scenario.surface();
-    let build = scenario.two_stage();
-    let failed = || {
-        format!(
-            "{}: the mechanics simulation failed",
-            scenario.origin.display()
-        )
-    };
-    let text = if scenario.coil.is_some() {
-        let (chatter, run) = check::dc_step(&scenario).with_context(failed)?;
-        let pole_face = build
-            .pole_face
-            .is_some()
-            .then(|| run.as_ref().map_or(&[][..], |r| &r.pole_face[..]));
-        report::render_two_stage(args.format.into(), &chatter, None, pole_face)
-    } else if build.is_one_mass() {
-        let mechanics = scenario.mechanics()?;
-        let dimensionless = Dimensionless::of(&mechanics, &surface);
-        let chatter = simulate(&mechanics, &surface, &scenario.settings()).with_context(failed)?;
-        report::render(args.format.into(), &chatter, Some(&dimensionless))
-    } else {
-        let mechanics = scenario.mechanics()?;
-        let dimensionless = Dimensionless::of(&mechanics, &surface);
-        let trajectory = chatterspice::mechanics::two_stage::step_closing(
-            &mechanics,
-            &build,
-            &surface,
-            &scenario.settings(),
-        )
-        .with_context(failed)?;
-        let pole_face = build
-            .pole_face
-            .is_some()
-            .then(|| trajectory.pole_face_impacts());
-        report::render_two_stage(
-            args.format.into(),
-            trajectory.chatter(),
-            Some(&dimensionless),
-            pole_face,
-        )
-    };
+    let text = chatterspice::commands::bounce(&scenario, args.format.into())?;
     emit(&text, args.output.as_deref(), args.force)
 }
 
@@ -485,10 +443,7 @@ fn run(args: &RunArgs) -> Result<()> {
     {
         result.netlist = relative;
     }
-    let dimensionless = scenario
-        .mechanics()
-        .ok()
-        .map(|m| Dimensionless::of(&m, &scenario.surface()));
+    let dimensionless = chatterspice::commands::dimensionless(&scenario);
     for sim in std::iter::once(&result.simulation).chain(&result.ideal) {
         if let Some(dir) = &sim.workdir {
             eprintln!("ngspice work directory kept: {}", dir.display());
@@ -523,14 +478,14 @@ fn run(args: &RunArgs) -> Result<()> {
 fn check(args: &CheckArgs) -> Result<Status> {
     let scenario = load_scenario(args.scenario.as_deref())?;
     let needs_ngspice =
-        (scenario.coil.is_some() && scenario.circuit.is_some()) || check::needs_circuit(&scenario);
+        chatterspice::commands::check_needs_ngspice(&scenario, args.measured.is_some());
     let options = args.simulator.run_options();
     if args.envelope.envelope {
         return check_envelope(args, &scenario, needs_ngspice, options);
     }
     let (verdict, evidence) = if let Some(csv) = &args.measured {
         let intervals = read_measured(csv)?;
-        if check::needs_circuit(&scenario) {
+        if needs_ngspice {
             let ngspice = args.simulator.ngspice()?;
             check::measured(&scenario, intervals, Some(&ngspice), &options)?
         } else {
@@ -543,10 +498,7 @@ fn check(args: &CheckArgs) -> Result<Status> {
         // The relay's limits alone: no circuit, no ngspice needed.
         check::relay_only(&scenario)?
     };
-    let dimensionless = scenario
-        .mechanics()
-        .ok()
-        .map(|m| Dimensionless::of(&m, &scenario.surface()));
+    let dimensionless = chatterspice::commands::dimensionless(&scenario);
     let text = match args.format {
         RunFormat::Json => report::json::render_check(&verdict, &evidence, dimensionless.as_ref()),
         RunFormat::Table => {

@@ -11,7 +11,8 @@
 //! the probed signals ([`analysis`]); [`pipeline`] runs them in order.
 //! A coil-driven relay is coupled to its driver circuit ([`coil`]); on a
 //! power load the contact arcs ([`arc`]); scope captures and datasheets
-//! calibrate the model ([`capture`], [`calibrate`]).
+//! calibrate the model ([`capture`], [`calibrate`]). [`commands`] holds
+//! the work of `bounce` and `check` for the binary and the Python package.
 
 pub mod analysis;
 pub mod arc;
@@ -20,6 +21,7 @@ pub mod capture;
 pub mod chatter;
 pub mod check;
 pub mod coil;
+pub mod commands;
 pub mod envelope;
 pub mod input;
 pub mod interrupt;

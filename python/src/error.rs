@@ -1,0 +1,305 @@
+//! The library's errors as Python exceptions.
+//!
+//! Bad input (a scenario value, an unknown key, a broken raw file or
+//! capture) is [`InputError`], a `ValueError`; a file that is not there is
+//! `FileNotFoundError` (`PermissionError` when it cannot be read); ngspice
+//! failing, or missing, is [`NgspiceError`] and the mechanics failing is
+//! [`SimulationError`], both `RuntimeError`s. The message is the one the
+//! command line prints: the library's error and each of its causes. An
+//! exception about a scenario key carries `key`, `path` and `line`.
+
+use std::error::Error as StdError;
+use std::fmt::Write as _;
+use std::io;
+use std::path::Path;
+
+use chatterspice::calibrate::fit::FitError;
+use chatterspice::capture::{CaptureError, EdgeError};
+use chatterspice::check::CheckError;
+use chatterspice::pipeline::{CouplingError, PassError, RunError};
+use chatterspice::rawfile::RawError;
+use chatterspice::scenario::{Location, ScenarioError};
+use chatterspice::spice::SpiceError;
+use chatterspice::sweep::SweepError;
+use chatterspice::waveform::WaveformError;
+use pyo3::exceptions::{PyFileNotFoundError, PyPermissionError, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+
+pyo3::create_exception!(
+    chatterspice,
+    InputError,
+    PyValueError,
+    "Bad input: a scenario key or value, a netlist, a raw file, a capture or \
+     a measured record. `key`, `path` and `line` say where, when known."
+);
+pyo3::create_exception!(
+    chatterspice,
+    NgspiceError,
+    PyRuntimeError,
+    "ngspice could not be run, or failed on the deck; the message carries \
+     ngspice's own words."
+);
+pyo3::create_exception!(
+    chatterspice,
+    SimulationError,
+    PyRuntimeError,
+    "The mechanics, the coil coupling or the analysis of a run failed."
+);
+
+/// Which Python exception an error becomes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Input,
+    Ngspice,
+    Simulation,
+}
+
+/// A library error on its way to Python: its kind, its message and where
+/// in a scenario it is.
+#[derive(Debug)]
+pub struct Failure {
+    kind: Kind,
+    message: String,
+    key: Option<String>,
+    location: Option<Location>,
+    /// Why a file could not be read, when that is the error.
+    io: Option<io::ErrorKind>,
+}
+
+impl Failure {
+    /// Bad input described by `message`.
+    pub fn input(message: impl Into<String>) -> Failure {
+        Failure {
+            kind: Kind::Input,
+            message: message.into(),
+            key: None,
+            location: None,
+            io: None,
+        }
+    }
+
+    /// `path` could not be read: `what` it was meant to be.
+    pub fn unreadable(path: &Path, what: &str, source: &io::Error) -> Failure {
+        Failure {
+            io: Some(source.kind()),
+            ..Failure::input(format!("{}: cannot read {what}: {source}", path.display()))
+        }
+    }
+
+    /// The same failure, its message after `context` (what was being
+    /// read when it happened).
+    pub fn within(self, context: impl std::fmt::Display) -> Failure {
+        Failure {
+            message: format!("{context}: {}", self.message),
+            ..self
+        }
+    }
+
+    fn of(kind: Kind, err: &(dyn StdError + 'static)) -> Failure {
+        Failure {
+            kind,
+            message: with_causes(err),
+            key: None,
+            location: None,
+            io: io_kind(err),
+        }
+    }
+
+    /// A scenario error; `causes` false leaves out the parser's excerpt,
+    /// which quotes text the user did not write (see `overlay`).
+    pub fn scenario(err: &ScenarioError, causes: bool) -> Failure {
+        let message = if causes {
+            with_causes(err)
+        } else {
+            err.to_string()
+        };
+        Failure {
+            kind: Kind::Input,
+            message,
+            key: err.key().map(str::to_owned),
+            location: location(err).cloned(),
+            io: io_kind(err),
+        }
+    }
+}
+
+/// The place a scenario error names, when it names one.
+pub fn location(err: &ScenarioError) -> Option<&Location> {
+    match err {
+        ScenarioError::Syntax { at, .. }
+        | ScenarioError::UnknownKey { at, .. }
+        | ScenarioError::MissingKey { at, .. }
+        | ScenarioError::BadValue { at, .. }
+        | ScenarioError::Invalid { at, .. }
+        | ScenarioError::Empty { at, .. }
+        | ScenarioError::Conflict { at, .. }
+        | ScenarioError::NotForLaw { at, .. }
+        | ScenarioError::UnknownNumber { at, .. }
+        | ScenarioError::Sweep { at, .. } => Some(at),
+        _ => None,
+    }
+}
+
+/// [`location`], to move it.
+pub fn location_mut(err: &mut ScenarioError) -> Option<&mut Location> {
+    match err {
+        ScenarioError::Syntax { at, .. }
+        | ScenarioError::UnknownKey { at, .. }
+        | ScenarioError::MissingKey { at, .. }
+        | ScenarioError::BadValue { at, .. }
+        | ScenarioError::Invalid { at, .. }
+        | ScenarioError::Empty { at, .. }
+        | ScenarioError::Conflict { at, .. }
+        | ScenarioError::NotForLaw { at, .. }
+        | ScenarioError::UnknownNumber { at, .. }
+        | ScenarioError::Sweep { at, .. } => Some(at),
+        _ => None,
+    }
+}
+
+/// The error and each cause on lines of their own, as the command line
+/// prints them.
+fn with_causes(err: &(dyn StdError + 'static)) -> String {
+    let mut text = err.to_string();
+    let mut cause = err.source();
+    while let Some(c) = cause {
+        let shown = c.to_string();
+        let mut lines = shown.trim_end().lines();
+        if let Some(first) = lines.next() {
+            let _ = write!(text, "\n  caused by: {first}");
+        }
+        for line in lines {
+            let _ = write!(text, "\n    {line}");
+        }
+        cause = c.source();
+    }
+    text
+}
+
+/// How reading a file failed, when an I/O error is in the chain.
+fn io_kind(err: &(dyn StdError + 'static)) -> Option<io::ErrorKind> {
+    let mut cause = Some(err);
+    while let Some(c) = cause {
+        if let Some(e) = c.downcast_ref::<io::Error>() {
+            return Some(e.kind());
+        }
+        cause = c.source();
+    }
+    None
+}
+
+impl From<Failure> for PyErr {
+    fn from(f: Failure) -> PyErr {
+        let err = match (f.kind, f.io) {
+            (Kind::Input, Some(io::ErrorKind::NotFound)) => PyFileNotFoundError::new_err(f.message),
+            (Kind::Input, Some(io::ErrorKind::PermissionDenied)) => {
+                PyPermissionError::new_err(f.message)
+            }
+            (Kind::Input, _) => InputError::new_err(f.message),
+            (Kind::Ngspice, _) => NgspiceError::new_err(f.message),
+            (Kind::Simulation, _) => SimulationError::new_err(f.message),
+        };
+        Python::attach(|py| {
+            let value = err.value(py);
+            let path = f.location.as_ref().map(|l| l.path.display().to_string());
+            let line = f.location.as_ref().and_then(|l| l.line);
+            // Setting attributes on a fresh exception cannot fail.
+            let _ = value.setattr("key", f.key);
+            let _ = value.setattr("path", path);
+            let _ = value.setattr("line", line);
+        });
+        err
+    }
+}
+
+impl From<ScenarioError> for Failure {
+    fn from(e: ScenarioError) -> Failure {
+        Failure::scenario(&e, true)
+    }
+}
+
+impl From<SpiceError> for Failure {
+    fn from(e: SpiceError) -> Failure {
+        Failure::of(Kind::Ngspice, &e)
+    }
+}
+
+impl From<RawError> for Failure {
+    fn from(e: RawError) -> Failure {
+        Failure::of(Kind::Input, &e)
+    }
+}
+
+impl From<CaptureError> for Failure {
+    fn from(e: CaptureError) -> Failure {
+        Failure::of(Kind::Input, &e)
+    }
+}
+
+impl From<EdgeError> for Failure {
+    fn from(e: EdgeError) -> Failure {
+        Failure::of(Kind::Input, &e)
+    }
+}
+
+impl From<WaveformError> for Failure {
+    fn from(e: WaveformError) -> Failure {
+        Failure::of(Kind::Input, &e)
+    }
+}
+
+impl From<FitError> for Failure {
+    fn from(e: FitError) -> Failure {
+        Failure::of(Kind::Input, &e)
+    }
+}
+
+impl From<SweepError> for Failure {
+    fn from(e: SweepError) -> Failure {
+        match e {
+            SweepError::Scenario(e) => e.into(),
+            SweepError::Write(_) => Failure::of(Kind::Simulation, &e),
+            e => Failure::of(Kind::Input, &e),
+        }
+    }
+}
+
+impl From<CheckError> for Failure {
+    fn from(e: CheckError) -> Failure {
+        match e {
+            CheckError::Scenario(e) => e.into(),
+            CheckError::Run(e) => (*e).into(),
+            CheckError::Motion { .. } | CheckError::Mechanics { .. } => {
+                Failure::of(Kind::Simulation, &e)
+            }
+            e => Failure::of(Kind::Input, &e),
+        }
+    }
+}
+
+impl From<RunError> for Failure {
+    fn from(e: RunError) -> Failure {
+        let kind = match &e {
+            RunError::Scenario(e) => return Failure::scenario(e, true),
+            RunError::Pass(PassError::Spice { .. }) => Kind::Ngspice,
+            RunError::Coupling(c) => match **c {
+                CouplingError::Scenario(_)
+                | CouplingError::Netlist(_)
+                | CouplingError::NoCoil { .. }
+                | CouplingError::NoCircuit { .. }
+                | CouplingError::CoilInstances { .. }
+                | CouplingError::NcNotInstantiated { .. } => Kind::Input,
+                CouplingError::Spice { .. } => Kind::Ngspice,
+                _ => Kind::Simulation,
+            },
+            RunError::Mechanics { .. }
+            | RunError::Motion { .. }
+            | RunError::Waveform { .. }
+            | RunError::Arc { .. } => Kind::Simulation,
+            // The netlist, a missing [circuit] or probe, a probe naming a
+            // vector the circuit does not have, .tran missing.
+            _ => Kind::Input,
+        };
+        Failure::of(kind, &e)
+    }
+}
