@@ -170,6 +170,23 @@ pub const BUNDLED_PARTS: &[(&str, &str)] = &[
         "te-v23145-12v",
         include_str!("../../parts/te-v23145-12v.toml"),
     ),
+    (
+        "te-axicom-im-5v",
+        include_str!("../../parts/te-axicom-im-5v.toml"),
+    ),
+    (
+        "te-rt1-rt314012",
+        include_str!("../../parts/te-rt1-rt314012.toml"),
+    ),
+    (
+        "omron-g8h-1c4t-r-12v",
+        include_str!("../../parts/omron-g8h-1c4t-r-12v.toml"),
+    ),
+    (
+        "te-card-e-v23057-12v",
+        include_str!("../../parts/te-card-e-v23057-12v.toml"),
+    ),
+    ("te-rel-5v", include_str!("../../parts/te-rel-5v.toml")),
 ];
 
 /// The scenario text of bundled part `name`.

@@ -8,10 +8,17 @@ use chatterspice::calibrate::parts;
 use chatterspice::scenario::Scenario;
 
 #[test]
-fn there_are_six_parts_and_each_meets_its_datasheet() {
-    assert!(parts::all().len() >= 6);
+fn there_are_ten_parts_and_each_meets_its_datasheet() {
+    assert!(parts::all().len() >= 10, "{}", parts::all().len());
     for part in parts::all() {
         let scenario = part.load().unwrap_or_else(|e| panic!("{}: {e}", part.name));
+        // `base = "part:NAME"` starts from the same text.
+        assert_eq!(
+            chatterspice::scenario::bundled_part(part.name),
+            Some(part.scenario),
+            "{}",
+            part.name
+        );
         let d = scenario.datasheet.clone().expect("a [datasheet]");
         let provenance = scenario.provenance.clone().expect("a [provenance]");
         assert_eq!(provenance.fitted_to, "datasheet", "{}", part.name);
@@ -86,5 +93,117 @@ fn parts_writes_a_scenario_that_loads_and_never_overwrites() {
     .unwrap();
     let first = &listed[0];
     assert!(first["name"].is_string() && first["source"].is_string());
-    assert_eq!(first["datasheet"]["bounce_time"], "not given");
+    // Each printed figure as printed: a number, or a table of its bounds.
+    let im = listed
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["name"] == "te-axicom-im-5v")
+        .expect("the Axicom IM is listed");
+    assert_eq!(im["datasheet"]["bounce_time"]["typ"], 1.0e-3);
+    assert_eq!(im["datasheet"]["bounce_time"]["max"], 5.0e-3);
+    assert_eq!(im["datasheet"]["coil_voltage"], 5.0);
+    assert_eq!(im["met"]["bounce_time"], true);
+    assert!(im["envelope"]["source"].is_string());
+}
+
+/// Every part the library bundles works without a circuit: `bounce`,
+/// `pwl` and `check` on its own scenario (the ideal DC step of its coil).
+#[test]
+fn every_part_bounces_writes_its_contact_and_checks_without_a_circuit() {
+    let dir = tempfile::tempdir().unwrap();
+    for part in parts::all() {
+        let file = dir.path().join(format!("{}.toml", part.name));
+        std::fs::write(&file, part.scenario).unwrap();
+        for args in [vec!["bounce"], vec!["pwl"], vec!["check"]] {
+            let out = Command::cargo_bin("chatterspice")
+                .unwrap()
+                .args(&args)
+                .arg(&file)
+                .output()
+                .unwrap();
+            assert!(
+                out.status.success(),
+                "{} {args:?}: {}",
+                part.name,
+                String::from_utf8_lossy(&out.stderr)
+            );
+        }
+    }
+}
+
+/// At least three parts print a bounce time, and their nominal relays
+/// meet it; a bounce time the model misses is caught.
+#[test]
+fn three_parts_meet_a_printed_bounce_time_and_a_miss_is_caught() {
+    let mut met = Vec::new();
+    for part in parts::all() {
+        let s = part.load().unwrap();
+        let d = s.datasheet.clone().unwrap();
+        let Some(printed) = d.bounce_time else {
+            continue;
+        };
+        let model = datasheet_figures(&s, &d)
+            .into_iter()
+            .find(|(n, _)| *n == "bounce_time")
+            .and_then(|(_, v)| v)
+            .unwrap_or_else(|| panic!("{}: no bounce time", part.name));
+        assert!(
+            printed.met_by_nominal(model),
+            "{}: {model} vs {printed}",
+            part.name
+        );
+        // The same relay against a bounce time ten times shorter fails.
+        let missed = chatterspice::scenario::PrintedFigure {
+            typ: printed.typ.map(|t| t / 10.0),
+            max: printed.max.map(|m| m / 10.0),
+            ..printed
+        };
+        if model > printed.nominal() / 5.0 {
+            assert!(!missed.met_by_nominal(model), "{}", part.name);
+        }
+        met.push(part.name);
+    }
+    assert!(met.len() >= 3, "{met:?}");
+}
+
+/// No part reports a σ finer than 1e-4 of its value: a σ from a zero
+/// residual would claim a precision no datasheet has.
+#[test]
+fn no_part_claims_a_sigma_below_1e_4_relative() {
+    for part in parts::all() {
+        let provenance = part.load().unwrap().provenance.unwrap();
+        for (key, p) in &provenance.parameters {
+            if let Some(sigma) = p.sigma {
+                assert!(
+                    sigma >= 1e-4 * p.value.abs(),
+                    "{}: {key} σ {sigma} on {}",
+                    part.name,
+                    p.value
+                );
+            }
+        }
+    }
+}
+
+/// Every part's envelope keeps relays and gives a real band (no ngspice:
+/// the relay alone on its DC step).
+#[test]
+fn every_part_envelope_keeps_relays_and_gives_a_band() {
+    use chatterspice::envelope::{EnvelopeOptions, run};
+    for part in parts::all() {
+        let s = part.load().unwrap();
+        assert!(s.envelope.is_some(), "{}: no [envelope]", part.name);
+        let options = EnvelopeOptions {
+            samples: 12,
+            jobs: std::num::NonZeroUsize::new(2).unwrap(),
+            ..EnvelopeOptions::default()
+        };
+        let env = run(&s, None, &options).unwrap_or_else(|e| panic!("{}: {e}", part.name));
+        assert!(env.report.kept >= 3, "{}: {:?}", part.name, env.report);
+        let operate = env.report.quantities["operate_time"];
+        assert!(operate.max > operate.min, "{}: {operate:?}", part.name);
+        let bounces = env.report.quantities["bounce_count"];
+        assert!(bounces.max > bounces.min, "{}: {bounces:?}", part.name);
+    }
 }

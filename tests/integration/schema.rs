@@ -190,6 +190,26 @@ fn run_and_check_output_match_their_schemas() {
     );
     assert_valid("check", &check, "coil check");
     assert!(check["run"].is_object());
+    let scenario = format!(
+        "{}/tests/data/scenarios/im_mcu_envelope.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    for command in ["check", "run"] {
+        let doc = json_of(
+            &[
+                command,
+                &scenario,
+                "--envelope",
+                "--samples",
+                "8",
+                "--format",
+                "json",
+            ],
+            0,
+        );
+        assert!(doc["envelope"]["quantities"].is_object());
+        assert_valid(command, &doc, "an envelope");
+    }
 }
 
 #[test]
