@@ -309,11 +309,12 @@ pub fn relay_checks(
         ));
     }
     let worst = |what: &str, get: &dyn Fn(&Operation) -> Option<f64>| {
+        release_unevaluated(operations, what)?;
         let values: Vec<f64> = operations.iter().filter_map(get).collect();
         if values.is_empty() {
             Err(format!(
-                "no {what}: the coil is not switched off after the contact closed, within \
-                 `simulation.t_end`"
+                "not evaluated: no {what} in the run (the contact never broke after the coil \
+                 went off)"
             ))
         } else {
             Ok(values.into_iter().fold(f64::NEG_INFINITY, f64::max))
@@ -352,6 +353,32 @@ pub fn relay_checks(
         ));
     }
     out
+}
+
+/// Why a limit on the releases cannot be held yet: the coil is never
+/// switched off within the run, or an operation's coil goes off and the
+/// run ends before its contact breaks (a part's `simulation.t_end` shorter
+/// than the driver's on-time). Such a limit fails as not evaluated; it
+/// never passes on a release that was not simulated.
+fn release_unevaluated(operations: &[Operation], what: &str) -> Result<(), String> {
+    if !operations.iter().any(|op| op.coil_off.is_some()) {
+        return Err(format!(
+            "not evaluated: the coil is never switched off within the run, so there is no \
+             {what} to hold; switch it off in the driver before `simulation.t_end` and the \
+             `.tran` stop time"
+        ));
+    }
+    if let Some(op) = operations
+        .iter()
+        .find(|op| op.coil_off.is_some() && op.release_time.is_none())
+    {
+        return Err(format!(
+            "not evaluated: the coil goes off at {} s but the run ends before the contact \
+             breaks; raise `simulation.t_end` (and the `.tran` stop time) past the release",
+            op.coil_off.unwrap_or_default()
+        ));
+    }
+    Ok(())
 }
 
 /// Probe `index`'s limits against its analysis.
@@ -432,7 +459,7 @@ pub fn evaluate(scenario: &Scenario, run: &RunResult) -> Verdict {
         .map(|l| relay_checks(l, &run.chatter, &run.operations))
         .unwrap_or_default();
     if let Some(limits) = &scenario.limits {
-        checks.extend(arc_checks(limits, run.arcs.as_ref()));
+        checks.extend(arc_checks(limits, run.arcs.as_ref(), &run.operations));
     }
     for (i, (probe, result)) in scenario.probes.iter().zip(&run.probes).enumerate() {
         checks.extend(probe_checks(i, probe, &result.analysis));
@@ -441,9 +468,27 @@ pub fn evaluate(scenario: &Scenario, run: &RunResult) -> Verdict {
 }
 
 /// `max_arc_energy` and `max_arc_count` against the worst operation of
-/// the run's arcs.
-pub fn arc_checks(limits: &LimitsSection, arcs: Option<&ArcReport>) -> Vec<LimitCheck> {
-    let missing = || "the run has no arc report: add an [arc] section".to_owned();
+/// the run's arcs. A break the run did not reach (the coil goes off but
+/// the run ends before the contact breaks) has an arc that was never
+/// simulated: the limits then fail as not evaluated.
+pub fn arc_checks(
+    limits: &LimitsSection,
+    arcs: Option<&ArcReport>,
+    operations: &[Operation],
+) -> Vec<LimitCheck> {
+    let unreached = operations
+        .iter()
+        .find(|op| op.coil_off.is_some() && op.release_time.is_none())
+        .and_then(|op| op.coil_off);
+    let missing = || match unreached {
+        Some(off) => format!(
+            "not evaluated: the coil goes off at {off} s but the run ends before the contact \
+             breaks, so that break's arc was never simulated; raise `simulation.t_end` (and \
+             the `.tran` stop time)"
+        ),
+        None => "the run has no arc report: add an [arc] section".to_owned(),
+    };
+    let arcs = arcs.filter(|_| unreached.is_none());
     let mut out = Vec::new();
     if let Some(limit) = limits.max_arc_energy {
         out.push(LimitCheck::new(

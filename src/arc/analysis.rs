@@ -30,6 +30,24 @@ pub const DISCHARGE_FRACTION: f64 = 0.025;
 /// (an arc flickering at I_min, a discharge that collapses and restrikes).
 pub const MERGE_GAP: f64 = 1e-6;
 
+/// s, how long the arc element's own transient lasts after an arc or a
+/// breakdown starts: ten times its slowest internal lag (the state's,
+/// 100 ns). Within it the element's clamp settles onto the circuit, and
+/// its current is the element's, not the circuit's.
+pub const ELEMENT_SETTLE: f64 = 1e-6;
+
+/// A, the largest |i| of samples `first..=last` that the circuit drives:
+/// the current at the start (what flowed through the contact as it
+/// separated) and every sample once [`ELEMENT_SETTLE`] has passed. On a
+/// DC RL break that is the load current at separation.
+fn settled_peak(time: &[f64], i: &[f64], first: usize, last: usize) -> f64 {
+    let start = time[first];
+    (first..=last)
+        .filter(|&j| j == first || time[j] - start >= ELEMENT_SETTLE)
+        .map(|j| i[j].abs())
+        .fold(0.0f64, f64::max)
+}
+
 /// One arc.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ArcEvent {
@@ -43,7 +61,9 @@ pub struct ArcEvent {
     pub start: f64,
     /// s
     pub duration: f64,
-    /// A, the largest |i|.
+    /// A, the largest |i| the circuit drives through the arc: the current
+    /// at separation and the arc's current once the element's own
+    /// transient ([`ELEMENT_SETTLE`]) is over.
     pub peak_current: f64,
     /// J, ∫ v·i dt.
     pub energy: f64,
@@ -364,7 +384,7 @@ impl<'a> Samples<'a> {
                 energy += 0.5 * ((v[j] * i[j]).abs() + (v[j + 1] * i[j + 1]).abs()) * dt;
                 charge += 0.5 * (i[j].abs() + i[j + 1].abs()) * dt;
             }
-            let peak_current = i[first..=last].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            let peak_current = settled_peak(time, i, first, last);
             let (start, end) = (time[first], time[last]);
             let (operation, opening) = opening_at(openings, start);
             match this {

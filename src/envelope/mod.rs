@@ -313,7 +313,7 @@ pub fn run(
         ideal_alongside: false,
         ..options.run.clone()
     };
-    let outcomes: Mutex<Vec<(usize, Result<Kept, Vec<String>>)>> = Mutex::new(Vec::new());
+    let outcomes: Mutex<Vec<Outcome>> = Mutex::new(Vec::new());
     let next = AtomicUsize::new(0);
     std::thread::scope(|scope| {
         for _ in 0..options.jobs.get().min(draw.relays.len()) {
@@ -394,6 +394,10 @@ pub fn run(
         verdict,
     })
 }
+
+/// A relay's place in the draw, and what became of it: kept, or the
+/// reasons it was not.
+type Outcome = (usize, Result<Kept, Vec<String>>);
 
 /// One sampled relay: set its values, screen it against the datasheet,
 /// run it. `Err` carries the reasons it was not kept.

@@ -558,3 +558,35 @@ fn a_sweep_over_v_min_shows_where_the_supply_sustains_the_arc() {
     // 10 V: 2 V left across the lamp, and the arc burns the whole opening.
     assert!(energy[0] > 50.0 * energy[1], "{energy:?}");
 }
+
+/// Every arc of a bouncing RL load carries at most what the circuit
+/// drives through the contact: the inductor's current, never above the
+/// steady load current V/R (within 2 %), whatever the arc element's own
+/// transient at the start of each arc.
+#[test]
+fn no_arc_peak_exceeds_what_the_circuit_drives() {
+    let ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    let (v, r) = (24.0f64, 24.0f64);
+    let netlist = format!(
+        "RL bounce\nV1 vcc 0 {v}\nL1 vcc n1 2m\nR1 n1 a {r}\nX1 a 0 CONTACT\n\
+         .tran 1u 5m 0 1u\n.end\n"
+    );
+    let scenario = relay_on(
+        dir.path(),
+        &netlist,
+        "[[probe]]\nsignal = \"v(a)\"\nlow = 1\nhigh = 2\n\n[arc]\nmaterial = \"Ag\"\n",
+    );
+    let result = run(&ng, &scenario);
+    let arcs = &result.arcs.as_ref().unwrap().arcs;
+    assert!(!arcs.is_empty(), "the bounces of a 1 A inductive load arc");
+    let load = v / r;
+    for arc in arcs {
+        assert!(
+            arc.peak_current <= 1.02 * load,
+            "{}: {} A from a {load} A load",
+            arc.opening,
+            arc.peak_current
+        );
+    }
+}

@@ -296,3 +296,43 @@ fn a_measured_record_is_checked_instead_of_the_mechanics() {
     let v = with(&csv, 1);
     assert_eq!(v["passed"], false, "{v}");
 }
+
+/// A run that ends before the release a limit needs (the driver turns
+/// the coil off at 20 ms, the scenario stops at 15 ms) fails that limit
+/// as not evaluated: it never passes on a release that was not simulated.
+#[test]
+fn a_release_limit_past_the_end_of_the_run_fails_as_not_evaluated() {
+    let Some(_) = crate::common::ngspice() else {
+        return;
+    };
+    let root = env!("CARGO_MANIFEST_DIR");
+    let text =
+        std::fs::read_to_string(format!("{root}/examples/scenarios/relay-driver-zener.toml"))
+            .unwrap()
+            .replace("t_end = 0.05 ", "t_end = 0.015 ")
+            .replace(
+                "../../netlists/relay_driver_zener.cir",
+                &format!("{root}/netlists/relay_driver_zener.cir"),
+            );
+    assert!(text.contains("t_end = 0.015"));
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("short.toml");
+    std::fs::write(&file, text).unwrap();
+    let out = assert_cmd::Command::cargo_bin("chatterspice")
+        .unwrap()
+        .args(["check", file.to_str().unwrap(), "--format", "json"])
+        .assert()
+        .code(1);
+    let doc: serde_json::Value = serde_json::from_slice(&out.get_output().stdout).unwrap();
+    let release = doc["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["key"] == "limits.max_release_time")
+        .expect("the release limit is reported");
+    assert_eq!(release["passed"], false, "{release}");
+    assert!(
+        release["note"].as_str().unwrap().contains("not evaluated"),
+        "{release}"
+    );
+}
