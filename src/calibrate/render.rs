@@ -102,11 +102,17 @@ pub fn table(report: &FitReport) -> String {
             );
         }
     }
-    let unit = if report.events.is_empty() { "" } else { " s" };
+    // A record's misfit is a time; a datasheet's alone is relative.
+    let rms = if report.events.is_empty() {
+        format!("{:.4} %", report.rms_residual * 100.0)
+    } else {
+        engineering(report.rms_residual, "s")
+    };
     let _ = writeln!(
         out,
-        "\nrms residual {:.3e}{unit}; {} evaluations in {:.3} s",
-        report.rms_residual, report.evaluations, report.elapsed
+        "\nrms residual {rms}; {} evaluations in {}",
+        report.evaluations,
+        engineering(report.elapsed, "s")
     );
     for n in &report.notes {
         let _ = writeln!(out, "note: {n}");
