@@ -125,36 +125,12 @@ impl Failure {
 
 /// The place a scenario error names, when it names one.
 pub fn location(err: &ScenarioError) -> Option<&Location> {
-    match err {
-        ScenarioError::Syntax { at, .. }
-        | ScenarioError::UnknownKey { at, .. }
-        | ScenarioError::MissingKey { at, .. }
-        | ScenarioError::BadValue { at, .. }
-        | ScenarioError::Invalid { at, .. }
-        | ScenarioError::Empty { at, .. }
-        | ScenarioError::Conflict { at, .. }
-        | ScenarioError::NotForLaw { at, .. }
-        | ScenarioError::UnknownNumber { at, .. }
-        | ScenarioError::Sweep { at, .. } => Some(at),
-        _ => None,
-    }
+    err.location()
 }
 
 /// [`location`], to move it.
 pub fn location_mut(err: &mut ScenarioError) -> Option<&mut Location> {
-    match err {
-        ScenarioError::Syntax { at, .. }
-        | ScenarioError::UnknownKey { at, .. }
-        | ScenarioError::MissingKey { at, .. }
-        | ScenarioError::BadValue { at, .. }
-        | ScenarioError::Invalid { at, .. }
-        | ScenarioError::Empty { at, .. }
-        | ScenarioError::Conflict { at, .. }
-        | ScenarioError::NotForLaw { at, .. }
-        | ScenarioError::UnknownNumber { at, .. }
-        | ScenarioError::Sweep { at, .. } => Some(at),
-        _ => None,
-    }
+    err.location_mut()
 }
 
 /// The error and each cause on lines of their own, as the command line

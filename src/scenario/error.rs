@@ -215,9 +215,28 @@ pub enum ScenarioError {
 }
 
 impl ScenarioError {
-    /// The place the error points at, for the errors that point at a key
-    /// of the file.
-    pub(super) fn location_mut(&mut self) -> Option<&mut Location> {
+    /// The place in a scenario file the error points at, when it points
+    /// at one (its file and line).
+    pub fn location(&self) -> Option<&Location> {
+        match self {
+            ScenarioError::UnknownKey { at, .. }
+            | ScenarioError::MissingKey { at, .. }
+            | ScenarioError::BadValue { at, .. }
+            | ScenarioError::Invalid { at, .. }
+            | ScenarioError::Empty { at, .. }
+            | ScenarioError::Conflict { at, .. }
+            | ScenarioError::NotForLaw { at, .. }
+            | ScenarioError::UnknownNumber { at, .. }
+            | ScenarioError::Sweep { at, .. }
+            | ScenarioError::Syntax { at, .. }
+            | ScenarioError::Base { at, .. } => Some(at),
+            _ => None,
+        }
+    }
+
+    /// [`ScenarioError::location`], to move it (an error found in merged
+    /// or overlaid text, pointed back at the file its key came from).
+    pub fn location_mut(&mut self) -> Option<&mut Location> {
         match self {
             ScenarioError::UnknownKey { at, .. }
             | ScenarioError::MissingKey { at, .. }

@@ -59,22 +59,7 @@ fn fails_on(text: &str, key: &str) -> ScenarioError {
 
 #[track_caller]
 fn line_of(err: &ScenarioError) -> Option<usize> {
-    match err {
-        ScenarioError::Syntax { at, .. }
-        | ScenarioError::UnknownKey { at, .. }
-        | ScenarioError::MissingKey { at, .. }
-        | ScenarioError::BadValue { at, .. }
-        | ScenarioError::Invalid { at, .. }
-        | ScenarioError::Empty { at, .. }
-        | ScenarioError::Conflict { at, .. }
-        | ScenarioError::NotForLaw { at, .. }
-        | ScenarioError::UnknownNumber { at, .. }
-        | ScenarioError::Sweep { at, .. }
-        | ScenarioError::Base { at, .. } => at.line,
-        ScenarioError::Read { .. }
-        | ScenarioError::CoilDriveUnsupported { .. }
-        | ScenarioError::NetlistRead { .. } => None,
-    }
+    err.location().and_then(|at| at.line)
 }
 
 #[test]
