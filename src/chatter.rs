@@ -23,8 +23,9 @@ pub enum Outcome {
     EndsOpen,
     /// Still chattering at `t_end`.
     EndOfTime,
-    /// Still chattering after [`crate::mechanics::MAX_EVENTS`] impacts: the
-    /// sequence is cut there (an undamped or perfectly elastic model).
+    /// Still chattering at the most impacts a simulation records (the
+    /// mechanics' `MAX_EVENTS`): the sequence is cut there (an undamped or
+    /// perfectly elastic model).
     EventLimit,
 }
 

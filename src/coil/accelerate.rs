@@ -36,7 +36,7 @@
 //! ngspice run is the fixed point of this cheap map, found by relaxation
 //! among the mechanics runs alone.
 
-use super::{Coil, CoilError};
+use super::magnet::{Coil, CoilError};
 use crate::mechanics::cycle::Stops;
 use crate::mechanics::two_stage::{TwoStage, driven_run};
 use crate::mechanics::{Mechanics, Settings, Trajectory};

@@ -22,8 +22,8 @@
 
 use nalgebra::SVector;
 
-use super::MechanicsError;
-use super::integrate::{Tolerance, trial_step};
+use super::error::MechanicsError;
+use super::step_control::{Tolerance, trial_step};
 
 const C2: f64 = 0.526001519587677318785587544488e-01;
 const C3: f64 = 0.789002279381515978178381316732e-01;

@@ -1,8 +1,8 @@
-//! What the integrated engine ([`super::cycle`]) shares with its users:
-//! the `Drive` trait (a force that varies in time and position and may
-//! carry a state of its own, such as the coil's flux), the state it
-//! integrates, the record of a closing (`Run`, `Piece`) and the
-//! event-location numerics.
+//! What the integrated engines (the cycle engine and the two-stage
+//! engine) share with their users: the `Drive` trait (a force that varies
+//! in time and position and may carry a state of its own, such as the
+//! coil's flux), the state the cycle engine integrates, a view of one of
+//! its steps (`Piece`) and the event-location numerics.
 //!
 //! The state is `(u, v, e)`: `u = x − g` (m, the position relative to the
 //! fixed contact, so that the µm penetrations keep their precision), the
@@ -22,11 +22,9 @@
 
 use nalgebra::Vector3;
 
-use super::DriveError;
-use super::Mechanics;
+use super::error::DriveError;
 use super::integrate::{Step, Tolerance};
-use super::trajectory::Segment;
-use crate::chatter::Chatter;
+use super::parameters::Mechanics;
 
 /// `(u = x − g, v, e)`: m, m/s, and the drive's own state.
 pub(crate) type State = Vector3<f64>;
@@ -76,8 +74,7 @@ pub(crate) enum StepKind {
 
 /// One accepted step, cut at the event that ended its phase: valid on
 /// `[step.t0, t1]`, where the state is `y1` (the exact event state for
-/// the last step of a phase). A view of a trajectory's segment
-/// ([`super::trajectory`]).
+/// the last step of a phase). A view of a trajectory's segment.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Piece<'a> {
     pub phase: StepKind,
@@ -105,21 +102,6 @@ impl Piece<'_> {
             state_on(self.step, t)
         }
     }
-}
-
-/// A finished run.
-pub(crate) struct Run {
-    pub chatter: Chatter,
-    /// s, the first lift-off from the rest stop (`None` if it never lifts
-    /// or did not start on it).
-    pub lift_off: Option<f64>,
-    /// Every accepted step in time order, cut at events: they tile
-    /// `[0, end]`; each is a [`Piece`] ([`Segment::piece`]).
-    pub steps: Vec<Segment>,
-    /// J, kinetic energy taken by rigid impacts and inelastic landings.
-    pub jump_loss: f64,
-    /// (s, state) where the run stopped.
-    pub end: (f64, State),
 }
 
 /// The integration tolerance for `m` under `drive`, once the drive is

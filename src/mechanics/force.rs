@@ -9,12 +9,13 @@
 
 use nalgebra::Vector2;
 
-use super::MechanicsError;
 use super::engine::kelvin_voigt_contact;
+use super::error::MechanicsError;
 use super::hunt_crossley::HcContact;
 use super::integrate::{Dopri5, Tolerance};
 use super::linear::LinearPiece;
-use super::{Mechanics, Surface};
+use super::parameters::Mechanics;
+use super::surface::Surface;
 use crate::chatter::Chatter;
 
 /// The contact force (N, positive pressing the contacts together) at each

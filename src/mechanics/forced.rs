@@ -2,17 +2,18 @@
 //!
 //! This is the mechanical half of the waveform-relaxation coupling with
 //! ngspice: the circuit gives the coil current `i(t)`, the coil turns it
-//! into `F_m(i(t), x)` ([`crate::coil::Coil::force`]), and this integrates the
-//! armature under it, with the same events, surface laws and endings as
-//! the step-force engine, by the one integrated engine ([`super::cycle`]:
-//! the whole cycle, or one closing stopped at its ending). With a
-//! constant force it reproduces [`crate::mechanics::simulate`].
+//! into its pull `F_m(i(t), x)`, and this integrates the armature under
+//! it, with the same events, surface laws and endings as the step-force
+//! engine, by the one integrated engine ([`super::cycle`]: the whole
+//! cycle, or one closing stopped at its ending). With a constant force it
+//! reproduces [`super::engine::simulate`].
 
-use super::DriveError;
-use super::cycle::{self, Cycle, Stops};
+use super::cycle::{self, Cycle};
 use super::driven::Drive;
-use super::trajectory::{Segment, path_of};
-use super::{self as mechanics, Mechanics, Settings, Surface};
+use super::error::DriveError;
+use super::parameters::{self, Mechanics, Settings, Stops};
+use super::segment::{Segment, path_of};
+use super::surface::Surface;
 use crate::chatter::Chatter;
 
 /// Simulate one closing under `force(t, x)` (s, m → N, toward closing),
@@ -87,7 +88,7 @@ fn validate(
         ..*mechanics
     };
     for surface in surfaces {
-        mechanics::validate(&unforced, surface, settings)?;
+        parameters::validate(&unforced, surface, settings)?;
     }
     if mechanics.initial_position < 0.0 {
         return Err(DriveError::InvalidParameter {

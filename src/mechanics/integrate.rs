@@ -1,7 +1,7 @@
 //! Adaptive Runge–Kutta integration with dense output, for the pieces of
 //! motion that have no closed form (later, a force that varies in time).
 //! The Hunt–Crossley contact, which needs tight tolerances, uses the
-//! higher-order [`super::dop853`] instead; [`Tolerance`] serves both.
+//! higher-order method of `dop853` instead; [`Tolerance`] serves both.
 //!
 //! The method is Dormand–Prince 5(4) with its 4th-order continuous
 //! extension (Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.5–6). It is
@@ -16,17 +16,9 @@
 
 use nalgebra::SVector;
 
-use super::MechanicsError;
-
-/// Tolerances: a step is accepted when every component's error estimate
-/// is within `atol[i] + rtol·|y[i]|`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Tolerance<const N: usize> {
-    /// The relative tolerance, the same for every component.
-    pub rtol: f64,
-    /// The absolute tolerance of each component, in its unit.
-    pub atol: SVector<f64, N>,
-}
+use super::error::MechanicsError;
+pub use super::step_control::Tolerance;
+use super::step_control::trial_step;
 
 /// One accepted step from `t0` to `t1`, with the coefficients of its
 /// continuous extension.
@@ -68,29 +60,6 @@ where
     h: f64,
     /// Number of right-hand-side evaluations so far.
     pub evaluations: usize,
-}
-
-/// The step to try from `t` with the controller's `h`: cut to land on
-/// `t_stop` (then `true`: the last), and an error when the controller has
-/// shrunk it to rounding level before getting there.
-#[inline(always)]
-pub(crate) fn trial_step(h: f64, t: f64, t_stop: f64) -> Result<(f64, bool), MechanicsError> {
-    // A step that is not a positive finite number (the state overflowed,
-    // or an open-ended integration was handed one) would repeat forever:
-    // `min` drops a NaN, and 0.1 × ∞ is ∞.
-    if !(h.is_finite() && h > 0.0 && t.is_finite()) {
-        return Err(MechanicsError::StepSizeTooSmall { time: t, step: h });
-    }
-    let mut h = h.min(t_stop - t);
-    let last = h >= t_stop - t;
-    if last {
-        h = t_stop - t;
-    }
-    let too_small = h.is_nan() || h <= 16.0 * f64::EPSILON * t.abs().max(h.abs());
-    if too_small && !last {
-        return Err(MechanicsError::StepSizeTooSmall { time: t, step: h });
-    }
-    Ok((h, last))
 }
 
 // Butcher tableau of Dormand & Prince (1980).

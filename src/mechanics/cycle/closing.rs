@@ -37,35 +37,27 @@
 //! For a constant drive the endings are exact, which is what makes the
 //! results equal the step-force engine's.
 
-use super::{Event, Model, Phase, Record, Sim, Track};
+use super::model::{Ending, Event, Model, Phase, Record, Track};
 use crate::chatter::{Chatter, Outcome, bounces};
-use crate::mechanics::Surface;
-use crate::mechanics::driven::{Drive, Run, State};
+use crate::mechanics::driven::{Drive, State};
 use crate::mechanics::integrate::Step;
 use crate::mechanics::linear::LinearPiece;
-use crate::mechanics::surface::surface_energy;
+use crate::mechanics::segment::Segment;
+use crate::mechanics::surface::{Surface, surface_energy};
 
-/// How a closing ended, and where the run stopped: (s, state).
-#[derive(Debug, Clone, Copy)]
-pub(crate) enum Ending {
-    /// Closed for good from the last touch.
-    Stuck { end: (f64, State) },
-    /// The opening that ended at `end` is below resolution: closed from
-    /// the touch before it; `accumulation` (s) for a rigid surface.
-    Resolved {
-        accumulation: Option<f64>,
-        end: (f64, State),
-    },
-    /// Open at the horizon; `reaches`: the frozen drive would still
-    /// close the contact; `reach` (m): the largest x, counting the
-    /// frozen motion's.
-    Open {
-        reaches: bool,
-        reach: f64,
-        end: (f64, State),
-    },
-    /// In a contact at the horizon that may still release.
-    InContact { end: (f64, State) },
+/// A finished closing.
+pub(crate) struct Run {
+    pub chatter: Chatter,
+    /// s, the first lift-off from the rest stop (`None` if it never lifts
+    /// or did not start on it).
+    pub lift_off: Option<f64>,
+    /// Every accepted step in time order, cut at events: they tile
+    /// `[0, end]`; each is a `Piece` ([`Segment::piece`]).
+    pub steps: Vec<Segment>,
+    /// J, kinetic energy taken by rigid impacts and inelastic landings.
+    pub jump_loss: f64,
+    /// (s, state) where the run stopped.
+    pub end: (f64, State),
 }
 
 /// J, the sticking margin `M` at (t, y) in the make contact.
@@ -234,10 +226,9 @@ pub(super) fn at_horizon<D: Drive>(
 }
 
 /// The closing's record from the run that stopped at its ending.
-pub(super) fn finish<D: Drive>(sim: Sim<'_, D>) -> Run {
-    let t_end = sim.model.settings.t_end;
-    let g = sim.model.g();
-    let rec = sim.rec;
+pub(super) fn finish<D: Drive>(model: &Model<'_, D>, rec: Record) -> Run {
+    let t_end = model.settings.t_end;
+    let g = model.g();
     let ending = rec.ending.expect("a closing stops at its ending");
     let since = rec.make.since;
     let (outcome, settle_time, accumulation_time, end) = match ending {

@@ -29,11 +29,10 @@
 //! Minima of a convex function of one variable are found by golden
 //! section; of two, by golden section nested in golden section.
 
-use super::super::Surface;
-use super::super::driven::Drive;
-use super::super::surface::surface_energy;
-use super::Release;
-use super::engine::{Modes, Relay, Y};
+use super::model::{Modes, Relay, Y};
+use super::relay::Release;
+use crate::mechanics::driven::Drive;
+use crate::mechanics::surface::{Surface, surface_energy};
 
 /// Golden-section iterations: the bracket shrinks by 0.618^80 ≈ 2e-17.
 const ITERATIONS: usize = 80;
