@@ -49,7 +49,7 @@
 
 use super::driven::{self, Drive, State, first_true, monotone_parts, state_on};
 use super::error::{DriveError, MAX_DRIVEN_STEPS, MAX_EVENTS, MechanicsError};
-use super::integrate::Step;
+use super::integrate::Dopri5Step;
 pub use super::parameters::Stops;
 use super::parameters::{Mechanics, Settings};
 use super::segment::{Segment, path_of};
@@ -492,7 +492,7 @@ fn moving_event<D: Drive>(
     model: &Model<'_, D>,
     rec: &mut Record,
     phase: Phase,
-    step: &Step<3>,
+    step: &Dopri5Step<3>,
 ) -> Result<Option<(Event, f64, State)>, DriveError> {
     let g = model.g();
     let parts = monotone_parts(step);

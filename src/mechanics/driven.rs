@@ -23,7 +23,7 @@
 use nalgebra::Vector3;
 
 use super::error::DriveError;
-use super::integrate::{Step, Tolerance};
+use super::integrate::{Dopri5Step, StepTolerance};
 use super::parameters::Mechanics;
 
 /// `(u = x − g, v, e)`: m, m/s, and the drive's own state.
@@ -78,7 +78,7 @@ pub(crate) enum StepKind {
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Piece<'a> {
     pub phase: StepKind,
-    pub step: &'a Step<3>,
+    pub step: &'a Dopri5Step<3>,
     pub t1: f64,
     pub y1: State,
 }
@@ -110,7 +110,7 @@ pub(crate) fn start<D: Drive>(
     m: &Mechanics,
     drive: &D,
     e0: f64,
-) -> Result<Tolerance<3>, DriveError> {
+) -> Result<StepTolerance<3>, DriveError> {
     let x0 = m.initial_position;
     let f0 = drive.force(0.0, x0, e0);
     if !f0.is_finite() {
@@ -121,7 +121,7 @@ pub(crate) fn start<D: Drive>(
         });
     }
     let omega = (m.stiffness / m.mass).sqrt();
-    Ok(Tolerance {
+    Ok(StepTolerance {
         rtol: RTOL,
         atol: State::new(RTOL * m.gap, RTOL * m.gap * omega, RTOL * drive.e_scale()),
     })
@@ -179,7 +179,7 @@ impl Parts {
 
 /// The step split at the velocity zero it may contain: up to two parts,
 /// each with x monotonic, and the turning point if any.
-pub(crate) fn monotone_parts(step: &Step<3>) -> Parts {
+pub(crate) fn monotone_parts(step: &Dopri5Step<3>) -> Parts {
     let (v0, v1) = (step.y0[1], step.y1[1]);
     if (v0 > 0.0 && v1 < 0.0) || (v0 < 0.0 && v1 > 0.0) {
         let up = v0 > 0.0;
@@ -207,7 +207,7 @@ pub(crate) fn monotone_parts(step: &Step<3>) -> Parts {
 }
 
 /// The state on `step` at `t`, exact at its ends.
-pub(crate) fn state_on(step: &Step<3>, t: f64) -> State {
+pub(crate) fn state_on(step: &Dopri5Step<3>, t: f64) -> State {
     if t == step.t0 {
         step.y0
     } else if t == step.t1 {

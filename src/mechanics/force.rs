@@ -12,7 +12,7 @@ use nalgebra::Vector2;
 use super::engine::kelvin_voigt_contact;
 use super::error::MechanicsError;
 use super::hunt_crossley::HcContact;
-use super::integrate::{Dopri5, Tolerance};
+use super::integrate::{Dopri5, StepTolerance};
 use super::linear::LinearPiece;
 use super::parameters::Mechanics;
 use super::surface::Surface;
@@ -122,7 +122,7 @@ fn hunt_crossley_forces(
     let depth =
         ((n + 1.0) * hc.mass * v_hit * v_hit / (2.0 * hc.surface_stiffness)).powf(1.0 / (n + 1.0));
     let rtol = 1e-9;
-    let tol = Tolerance {
+    let tol = StepTolerance {
         rtol,
         atol: Vector2::new(rtol * depth, rtol * v_hit),
     };

@@ -41,7 +41,7 @@ use super::dop853::{Dense, Dop853, Dop853Step};
 use super::error::{MAX_CONTACT_STEPS, MechanicsError};
 use super::parameters::Mechanics;
 use super::root;
-use super::step_control::Tolerance;
+use super::step_control::StepTolerance;
 
 /// Everything the contact integration needs (SI units).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -216,7 +216,7 @@ impl HcContact {
         let u_scale = depth.sqrt();
         let s_scale = t_scale / u_scale;
         let rtol = 1e-9;
-        let tol = Tolerance {
+        let tol = StepTolerance {
             rtol,
             // (The solver controls u and v only; t's entry goes unread.)
             atol: HcState::new(rtol * u_scale, rtol * v_hit, rtol * t_scale),

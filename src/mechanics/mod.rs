@@ -66,4 +66,6 @@ pub use error::{DriveError, MAX_CONTACT_STEPS, MAX_DRIVEN_STEPS, MAX_EVENTS, Mec
 pub use force::contact_forces;
 pub use parameters::{Dimensionless, Mechanics, Settings, validate};
 pub use surface::Surface;
-pub use trajectory::{Drive, Event, EventKind, Trajectory, simulate_drive};
+pub use trajectory::{Drive, Trajectory, TrajectoryEvent, TrajectoryEventKind, simulate_drive};
+#[allow(deprecated)]
+pub use trajectory::{Event, EventKind};

@@ -8,7 +8,7 @@
 
 use super::driven::{Piece, State, StepKind};
 use super::hunt_crossley::HcStep;
-use super::integrate::Step;
+use super::integrate::Dopri5Step;
 use super::linear::LinearPiece;
 use super::two_stage::span::Span as StagedSpan;
 
@@ -33,7 +33,7 @@ pub(super) enum Motion {
     /// `forces.1` at the end.
     Held {
         x: f64,
-        step: Step<3>,
+        step: Dopri5Step<3>,
         y1: State,
         forces: (f64, f64),
     },
@@ -42,7 +42,7 @@ pub(super) enum Motion {
     Linear(LinearPiece),
     /// One integrator step in (u = x − g, v, drive state), exact at its
     /// end `y1`.
-    Integrated { step: Step<3>, y1: State },
+    Integrated { step: Dopri5Step<3>, y1: State },
     /// One step of a Hunt–Crossley contact under the step drive, touched
     /// at `touch` (s).
     Contact { step: HcStep, touch: f64 },
@@ -78,7 +78,7 @@ impl Segment {
     /// (`on_contact`: the make contact, else the rest stop) with `forces`
     /// (N) at the step's start and at `t1`.
     pub(crate) fn held(
-        step: Step<3>,
+        step: Dopri5Step<3>,
         t1: f64,
         y1: State,
         x: f64,
@@ -101,7 +101,7 @@ impl Segment {
     /// One integrator step of the cycle, cut at `t1` where the state is
     /// `y1`; `side` is 0 in flight, 1 on the make contact, −1 on the rest
     /// stop.
-    pub(crate) fn integrated(step: Step<3>, t1: f64, y1: State, side: i8) -> Self {
+    pub(crate) fn integrated(step: Dopri5Step<3>, t1: f64, y1: State, side: i8) -> Self {
         Segment {
             t0: step.t0,
             t1,

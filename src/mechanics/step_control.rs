@@ -9,7 +9,7 @@ use super::error::MechanicsError;
 /// Tolerances: a step is accepted when every component's error estimate
 /// is within `atol[i] + rtol·|y[i]|`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Tolerance<const N: usize> {
+pub struct StepTolerance<const N: usize> {
     /// The relative tolerance, the same for every component.
     pub rtol: f64,
     /// The absolute tolerance of each component, in its unit.

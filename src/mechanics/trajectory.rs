@@ -60,7 +60,7 @@ impl std::fmt::Debug for Drive<'_> {
 ///
 /// ```
 /// use chatterspice::mechanics::cycle::Stops;
-/// use chatterspice::mechanics::{Drive, EventKind, simulate_drive};
+/// use chatterspice::mechanics::{Drive, TrajectoryEventKind, simulate_drive};
 /// use chatterspice::{Mechanics, Settings, Surface};
 ///
 /// let relay = Mechanics { mass: 1e-4, stiffness: 5000.0, damping: 0.07, force: 1.0,
@@ -81,10 +81,11 @@ impl std::fmt::Debug for Drive<'_> {
 /// let held = Mechanics { preload: 0.1, ..relay };
 /// let settings = Settings { t_end: 0.03, ..Settings::default() };
 /// let cycle = simulate_drive(&held, &stops, &settings, Drive::Force(&pulse))?;
-/// let kinds: Vec<EventKind> = cycle.events().iter().map(|e| e.kind).collect();
-/// assert_eq!(kinds.first(), Some(&EventKind::LiftOff));
-/// assert!(kinds.contains(&EventKind::Settled) && kinds.contains(&EventKind::Release));
-/// assert_eq!(kinds.last(), Some(&EventKind::Landing));
+/// let kinds: Vec<TrajectoryEventKind> = cycle.events().iter().map(|e| e.kind).collect();
+/// assert_eq!(kinds.first(), Some(&TrajectoryEventKind::LiftOff));
+/// assert!(kinds.contains(&TrajectoryEventKind::Settled));
+/// assert!(kinds.contains(&TrajectoryEventKind::Release));
+/// assert_eq!(kinds.last(), Some(&TrajectoryEventKind::Landing));
 /// assert_eq!(cycle.gap(0.029), relay.gap);
 /// # Ok::<(), chatterspice::mechanics::DriveError>(())
 /// ```
@@ -106,7 +107,7 @@ pub fn simulate_drive(
 /// What happened at an event.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
-pub enum EventKind {
+pub enum TrajectoryEventKind {
     /// The armature leaves its rest stop on its way to the contact.
     LiftOff,
     /// The moving contact touches the fixed one.
@@ -128,11 +129,11 @@ pub enum EventKind {
 
 /// One event of a trajectory.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
-pub struct Event {
+pub struct TrajectoryEvent {
     /// s
     pub time: f64,
     /// What happened.
-    pub kind: EventKind,
+    pub kind: TrajectoryEventKind,
     /// m, the position (the gap for contact events, 0 on the rest stop).
     pub position: f64,
     /// m/s, the velocity just before the event for a touch or a landing,
@@ -140,6 +141,14 @@ pub struct Event {
     /// contact; 0 for lift-off and settling.
     pub velocity: f64,
 }
+
+/// The old name of [`TrajectoryEventKind`].
+#[deprecated(note = "renamed to `TrajectoryEventKind`")]
+pub type EventKind = TrajectoryEventKind;
+
+/// The old name of [`TrajectoryEvent`].
+#[deprecated(note = "renamed to `TrajectoryEvent`")]
+pub type Event = TrajectoryEvent;
 
 /// The armature's motion from t = 0 to the horizon.
 #[derive(Debug, Clone, PartialEq)]
@@ -150,7 +159,7 @@ pub struct Trajectory {
     back_surface: Option<Surface>,
     /// Tiling [0, t_end] in order.
     segments: Vec<Segment>,
-    events: Vec<Event>,
+    events: Vec<TrajectoryEvent>,
     make: Chatter,
     back: Option<Chatter>,
     strokes: Vec<Stroke>,
@@ -247,7 +256,7 @@ impl Trajectory {
     }
 
     /// Every event in time order.
-    pub fn events(&self) -> &[Event] {
+    pub fn events(&self) -> &[TrajectoryEvent] {
         &self.events
     }
 
@@ -357,16 +366,16 @@ impl Trajectory {
     ) -> Self {
         let mut events = contact_events(&cycle.make, m.gap);
         for b in &cycle.back.impacts {
-            events.push(Event {
+            events.push(TrajectoryEvent {
                 time: b.impact_time,
-                kind: EventKind::Landing,
+                kind: TrajectoryEventKind::Landing,
                 position: 0.0,
                 velocity: -b.impact_velocity,
             });
             if let (Some(t), Some(v)) = (b.release_time, b.release_velocity) {
-                events.push(Event {
+                events.push(TrajectoryEvent {
                     time: t,
-                    kind: EventKind::Rebound,
+                    kind: TrajectoryEventKind::Rebound,
                     position: 0.0,
                     velocity: -v,
                 });
@@ -375,11 +384,11 @@ impl Trajectory {
         for s in &cycle.strokes {
             let rebound = events
                 .iter()
-                .any(|e| e.kind == EventKind::Rebound && e.time == s.lift_off);
+                .any(|e| e.kind == TrajectoryEventKind::Rebound && e.time == s.lift_off);
             if !rebound {
-                events.push(Event {
+                events.push(TrajectoryEvent {
                     time: s.lift_off,
-                    kind: EventKind::LiftOff,
+                    kind: TrajectoryEventKind::LiftOff,
                     position: 0.0,
                     velocity: 0.0,
                 });
@@ -417,33 +426,33 @@ impl Trajectory {
         let g = m.gap;
         let mut events = contact_events(&run.contact, g);
         for p in &run.pole_face {
-            events.push(Event {
+            events.push(TrajectoryEvent {
                 time: p.impact_time,
-                kind: EventKind::PoleFace,
+                kind: TrajectoryEventKind::PoleFace,
                 position: run.state(p.impact_time, g).0,
                 velocity: p.impact_velocity,
             });
             if let (Some(t), Some(v)) = (p.release_time, p.release_velocity) {
-                events.push(Event {
+                events.push(TrajectoryEvent {
                     time: t,
-                    kind: EventKind::PoleFaceRelease,
+                    kind: TrajectoryEventKind::PoleFaceRelease,
                     position: run.state(t, g).0,
                     velocity: v,
                 });
             }
         }
         for &t in run.strokes.iter().map(|s| &s.lift_off) {
-            events.push(Event {
+            events.push(TrajectoryEvent {
                 time: t,
-                kind: EventKind::LiftOff,
+                kind: TrajectoryEventKind::LiftOff,
                 position: 0.0,
                 velocity: 0.0,
             });
         }
         for b in &run.back.impacts {
-            events.push(Event {
+            events.push(TrajectoryEvent {
                 time: b.impact_time,
-                kind: EventKind::Landing,
+                kind: TrajectoryEventKind::Landing,
                 position: 0.0,
                 velocity: -b.impact_velocity,
             });
@@ -512,9 +521,9 @@ fn step_trajectory(
         let held = m.preload - m.force;
         segments.push(Segment::rest(0.0, t_end, 0.0, false, held));
     } else if m.initial_position == 0.0 && m.initial_velocity == 0.0 {
-        events.push(Event {
+        events.push(TrajectoryEvent {
             time: 0.0,
-            kind: EventKind::LiftOff,
+            kind: TrajectoryEventKind::LiftOff,
             position: 0.0,
             velocity: 0.0,
         });
@@ -635,19 +644,19 @@ fn contact_segments(
 }
 
 /// Touch and release events of a contact record at the gap `g`.
-fn contact_events(chatter: &Chatter, g: f64) -> Vec<Event> {
+fn contact_events(chatter: &Chatter, g: f64) -> Vec<TrajectoryEvent> {
     let mut events = Vec::with_capacity(2 * chatter.impacts.len() + 2);
     for i in &chatter.impacts {
-        events.push(Event {
+        events.push(TrajectoryEvent {
             time: i.impact_time,
-            kind: EventKind::Touch,
+            kind: TrajectoryEventKind::Touch,
             position: g,
             velocity: i.impact_velocity,
         });
         if let (Some(t), Some(v)) = (i.release_time, i.release_velocity) {
-            events.push(Event {
+            events.push(TrajectoryEvent {
                 time: t,
-                kind: EventKind::Release,
+                kind: TrajectoryEventKind::Release,
                 position: g,
                 velocity: v,
             });
@@ -656,10 +665,10 @@ fn contact_events(chatter: &Chatter, g: f64) -> Vec<Event> {
     events
 }
 
-fn settled(time: f64, g: f64) -> Event {
-    Event {
+fn settled(time: f64, g: f64) -> TrajectoryEvent {
+    TrajectoryEvent {
         time,
-        kind: EventKind::Settled,
+        kind: TrajectoryEventKind::Settled,
         position: g,
         velocity: 0.0,
     }
@@ -667,15 +676,15 @@ fn settled(time: f64, g: f64) -> Event {
 
 /// In time order; at one instant, in the order things happen (a lift-off
 /// before a touch, a touch before its release or its settling).
-fn sort(events: &mut [Event]) {
-    let rank = |k: EventKind| match k {
-        EventKind::Landing => 0,
-        EventKind::Rebound | EventKind::LiftOff => 1,
-        EventKind::Touch => 2,
-        EventKind::Settled => 3,
-        EventKind::Release => 4,
-        EventKind::PoleFace => 5,
-        EventKind::PoleFaceRelease => 6,
+fn sort(events: &mut [TrajectoryEvent]) {
+    let rank = |k: TrajectoryEventKind| match k {
+        TrajectoryEventKind::Landing => 0,
+        TrajectoryEventKind::Rebound | TrajectoryEventKind::LiftOff => 1,
+        TrajectoryEventKind::Touch => 2,
+        TrajectoryEventKind::Settled => 3,
+        TrajectoryEventKind::Release => 4,
+        TrajectoryEventKind::PoleFace => 5,
+        TrajectoryEventKind::PoleFaceRelease => 6,
     };
     events.sort_by(|a, b| {
         a.time

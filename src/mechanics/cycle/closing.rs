@@ -40,7 +40,7 @@
 use super::model::{Ending, Event, Model, Phase, Record, Track};
 use crate::chatter::{Chatter, Outcome, bounces};
 use crate::mechanics::driven::{Drive, State};
-use crate::mechanics::integrate::Step;
+use crate::mechanics::integrate::Dopri5Step;
 use crate::mechanics::linear::LinearPiece;
 use crate::mechanics::segment::Segment;
 use crate::mechanics::surface::{Surface, surface_energy};
@@ -117,7 +117,7 @@ fn kv_tail<D: Drive>(model: &Model<'_, D>, track: &mut Track, t: f64, y: &State)
 pub(super) fn stuck_after<D: Drive>(
     model: &Model<'_, D>,
     rec: &mut Record,
-    step: &Step<3>,
+    step: &Dopri5Step<3>,
 ) -> Option<(Event, f64, State)> {
     let (t1, y1) = (step.t1, step.y1);
     let v_hit = rec.make.impacts.last().map_or(0.0, |i| i.impact_velocity);

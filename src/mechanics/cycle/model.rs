@@ -5,7 +5,7 @@
 
 use crate::chatter::{ContactState, Impact, Interval};
 use crate::mechanics::driven::{Drive, State};
-use crate::mechanics::integrate::{Dopri5, Tolerance};
+use crate::mechanics::integrate::{Dopri5, StepTolerance};
 use crate::mechanics::parameters::{Mechanics, Settings, Stops};
 use crate::mechanics::segment::Segment;
 use crate::mechanics::surface::{Surface, surface_force};
@@ -169,7 +169,7 @@ pub(super) struct Model<'a, D> {
     pub(super) stops: Stops,
     pub(super) settings: Settings,
     pub(super) drive: &'a D,
-    pub(super) tol: Tolerance<3>,
+    pub(super) tol: StepTolerance<3>,
     /// Stop where one closing's ending is decided (a closing run).
     pub(super) closing: bool,
 }

@@ -27,7 +27,7 @@ use crate::mechanics::driven::{Drive, first_true};
 use crate::mechanics::error::{DriveError, MechanicsError};
 use crate::mechanics::forced::Forced;
 use crate::mechanics::parameters::{Mechanics, Settings, Stops};
-use crate::mechanics::step_control::Tolerance;
+use crate::mechanics::step_control::StepTolerance;
 use crate::mechanics::surface::Surface;
 use crate::mechanics::trajectory::{self, Trajectory, simulate_drive};
 
@@ -178,10 +178,10 @@ fn sample<D: Drive>(
 }
 
 /// Tolerances for the state's components.
-fn tolerance<D: Drive>(model: &Relay<'_, D>) -> Tolerance<5> {
+fn tolerance<D: Drive>(model: &Relay<'_, D>) -> StepTolerance<5> {
     let g = model.g();
     let omega = (model.m.stiffness / model.m.mass).sqrt();
-    Tolerance {
+    StepTolerance {
         rtol: RTOL,
         atol: Y::new(
             RTOL * g,
