@@ -5,11 +5,11 @@
 //! for as many pulses as the drive gives (docs/model.md §7).
 //!
 //! This is the one engine for every drive that varies in time or
-//! position. Run as a cycle (`run`) nothing ends before `t_end`: a
+//! position. ClosingRun as a cycle (`run`) nothing ends before `t_end`: a
 //! stuck contact stays in its contact phase and releases by the same rule
 //! that ends every contact (the moving contact back at the surface, moving
 //! out), so the break of the normally-open (NO) contact is found where the
-//! pull no longer holds it. Run as one closing (`run_closing`) it stops
+//! pull no longer holds it. ClosingRun as one closing (`run_closing`) it stops
 //! where the closing's ending is decided, on the understanding that the
 //! drive does not weaken afterwards (`closing`: the sticking test and the
 //! endings at the horizon).
@@ -45,9 +45,9 @@
 //!
 //! Every accepted step is kept, cut at its event, as a segment of the
 //! armature's trajectory; a closing hands the same steps on as
-//! its record (`Run`).
+//! its record (`ClosingRun`).
 
-use super::driven::{self, Drive, State, first_true, monotone_parts, state_on};
+use super::driven::{self, DriveModel, State, first_true, monotone_parts, state_on};
 use super::error::{DriveError, MAX_DRIVEN_STEPS, MAX_EVENTS, MechanicsError};
 use super::integrate::Dopri5Step;
 pub use super::parameters::Stops;
@@ -55,8 +55,8 @@ use super::parameters::{Mechanics, Settings};
 use super::segment::{Segment, path_of};
 use super::surface::Surface;
 use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome};
-pub(crate) use closing::Run;
-use model::{Ending, Event, Model, Phase, Record, Track};
+pub(crate) use closing::ClosingRun;
+use model::{CycleTally, Ending, Model, Phase, PhaseEnd, Track};
 
 mod closing;
 mod model;
@@ -124,7 +124,7 @@ pub struct Cycle {
 
 /// Simulate from t = 0 to `settings.t_end` under `drive`, from the
 /// drive's state `e0`. Parameters must have been validated.
-pub(crate) fn run<D: Drive>(
+pub(crate) fn run_cycle<D: DriveModel>(
     m: &Mechanics,
     stops: &Stops,
     settings: &Settings,
@@ -137,13 +137,13 @@ pub(crate) fn run<D: Drive>(
 /// One closing under `drive` onto `surface`, from the drive's state
 /// `e0`: the same engine, stopped where the closing's ending is decided
 /// ([`closing`]). Parameters must have been validated.
-pub(crate) fn run_closing<D: Drive>(
+pub(crate) fn run_closing<D: DriveModel>(
     m: &Mechanics,
     surface: &Surface,
     settings: &Settings,
     drive: &D,
     e0: f64,
-) -> Result<Run, DriveError> {
+) -> Result<ClosingRun, DriveError> {
     let stops = Stops {
         make: *surface,
         back: None,
@@ -152,7 +152,7 @@ pub(crate) fn run_closing<D: Drive>(
     Ok(closing::finish(&sim.model, sim.rec))
 }
 
-fn simulated<'a, D: Drive>(
+fn simulated<'a, D: DriveModel>(
     m: &Mechanics,
     stops: &Stops,
     settings: &Settings,
@@ -160,7 +160,7 @@ fn simulated<'a, D: Drive>(
     e0: f64,
     closing: bool,
 ) -> Result<Sim<'a, D>, DriveError> {
-    let tol = driven::start(m, drive, e0)?;
+    let tol = driven::start_tolerance(m, drive, e0)?;
     let x0 = m.initial_position;
     let held = x0 == 0.0 && m.initial_velocity <= 0.0;
     let back_state = if held {
@@ -177,7 +177,7 @@ fn simulated<'a, D: Drive>(
             tol,
             closing,
         },
-        rec: Record {
+        rec: CycleTally {
             make: Track::new(ContactState::Open),
             back: Track::new(back_state),
             log: Vec::new(),
@@ -194,11 +194,11 @@ fn simulated<'a, D: Drive>(
 
 struct Sim<'a, D> {
     model: Model<'a, D>,
-    rec: Record,
+    rec: CycleTally,
 }
 
-impl<D: Drive> Sim<'_, D> {
-    /// Run the phases from `phase` at (0, y) to `t_end`.
+impl<D: DriveModel> Sim<'_, D> {
+    /// ClosingRun the phases from `phase` at (0, y) to `t_end`.
     fn simulate(&mut self, mut phase: Phase, mut y: State) -> Result<(), DriveError> {
         let mut t = 0.0;
         loop {
@@ -207,31 +207,31 @@ impl<D: Drive> Sim<'_, D> {
                 return Err(MechanicsError::TooManyEvents { time: t, events }.into());
             }
             let (event, te, mut ye) = self.phase(phase, t, y)?;
-            if self.model.closing && event == Event::Horizon {
+            if self.model.closing && event == PhaseEnd::Horizon {
                 let ending = closing::at_horizon(&self.model, &mut self.rec, phase, te, ye);
                 self.rec.ending = Some(ending);
             }
             let rec = &mut self.rec;
             phase = match event {
-                Event::Horizon | Event::Stuck => return Ok(()),
-                Event::Lift => {
-                    rec.log.push((te, Event::Lift));
+                PhaseEnd::Horizon | PhaseEnd::Stuck => return Ok(()),
+                PhaseEnd::Lift => {
+                    rec.log.push((te, PhaseEnd::Lift));
                     rec.back.change(te, ContactState::Open);
                     rec.back.released = Some((te, 0.0));
                     Phase::Flight
                 }
-                Event::ReleaseMake | Event::Break => {
-                    rec.log.push((te, Event::ReleaseMake));
+                PhaseEnd::ReleaseMake | PhaseEnd::Break => {
+                    rec.log.push((te, PhaseEnd::ReleaseMake));
                     rec.make.release(te, (-ye[1]).max(0.0));
                     Phase::Flight
                 }
-                Event::ReleaseBack => {
-                    rec.log.push((te, Event::ReleaseBack));
+                PhaseEnd::ReleaseBack => {
+                    rec.log.push((te, PhaseEnd::ReleaseBack));
                     rec.back.release(te, ye[1].max(0.0));
                     Phase::Flight
                 }
-                Event::TouchMake => self.touch_make(te, &mut ye),
-                Event::TouchBack => self.touch_back(te, &mut ye),
+                PhaseEnd::TouchMake => self.touch_make(te, &mut ye),
+                PhaseEnd::TouchBack => self.touch_back(te, &mut ye),
             };
             if self.rec.ending.is_some() {
                 return Ok(());
@@ -260,7 +260,7 @@ impl<D: Drive> Sim<'_, D> {
                 _ => Phase::Make,
             };
         }
-        rec.log.push((t, Event::TouchMake));
+        rec.log.push((t, PhaseEnd::TouchMake));
         rec.make.touch(t, speed);
         match model.stops.make {
             Surface::Rigid { restitution } => {
@@ -276,7 +276,7 @@ impl<D: Drive> Sim<'_, D> {
                     return phase;
                 }
                 y[1] = -out;
-                rec.log.push((t, Event::ReleaseMake));
+                rec.log.push((t, PhaseEnd::ReleaseMake));
                 rec.make.release(t, out);
                 Phase::Flight
             }
@@ -295,7 +295,7 @@ impl<D: Drive> Sim<'_, D> {
             self.rec.make.see_force(held_by);
             Phase::Pressed
         } else {
-            self.rec.log.push((t, Event::ReleaseMake));
+            self.rec.log.push((t, PhaseEnd::ReleaseMake));
             self.rec.make.release(t, 0.0);
             Phase::Flight
         }
@@ -327,7 +327,7 @@ impl<D: Drive> Sim<'_, D> {
             rec.jump_loss += 0.5 * mass * speed * speed;
             return rest(y);
         }
-        rec.log.push((t, Event::TouchBack));
+        rec.log.push((t, PhaseEnd::TouchBack));
         rec.back.touch(t, speed);
         let out = match model.stops.back {
             None => 0.0,
@@ -342,7 +342,7 @@ impl<D: Drive> Sim<'_, D> {
             return rest(y);
         }
         y[1] = out;
-        rec.log.push((t, Event::ReleaseBack));
+        rec.log.push((t, PhaseEnd::ReleaseBack));
         rec.back.release(t, out);
         Phase::Flight
     }
@@ -354,18 +354,18 @@ impl<D: Drive> Sim<'_, D> {
         phase: Phase,
         t0: f64,
         y0: State,
-    ) -> Result<(Event, f64, State), DriveError> {
+    ) -> Result<(PhaseEnd, f64, State), DriveError> {
         let (model, rec) = (&self.model, &mut self.rec);
         let g = model.g();
         let t_end = model.settings.t_end;
         if t0 >= t_end {
-            return Ok((Event::Horizon, t0, y0));
+            return Ok((PhaseEnd::Horizon, t0, y0));
         }
         let held = matches!(phase, Phase::Held | Phase::Pressed);
         let (level, ends) = if phase == Phase::Held {
-            (-g, Event::Lift)
+            (-g, PhaseEnd::Lift)
         } else {
-            (0.0, Event::Break)
+            (0.0, PhaseEnd::Break)
         };
         if held && !model.holds(phase, t0, &y0) {
             return Ok((ends, t0, y0));
@@ -430,7 +430,7 @@ impl<D: Drive> Sim<'_, D> {
                 return Ok(found);
             }
             if step.t1 >= t_end {
-                return Ok((Event::Horizon, step.t1, step.y1));
+                return Ok((PhaseEnd::Horizon, step.t1, step.y1));
             }
         }
     }
@@ -488,12 +488,12 @@ fn rest(y: &mut State) -> Phase {
 
 /// The first event of a moving phase inside `step`, with the bookkeeping
 /// of the step (reach, distances, contact forces).
-fn moving_event<D: Drive>(
+fn moving_event<D: DriveModel>(
     model: &Model<'_, D>,
-    rec: &mut Record,
+    rec: &mut CycleTally,
     phase: Phase,
     step: &Dopri5Step<3>,
-) -> Result<Option<(Event, f64, State)>, DriveError> {
+) -> Result<Option<(PhaseEnd, f64, State)>, DriveError> {
     let g = model.g();
     let parts = monotone_parts(step);
     // A crossing of `level` (in u) in the given direction on a monotonic
@@ -523,10 +523,10 @@ fn moving_event<D: Drive>(
     for &(a, b) in parts.spans() {
         found = match phase {
             Phase::Flight => crossing(a, b, 0.0, true)
-                .map(|(t, y)| (Event::TouchMake, t, y))
-                .or_else(|| crossing(a, b, -g, false).map(|(t, y)| (Event::TouchBack, t, y))),
-            Phase::Make => crossing(a, b, 0.0, false).map(|(t, y)| (Event::ReleaseMake, t, y)),
-            Phase::Back => crossing(a, b, -g, true).map(|(t, y)| (Event::ReleaseBack, t, y)),
+                .map(|(t, y)| (PhaseEnd::TouchMake, t, y))
+                .or_else(|| crossing(a, b, -g, false).map(|(t, y)| (PhaseEnd::TouchBack, t, y))),
+            Phase::Make => crossing(a, b, 0.0, false).map(|(t, y)| (PhaseEnd::ReleaseMake, t, y)),
+            Phase::Back => crossing(a, b, -g, true).map(|(t, y)| (PhaseEnd::ReleaseBack, t, y)),
             Phase::Held | Phase::Pressed => None,
         };
         if found.is_some() {
@@ -543,7 +543,7 @@ fn moving_event<D: Drive>(
         rec.see_position(g + yz[0], g);
     }
     rec.see_position(g + y_last[0], g);
-    let track_force = |rec: &mut Record, side: Phase| {
+    let track_force = |rec: &mut CycleTally, side: Phase| {
         // The force at the end, and at its extremum inside the step: a
         // zero of its rate, bisected on the interpolant.
         let rate = |t: f64| {
@@ -580,15 +580,15 @@ fn moving_event<D: Drive>(
 /// s, the lift-offs in an event log: every departure from a held rest,
 /// and every release from the back stop after which the armature next
 /// touches the NO contact (the others are NC bounces).
-fn lift_offs(log: &[(f64, Event)]) -> Vec<f64> {
+fn lift_offs(log: &[(f64, PhaseEnd)]) -> Vec<f64> {
     let mut out = Vec::new();
     for (k, &(t, event)) in log.iter().enumerate() {
         let lifts = match event {
-            Event::Lift => true,
-            Event::ReleaseBack => log[k + 1..]
+            PhaseEnd::Lift => true,
+            PhaseEnd::ReleaseBack => log[k + 1..]
                 .iter()
-                .find(|(_, e)| matches!(e, Event::TouchMake | Event::TouchBack))
-                .is_some_and(|(_, e)| *e == Event::TouchMake),
+                .find(|(_, e)| matches!(e, PhaseEnd::TouchMake | PhaseEnd::TouchBack))
+                .is_some_and(|(_, e)| *e == PhaseEnd::TouchMake),
             _ => false,
         };
         if lifts {

@@ -1,8 +1,8 @@
 //! What the integrated engines (the cycle engine and the two-stage
-//! engine) share with their users: the `Drive` trait (a force that varies
-//! in time and position and may carry a state of its own, such as the
-//! coil's flux), the state the cycle engine integrates, a view of one of
-//! its steps (`Piece`) and the event-location numerics.
+//! engine) share with their users: the `DriveModel` trait (a force that
+//! varies in time and position and may carry a state of its own, such as
+//! the coil's flux), the state the cycle engine integrates, a view of one
+//! of its steps (`Piece`) and the event-location numerics.
 //!
 //! The state is `(u, v, e)`: `u = x − g` (m, the position relative to the
 //! fixed contact, so that the µm penetrations keep their precision), the
@@ -33,8 +33,11 @@ pub(crate) type State = Vector3<f64>;
 /// whole sequence agree with the closed-form engine to ~1e-9.
 pub(crate) const RTOL: f64 = 1e-11;
 
-/// What pushes the armature toward the fixed contact.
-pub(crate) trait Drive {
+/// What pushes the armature toward the fixed contact, as the integrated
+/// engines take it: a force with a state of its own and the work the
+/// sticking tests need. A trajectory's public `Drive` (a step, or a force
+/// `F(t, x)`) becomes one of these; so does the coil on its source.
+pub(crate) trait DriveModel {
     /// N, the force toward closing at time `t` (s), position `x` (m) and
     /// drive state `e`.
     fn force(&self, t: f64, x: f64, e: f64) -> f64;
@@ -53,7 +56,7 @@ pub(crate) trait Drive {
     /// J, the work of the drive with its state `e` held (its own dynamics
     /// stopped) on an armature moving from `from` to `to` (m): the
     /// potential of the energy bound that ends a two-stage closing. By
-    /// default [`Drive::frozen_work`].
+    /// default [`DriveModel::frozen_work`].
     fn held_work(&self, t: f64, e: f64, from: f64, to: f64) -> f64 {
         self.frozen_work(t, e, from, to)
     }
@@ -106,7 +109,7 @@ impl Piece<'_> {
 
 /// The integration tolerance for `m` under `drive`, once the drive is
 /// known to be finite where the run starts (drive state `e0`).
-pub(crate) fn start<D: Drive>(
+pub(crate) fn start_tolerance<D: DriveModel>(
     m: &Mechanics,
     drive: &D,
     e0: f64,

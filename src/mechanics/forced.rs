@@ -9,7 +9,7 @@
 //! reproduces [`super::engine::simulate`].
 
 use super::cycle::{self, Cycle};
-use super::driven::Drive;
+use super::driven::DriveModel;
 use super::error::DriveError;
 use super::parameters::{self, Mechanics, Settings, Stops};
 use super::segment::{Segment, path_of};
@@ -72,7 +72,7 @@ pub fn simulate_cycle(
     let surfaces: Vec<&Surface> = std::iter::once(&stops.make).chain(&stops.back).collect();
     validate(mechanics, &surfaces, settings)?;
     let drive = Forced::new(mechanics, force);
-    cycle::run(mechanics, stops, settings, &drive, 0.0)
+    cycle::run_cycle(mechanics, stops, settings, &drive, 0.0)
 }
 
 /// The engine's checks of the relay (its `force` unused: the drive
@@ -136,7 +136,7 @@ impl<F: Fn(f64, f64) -> f64> Forced<F> {
     }
 }
 
-impl<F: Fn(f64, f64) -> f64> Drive for Forced<F> {
+impl<F: Fn(f64, f64) -> f64> DriveModel for Forced<F> {
     fn force(&self, t: f64, x: f64, _e: f64) -> f64 {
         (self.force)(t, x)
     }

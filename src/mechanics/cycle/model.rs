@@ -1,10 +1,11 @@
 //! The cycle engine's model and records: the relay, its stops and the
 //! drive with the equations of each phase of the motion ([`Model`]), the
-//! events that end a phase, and what a run has recorded so far (each
-//! contact's [`Track`], the event log, the steps; a closing's [`Ending`]).
+//! events that end a phase ([`PhaseEnd`]), and what a run has recorded so
+//! far ([`CycleTally`]: each contact's [`Track`], the event log, the steps;
+//! a closing's [`Ending`]).
 
 use crate::chatter::{ContactState, Impact, Interval};
-use crate::mechanics::driven::{Drive, State};
+use crate::mechanics::driven::{DriveModel, State};
 use crate::mechanics::integrate::{Dopri5, StepTolerance};
 use crate::mechanics::parameters::{Mechanics, Settings, Stops};
 use crate::mechanics::segment::Segment;
@@ -45,7 +46,7 @@ pub(super) enum Phase {
 
 /// What ended a phase.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Event {
+pub(super) enum PhaseEnd {
     Lift,
     TouchMake,
     TouchBack,
@@ -175,11 +176,11 @@ pub(super) struct Model<'a, D> {
 }
 
 /// What the run has produced so far.
-pub(super) struct Record {
+pub(super) struct CycleTally {
     pub(super) make: Track,
     pub(super) back: Track,
     /// Every touch, release and lift-off, in order.
-    pub(super) log: Vec<(f64, Event)>,
+    pub(super) log: Vec<(f64, PhaseEnd)>,
     /// Every accepted step, cut at its event (held ones too).
     pub(super) segments: Vec<Segment>,
     /// m, the largest x reached.
@@ -190,7 +191,7 @@ pub(super) struct Record {
     pub(super) ending: Option<Ending>,
 }
 
-impl Record {
+impl CycleTally {
     /// The armature passed through `x`; the gap is `g`.
     pub(super) fn see_position(&mut self, x: f64, g: f64) {
         self.reach = self.reach.max(x);
@@ -199,7 +200,7 @@ impl Record {
     }
 }
 
-impl<D: Drive> Model<'_, D> {
+impl<D: DriveModel> Model<'_, D> {
     pub(super) fn g(&self) -> f64 {
         self.m.gap
     }

@@ -31,7 +31,7 @@
 
 use super::model::{Modes, Relay, Y};
 use super::relay::Release;
-use crate::mechanics::driven::Drive;
+use crate::mechanics::driven::DriveModel;
 use crate::mechanics::surface::{Surface, surface_energy};
 
 /// Golden-section iterations: the bracket shrinks by 0.618^80 ≈ 2e-17.
@@ -54,7 +54,7 @@ impl EnergyBound {
     }
 
     /// Whether the closed contact can never release again.
-    pub(crate) fn cannot_release<D: Drive>(
+    pub(crate) fn cannot_release<D: DriveModel>(
         &mut self,
         model: &Relay<'_, D>,
         t: f64,
@@ -68,7 +68,7 @@ impl EnergyBound {
     }
 
     /// Whether the open contact can never be reached again.
-    pub(crate) fn cannot_reach<D: Drive>(
+    pub(crate) fn cannot_reach<D: DriveModel>(
         &mut self,
         model: &Relay<'_, D>,
         t: f64,
@@ -95,7 +95,7 @@ struct Frozen<'m, 'a, D> {
     hi: f64,
 }
 
-impl<'m, 'a, D: Drive> Frozen<'m, 'a, D> {
+impl<'m, 'a, D: DriveModel> Frozen<'m, 'a, D> {
     fn at(model: &'m Relay<'a, D>, t: f64, y: &Y) -> Self {
         let m = model.m;
         let g = m.gap;

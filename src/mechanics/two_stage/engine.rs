@@ -16,14 +16,14 @@
 //! adjacent floats. At the event the state is set exactly on the surface
 //! and the integrator restarts in the new mode.
 use super::linear::{LinearSystem, propagate};
-use super::model::{Modes, Relay, Stop, Which, Y, law};
-use super::progress::{Progress, Tally, decided, finish, start};
+use super::model::{Modes, Relay, StopMode, Which, Y, law};
+use super::propagation::{Propagation, Tally, decided, finish, start};
 use super::relay::{Release, TwoStage, validate_all};
 pub use super::run::Horizon;
 use super::run::TwoStageRun;
 use super::span::Span;
 use crate::mechanics::dop853::{Dense, Dop853};
-use crate::mechanics::driven::{Drive, first_true};
+use crate::mechanics::driven::{DriveModel, first_true};
 use crate::mechanics::error::{DriveError, MechanicsError};
 use crate::mechanics::forced::Forced;
 use crate::mechanics::parameters::{Mechanics, Settings, Stops};
@@ -38,7 +38,7 @@ pub(crate) const RTOL: f64 = 1e-11;
 /// Sample points per step at which the event functions are checked.
 const SAMPLES: usize = 4;
 
-impl<D: Drive> Relay<'_, D> {
+impl<D: DriveModel> Relay<'_, D> {
     /// The first event in `(t0, t1]` on `dense`: (time, which).
     fn first_event(&self, dense: &Dense<5>, t1: f64, modes: Modes) -> Option<(f64, Which)> {
         const ALL: [Which; 3] = [Which::Contact, Which::Pole, Which::Rest];
@@ -71,7 +71,7 @@ impl<D: Drive> Relay<'_, D> {
 
 /// Simulate the relay of `model` from the drive's state `e0` to
 /// `horizon`. Parameters must have been validated.
-pub(crate) fn run<D: Drive>(
+pub(crate) fn run_relay<D: DriveModel>(
     model: &Relay<'_, D>,
     settings: &Settings,
     e0: f64,
@@ -86,11 +86,11 @@ pub(crate) fn run<D: Drive>(
 }
 
 /// DOP853 from event to event, to the horizon.
-fn integrate<D: Drive>(
+fn integrate<D: DriveModel>(
     model: &Relay<'_, D>,
     settings: &Settings,
     horizon: Horizon,
-    p: &mut Progress,
+    p: &mut Propagation,
 ) -> Result<(), DriveError> {
     let tol = tolerance(model);
     let mut h = 0.05 / fastest(model);
@@ -144,7 +144,7 @@ fn integrate<D: Drive>(
 
 /// The error when the armature has pressed through to the magnet's pole
 /// (the drive's model ends there) at `time`.
-fn pole_limit<D: Drive>(model: &Relay<'_, D>, y: &Y, time: f64) -> Option<DriveError> {
+fn pole_limit<D: DriveModel>(model: &Relay<'_, D>, y: &Y, time: f64) -> Option<DriveError> {
     let pole = model.drive.pole();
     let position = model.g() + y[0];
     (position >= pole).then_some(DriveError::ArmatureAtPole {
@@ -156,7 +156,7 @@ fn pole_limit<D: Drive>(model: &Relay<'_, D>, y: &Y, time: f64) -> Option<DriveE
 
 /// Peak and minimum contact forces and the largest opening after each
 /// release, sampled on the dense output of a step up to `t1`.
-fn sample<D: Drive>(
+fn sample<D: DriveModel>(
     model: &Relay<'_, D>,
     dense: &Dense<5>,
     t1: f64,
@@ -168,7 +168,7 @@ fn sample<D: Drive>(
         let t = t0 + (t1 - t0) * k as f64 / SAMPLES as f64;
         rec.observe(model.g(), modes, &dense.at(t), |y| match modes.contact {
             // Pressed on a rigid contact: the blade's spring is the force.
-            Stop::Pressed => model.blade_force(y),
+            StopMode::Pressed => model.blade_force(y),
             // F_c = max(0, ·) released by force: zero, not a rounding
             // below it, where the contact lets go.
             _ if model.build.release == Release::Force => law(&model.contact, y[2], y[3]).max(0.0),
@@ -178,7 +178,7 @@ fn sample<D: Drive>(
 }
 
 /// Tolerances for the state's components.
-fn tolerance<D: Drive>(model: &Relay<'_, D>) -> StepTolerance<5> {
+fn tolerance<D: DriveModel>(model: &Relay<'_, D>) -> StepTolerance<5> {
     let g = model.g();
     let omega = (model.m.stiffness / model.m.mass).sqrt();
     StepTolerance {
@@ -194,7 +194,7 @@ fn tolerance<D: Drive>(model: &Relay<'_, D>) -> StepTolerance<5> {
 }
 
 /// rad/s, the fastest natural frequency in the model (the first trial step).
-fn fastest<D: Drive>(model: &Relay<'_, D>) -> f64 {
+fn fastest<D: DriveModel>(model: &Relay<'_, D>) -> f64 {
     let m = model.m;
     let mut w = (m.stiffness / m.mass).sqrt();
     let mass_at_contact = model.build.blade.map_or(m.mass, |b| b.mass);
@@ -212,13 +212,13 @@ fn fastest<D: Drive>(model: &Relay<'_, D>) -> f64 {
     w
 }
 
-/// A constant force (the step drive), as a [`Drive`].
+/// A constant force (the step drive), as a [`DriveModel`].
 pub(crate) struct Constant {
     force: f64,
     time_scale: f64,
 }
 
-impl Drive for Constant {
+impl DriveModel for Constant {
     fn force(&self, _t: f64, _x: f64, _e: f64) -> f64 {
         self.force
     }
@@ -313,7 +313,7 @@ pub fn simulate_two_stage(
                 rest: false,
                 drive: &constant,
             };
-            run(&model, settings, 0.0, horizon)
+            run_relay(&model, settings, 0.0, horizon)
         }
         trajectory::Drive::Force(force) => {
             if m.initial_position < 0.0 {
@@ -332,7 +332,7 @@ pub fn simulate_two_stage(
                 rest: true,
                 drive: &forced,
             };
-            run(&model, settings, 0.0, horizon)
+            run_relay(&model, settings, 0.0, horizon)
         }
     }
 }

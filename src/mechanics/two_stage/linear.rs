@@ -32,13 +32,13 @@ use std::sync::Arc;
 use nalgebra::{Matrix4, Vector4};
 
 use super::mode::{Form, LinearMode, Poly, Taylor, W};
-use super::model::{Modes, Relay, Stop, Which, Y};
-use super::progress::{Progress, decided};
+use super::model::{Modes, Relay, StopMode, Which, Y};
+use super::propagation::{Propagation, decided};
 use super::relay::Release;
 use super::run::Horizon;
 use super::span::{Interpolant, Span};
 use crate::chatter::Outcome;
-use crate::mechanics::driven::Drive;
+use crate::mechanics::driven::DriveModel;
 use crate::mechanics::error::DriveError;
 use crate::mechanics::parameters::Settings;
 use crate::mechanics::surface::Surface;
@@ -93,7 +93,7 @@ impl LinearSystem {
     /// The linear system of `model`, when it is one: a constant force (no
     /// rest stop), a blade, a Kelvin–Voigt contact, and a Kelvin–Voigt
     /// pole face or none.
-    pub(crate) fn of<D: Drive>(model: &Relay<'_, D>) -> Option<LinearSystem> {
+    pub(crate) fn of<D: DriveModel>(model: &Relay<'_, D>) -> Option<LinearSystem> {
         let force = model.drive.constant()?;
         let blade = model.build.blade?;
         if model.rest {
@@ -201,8 +201,8 @@ impl LinearSystem {
         let mut out = vec![(
             Which::Contact,
             match (modes.contact, self.by_force) {
-                (Stop::Open, false) => Guard::One(ub.negated()),
-                (Stop::Open, true) => Guard::Max(ub.negated(), push.negated()),
+                (StopMode::Open, false) => Guard::One(ub.negated()),
+                (StopMode::Open, true) => Guard::Max(ub.negated(), push.negated()),
                 (_, false) => Guard::One(ub),
                 (_, true) => Guard::Min(ub, push),
             },
@@ -213,8 +213,8 @@ impl LinearSystem {
             out.push((
                 Which::Pole,
                 match (modes.pole, by_force) {
-                    (Stop::Open, false) => Guard::One(delta.negated()),
-                    (Stop::Open, true) => Guard::Max(delta.negated(), push.negated()),
+                    (StopMode::Open, false) => Guard::One(delta.negated()),
+                    (StopMode::Open, true) => Guard::Max(delta.negated(), push.negated()),
                     (_, false) => Guard::One(delta),
                     (_, true) => Guard::Min(delta, push),
                 },
@@ -272,8 +272,8 @@ impl LinearSystem {
             return None;
         }
         match modes.contact {
-            Stop::Open if y[2] < 0.0 => Some(Outcome::EndsOpen),
-            Stop::Open => None,
+            StopMode::Open if y[2] < 0.0 => Some(Outcome::EndsOpen),
+            StopMode::Open => None,
             _ => Some(Outcome::Stuck),
         }
     }
@@ -358,21 +358,24 @@ fn first_event(
 }
 
 /// Propagate `p` exactly from event to event, to the horizon.
-pub(crate) fn propagate<D: Drive>(
+pub(crate) fn propagate<D: DriveModel>(
     system: &LinearSystem,
     model: &Relay<'_, D>,
     settings: &Settings,
     horizon: Horizon,
-    p: &mut Progress,
+    p: &mut Propagation,
 ) -> Result<(), DriveError> {
     let mut cache: [Option<Arc<LinearMode>>; 4] = [None, None, None, None];
     let force_form = |mode: &LinearMode| mode.form([0.0, 0.0, system.s0, system.r0], 0.0);
     while p.t < settings.t_end && p.ending.is_none() {
-        let key = usize::from(p.modes.contact != Stop::Open)
-            + 2 * usize::from(p.modes.pole != Stop::Open);
+        let key = usize::from(p.modes.contact != StopMode::Open)
+            + 2 * usize::from(p.modes.pole != StopMode::Open);
         let mode = cache[key]
             .get_or_insert_with(|| {
-                Arc::new(system.mode(p.modes.contact != Stop::Open, p.modes.pole != Stop::Open))
+                Arc::new(system.mode(
+                    p.modes.contact != StopMode::Open,
+                    p.modes.pole != StopMode::Open,
+                ))
             })
             .clone();
         let guards = system.guards(&mode, p.modes);
@@ -457,7 +460,7 @@ pub(crate) fn propagate<D: Drive>(
 #[allow(clippy::too_many_arguments)] // one step's states, rates and forms, as the loop has them
 fn track(
     system: &LinearSystem,
-    p: &mut Progress,
+    p: &mut Propagation,
     mode: &LinearMode,
     (w0, w1): (&W, &W),
     (aw0, aw1): (&W, &W),
@@ -475,7 +478,7 @@ fn track(
     at(w1);
     // An opening's largest gap (or the reach before the first touch) and
     // a contact's peak and least force are where their rates turn.
-    let watched = if p.modes.contact == Stop::Open {
+    let watched = if p.modes.contact == StopMode::Open {
         ub
     } else {
         force

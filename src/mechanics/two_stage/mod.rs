@@ -34,7 +34,7 @@
 //! engines share (`model.rs`: state, modes, equations of motion), one
 //! linear mode (`mode.rs`), the motion piece by piece (`span.rs`), the
 //! run's result (`run.rs`), the energy bound (`energy.rs`), a run in
-//! progress (`progress.rs`: events, records, endings), the exact
+//! progress (`propagation.rs`: events, records, endings), the exact
 //! propagator (`linear.rs`) and the integrating one with the entry points
 //! ([`engine`]). This file only declares and re-exports.
 
@@ -43,7 +43,7 @@ pub mod engine;
 pub(crate) mod linear;
 mod mode;
 pub(crate) mod model;
-mod progress;
+mod propagation;
 mod relay;
 pub(crate) mod run;
 pub(crate) mod span;

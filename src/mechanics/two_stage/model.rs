@@ -6,7 +6,7 @@
 use nalgebra::SVector;
 
 use super::relay::{Release, TwoStage};
-use crate::mechanics::driven::Drive;
+use crate::mechanics::driven::DriveModel;
 use crate::mechanics::parameters::Mechanics;
 use crate::mechanics::surface::Surface;
 
@@ -15,7 +15,7 @@ pub(crate) type Y = SVector<f64, 5>;
 
 /// What holds a body at a stop.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Stop {
+pub(crate) enum StopMode {
     Open,
     Engaged,
     Pressed,
@@ -24,9 +24,9 @@ pub(crate) enum Stop {
 /// The three stops' modes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct Modes {
-    pub(crate) contact: Stop,
-    pub(crate) pole: Stop,
-    pub(crate) rest: Stop,
+    pub(crate) contact: StopMode,
+    pub(crate) pole: StopMode,
+    pub(crate) rest: StopMode,
 }
 
 /// Which stop an event belongs to.
@@ -68,7 +68,7 @@ pub(super) fn law(surface: &Surface, delta: f64, rate: f64) -> f64 {
     }
 }
 
-impl<D: Drive> Relay<'_, D> {
+impl<D: DriveModel> Relay<'_, D> {
     pub(super) fn g(&self) -> f64 {
         self.m.gap
     }
@@ -85,7 +85,7 @@ impl<D: Drive> Relay<'_, D> {
     }
 
     fn contact_force(&self, y: &Y, modes: Modes) -> f64 {
-        if modes.contact == Stop::Engaged {
+        if modes.contact == StopMode::Engaged {
             law(&self.contact, y[2], y[3])
         } else {
             0.0
@@ -94,14 +94,14 @@ impl<D: Drive> Relay<'_, D> {
 
     fn pole_force(&self, y: &Y, modes: Modes) -> f64 {
         match (&self.build.pole_face, modes.pole) {
-            (Some(p), Stop::Engaged) => law(&p.surface, y[0] - p.overtravel, y[1]),
+            (Some(p), StopMode::Engaged) => law(&p.surface, y[0] - p.overtravel, y[1]),
             _ => 0.0,
         }
     }
 
     fn rest_force(&self, y: &Y, modes: Modes) -> f64 {
         match (&self.back, modes.rest) {
-            (Some(b), Stop::Engaged) => law(b, -(self.g() + y[0]), -y[1]),
+            (Some(b), StopMode::Engaged) => law(b, -(self.g() + y[0]), -y[1]),
             _ => 0.0,
         }
     }
@@ -125,9 +125,9 @@ impl<D: Drive> Relay<'_, D> {
     }
 
     fn armature_held(&self, modes: Modes) -> bool {
-        modes.pole == Stop::Pressed
-            || modes.rest == Stop::Pressed
-            || (self.build.blade.is_none() && modes.contact == Stop::Pressed)
+        modes.pole == StopMode::Pressed
+            || modes.rest == StopMode::Pressed
+            || (self.build.blade.is_none() && modes.contact == StopMode::Pressed)
     }
 
     pub(crate) fn rate(&self, t: f64, y: &Y, modes: Modes) -> Y {
@@ -140,7 +140,7 @@ impl<D: Drive> Relay<'_, D> {
         };
         let (ub, ab) = match &self.build.blade {
             None => (ua, aa),
-            Some(_) if modes.contact == Stop::Pressed => (0.0, 0.0),
+            Some(_) if modes.contact == StopMode::Pressed => (0.0, 0.0),
             Some(b) => (
                 y[3],
                 (self.blade_force(y) - self.contact_force(y, modes)) / b.mass,
@@ -160,11 +160,11 @@ impl<D: Drive> Relay<'_, D> {
                 let s = &self.contact;
                 let by_force = force_rule(self.build.release, s);
                 match modes.contact {
-                    Stop::Open if by_force => (-y[2]).max(-push(s, y[2], y[3])),
-                    Stop::Open => -y[2],
-                    Stop::Engaged if by_force => y[2].min(push(s, y[2], y[3])),
-                    Stop::Engaged => y[2],
-                    Stop::Pressed => match self.build.blade {
+                    StopMode::Open if by_force => (-y[2]).max(-push(s, y[2], y[3])),
+                    StopMode::Open => -y[2],
+                    StopMode::Engaged if by_force => y[2].min(push(s, y[2], y[3])),
+                    StopMode::Engaged => y[2],
+                    StopMode::Pressed => match self.build.blade {
                         Some(_) => self.blade_force(y),
                         None => self.armature_push(t, y, modes),
                     },
@@ -177,11 +177,11 @@ impl<D: Drive> Relay<'_, D> {
                 let by_force = force_rule(p.release, &p.surface);
                 let delta = y[0] - p.overtravel;
                 match modes.pole {
-                    Stop::Open if by_force => (-delta).max(-push(&p.surface, delta, y[1])),
-                    Stop::Open => -delta,
-                    Stop::Engaged if by_force => delta.min(push(&p.surface, delta, y[1])),
-                    Stop::Engaged => delta,
-                    Stop::Pressed => self.armature_push(t, y, modes),
+                    StopMode::Open if by_force => (-delta).max(-push(&p.surface, delta, y[1])),
+                    StopMode::Open => -delta,
+                    StopMode::Engaged if by_force => delta.min(push(&p.surface, delta, y[1])),
+                    StopMode::Engaged => delta,
+                    StopMode::Pressed => self.armature_push(t, y, modes),
                 }
             }
             Which::Rest => {
@@ -190,9 +190,9 @@ impl<D: Drive> Relay<'_, D> {
                 }
                 let x = self.g() + y[0];
                 match modes.rest {
-                    Stop::Open => x,
-                    Stop::Engaged => -x,
-                    Stop::Pressed => -self.armature_push(t, y, modes),
+                    StopMode::Open => x,
+                    StopMode::Engaged => -x,
+                    StopMode::Pressed => -self.armature_push(t, y, modes),
                 }
             }
         }

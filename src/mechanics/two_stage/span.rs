@@ -5,7 +5,7 @@
 use std::sync::Arc;
 
 use super::mode::{LinearMode, W};
-use super::model::{Modes, Stop, Y};
+use super::model::{Modes, StopMode, Y};
 use crate::mechanics::dop853::Dense;
 
 /// How a piece's state is had between its ends.
@@ -53,7 +53,7 @@ impl Span {
 
     /// Whether the contact is closed over this piece.
     pub(crate) fn contact_closed(&self) -> bool {
-        self.modes.contact != Stop::Open
+        self.modes.contact != StopMode::Open
     }
 }
 

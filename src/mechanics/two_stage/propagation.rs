@@ -1,17 +1,18 @@
-//! A two-stage run in progress, as both propagators drive it: where it
-//! is and in which modes ([`Progress`]), what it has recorded ([`Tally`]),
+//! A two-stage run in progress, as both propagators drive it from event
+//! to event: where it is and in which modes ([`Propagation`]), what it has
+//! recorded ([`Tally`]),
 //! how an event changes the modes and the records ([`transition`]), when
 //! a closing's ending is decided ([`decided`]), and the records it
 //! returns.
 
 use super::energy::EnergyBound;
-use super::model::{Modes, Relay, Stop, Which, Y};
+use super::model::{Modes, Relay, StopMode, Which, Y};
 use super::run::{Horizon, TwoStageRun};
 use super::span::Span;
 use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome};
 use crate::mechanics::cycle::{Stroke, strokes, summary};
 use crate::mechanics::dop853::Dense;
-use crate::mechanics::driven::Drive;
+use crate::mechanics::driven::DriveModel;
 use crate::mechanics::error::{DriveError, MAX_DRIVEN_STEPS, MAX_EVENTS};
 use crate::mechanics::parameters::{Mechanics, Settings};
 use crate::mechanics::surface::Surface;
@@ -39,14 +40,14 @@ impl Tally {
     /// first touch.
     pub(crate) fn observe(&mut self, gap: f64, modes: Modes, y: &Y, force: impl Fn(&Y) -> f64) {
         match modes.contact {
-            Stop::Engaged | Stop::Pressed => {
+            StopMode::Engaged | StopMode::Pressed => {
                 let f = force(y);
                 if let Some(last) = self.contact.last_mut() {
                     last.peak_force = Some(last.peak_force.map_or(f, |p: f64| p.max(f)));
                     last.min_force = Some(last.min_force.map_or(f, |p: f64| p.min(f)));
                 }
             }
-            Stop::Open => match self.contact.last_mut() {
+            StopMode::Open => match self.contact.last_mut() {
                 Some(last) => {
                     let opening = (-y[2]).max(0.0);
                     last.max_gap_after =
@@ -80,7 +81,7 @@ fn release(impact: &mut Impact, t: f64, v: f64) {
 }
 
 /// A run in progress: where it is, in which modes, and what it recorded.
-pub(crate) struct Progress {
+pub(crate) struct Propagation {
     pub t: f64,
     pub y: Y,
     pub modes: Modes,
@@ -92,9 +93,9 @@ pub(crate) struct Progress {
     pub ending: Option<Outcome>,
 }
 
-impl Progress {
+impl Propagation {
     /// Apply the event of `which` at `t` (state `y` there, before it).
-    pub(crate) fn event<D: Drive>(
+    pub(crate) fn event<D: DriveModel>(
         &mut self,
         model: &Relay<'_, D>,
         settings: &Settings,
@@ -135,22 +136,22 @@ impl Progress {
 }
 
 /// The state at t = 0: on the rest stop when the drive does not lift it.
-pub(super) fn start<D: Drive>(model: &Relay<'_, D>, e0: f64) -> Progress {
+pub(super) fn start<D: DriveModel>(model: &Relay<'_, D>, e0: f64) -> Propagation {
     let m = model.m;
     let g = m.gap;
     let x0 = m.initial_position;
     let mut y = Y::new(x0 - g, m.initial_velocity, x0 - g, m.initial_velocity, e0);
     let mut modes = Modes {
-        contact: Stop::Open,
-        pole: Stop::Open,
-        rest: Stop::Open,
+        contact: StopMode::Open,
+        pole: StopMode::Open,
+        rest: StopMode::Open,
     };
     if model.rest
         && x0 == 0.0
         && m.initial_velocity <= 0.0
         && model.armature_push(0.0, &y, modes) <= 0.0
     {
-        modes.rest = Stop::Pressed;
+        modes.rest = StopMode::Pressed;
         y[1] = 0.0;
     }
     let mut rec = Tally {
@@ -163,7 +164,7 @@ pub(super) fn start<D: Drive>(model: &Relay<'_, D>, e0: f64) -> Progress {
         pole: Vec::new(),
         back: Vec::new(),
         back_intervals: vec![Interval {
-            state: if modes.rest == Stop::Pressed {
+            state: if modes.rest == StopMode::Pressed {
                 ContactState::Closed
             } else {
                 ContactState::Open
@@ -174,12 +175,12 @@ pub(super) fn start<D: Drive>(model: &Relay<'_, D>, e0: f64) -> Progress {
         lift_offs: Vec::new(),
         reach: x0,
     };
-    if modes.rest == Stop::Pressed {
+    if modes.rest == StopMode::Pressed {
         rec.back.push(Impact::touch(0.0, 0.0));
     } else if model.rest && x0 == 0.0 {
         rec.lift_offs.push(0.0);
     }
-    Progress {
+    Propagation {
         t: 0.0,
         y,
         modes,
@@ -192,11 +193,11 @@ pub(super) fn start<D: Drive>(model: &Relay<'_, D>, e0: f64) -> Progress {
 }
 
 /// The run's records, with the motion held where it stopped to `t_end`.
-pub(super) fn finish<D: Drive>(
+pub(super) fn finish<D: DriveModel>(
     model: &Relay<'_, D>,
     settings: &Settings,
     horizon: Horizon,
-    mut p: Progress,
+    mut p: Propagation,
 ) -> TwoStageRun {
     let t_end = settings.t_end;
     if p.t < t_end {
@@ -256,7 +257,7 @@ pub(super) fn finish<D: Drive>(
 
 /// The closing's chatter: its ending decided by the energy bound, or read
 /// at the horizon.
-pub(crate) fn closing_summary<D: Drive>(
+pub(crate) fn closing_summary<D: DriveModel>(
     model: &Relay<'_, D>,
     bound: &mut EnergyBound,
     rec: &mut Tally,
@@ -266,12 +267,12 @@ pub(crate) fn closing_summary<D: Drive>(
 ) -> Chatter {
     let impacts = std::mem::take(&mut rec.contact);
     let intervals = std::mem::take(&mut rec.intervals);
-    let closed = modes.contact != Stop::Open;
+    let closed = modes.contact != StopMode::Open;
     let outcome = match ending {
         Some(o) => o,
         None if impacts.is_empty() => Outcome::NeverCloses,
         None if closed => {
-            if modes.contact == Stop::Pressed || bound.cannot_release(model, t, &y, modes) {
+            if modes.contact == StopMode::Pressed || bound.cannot_release(model, t, &y, modes) {
                 Outcome::Stuck
             } else {
                 Outcome::EndOfTime
@@ -307,7 +308,7 @@ pub(crate) fn closing_summary<D: Drive>(
 
 /// Whether a closing's ending is decided at `t`: the contact closed and
 /// unable to release, or open after touching and unable to reach it again.
-pub(crate) fn decided<D: Drive>(
+pub(crate) fn decided<D: DriveModel>(
     model: &Relay<'_, D>,
     bound: &mut EnergyBound,
     t: f64,
@@ -319,15 +320,15 @@ pub(crate) fn decided<D: Drive>(
         return None;
     }
     match modes.contact {
-        Stop::Engaged if bound.cannot_release(model, t, y, modes) => Some(Outcome::Stuck),
-        Stop::Open if bound.cannot_reach(model, t, y, modes) => Some(Outcome::EndsOpen),
+        StopMode::Engaged if bound.cannot_release(model, t, y, modes) => Some(Outcome::Stuck),
+        StopMode::Open if bound.cannot_reach(model, t, y, modes) => Some(Outcome::EndsOpen),
         _ => None,
     }
 }
 
 /// Apply the event of `which` at `t` to the state and the records; the
 /// new modes.
-pub(crate) fn transition<D: Drive>(
+pub(crate) fn transition<D: DriveModel>(
     model: &Relay<'_, D>,
     settings: &Settings,
     which: Which,
@@ -340,7 +341,7 @@ pub(crate) fn transition<D: Drive>(
     let no_blade = model.build.blade.is_none();
     match which {
         Which::Contact => match modes.contact {
-            Stop::Open => {
+            StopMode::Open => {
                 if y[2] <= 0.0 {
                     y[2] = 0.0;
                     if no_blade {
@@ -361,11 +362,11 @@ pub(crate) fn transition<D: Drive>(
                         restitution,
                         rec,
                     ),
-                    _ => Stop::Engaged,
+                    _ => StopMode::Engaged,
                 };
             }
-            Stop::Engaged | Stop::Pressed => {
-                if modes.contact == Stop::Engaged && y[2] <= 0.0 {
+            StopMode::Engaged | StopMode::Pressed => {
+                if modes.contact == StopMode::Engaged && y[2] <= 0.0 {
                     y[2] = 0.0;
                     if no_blade {
                         y[0] = 0.0;
@@ -375,13 +376,13 @@ pub(crate) fn transition<D: Drive>(
                     release(last, t, y[3]);
                 }
                 Tally::switch(&mut rec.intervals, t, ContactState::Open);
-                modes.contact = Stop::Open;
+                modes.contact = StopMode::Open;
             }
         },
         Which::Pole => {
             let o = model.overtravel();
             match modes.pole {
-                Stop::Open => {
+                StopMode::Open => {
                     if y[0] <= o {
                         y[0] = o;
                     }
@@ -391,22 +392,22 @@ pub(crate) fn transition<D: Drive>(
                         Some(Surface::Rigid { restitution }) => {
                             rigid(model, settings, Which::Pole, t, y, modes, restitution, rec)
                         }
-                        _ => Stop::Engaged,
+                        _ => StopMode::Engaged,
                     };
                 }
-                Stop::Engaged | Stop::Pressed => {
-                    if modes.pole == Stop::Engaged && y[0] <= o {
+                StopMode::Engaged | StopMode::Pressed => {
+                    if modes.pole == StopMode::Engaged && y[0] <= o {
                         y[0] = o;
                     }
                     if let Some(last) = rec.pole.last_mut() {
                         release(last, t, y[1]);
                     }
-                    modes.pole = Stop::Open;
+                    modes.pole = StopMode::Open;
                 }
             }
         }
         Which::Rest => match modes.rest {
-            Stop::Open => {
+            StopMode::Open => {
                 y[0] = -g;
                 if no_blade {
                     y[2] = -g;
@@ -419,15 +420,15 @@ pub(crate) fn transition<D: Drive>(
                         if no_blade {
                             y[3] = 0.0;
                         }
-                        Stop::Pressed
+                        StopMode::Pressed
                     }
                     Some(Surface::Rigid { restitution }) => {
                         rigid(model, settings, Which::Rest, t, y, modes, restitution, rec)
                     }
-                    Some(_) => Stop::Engaged,
+                    Some(_) => StopMode::Engaged,
                 };
             }
-            Stop::Engaged | Stop::Pressed => {
+            StopMode::Engaged | StopMode::Pressed => {
                 y[0] = -g;
                 if no_blade {
                     y[2] = -g;
@@ -437,7 +438,7 @@ pub(crate) fn transition<D: Drive>(
                 }
                 Tally::switch(&mut rec.back_intervals, t, ContactState::Open);
                 rec.lift_offs.push(t);
-                modes.rest = Stop::Open;
+                modes.rest = StopMode::Open;
             }
         },
     }
@@ -449,7 +450,7 @@ pub(crate) fn transition<D: Drive>(
 /// below resolution (shorter than `min_open_time` or smaller than
 /// `min_gap`). Returns the stop's new mode; records the rebound.
 #[allow(clippy::too_many_arguments)]
-fn rigid<D: Drive>(
+fn rigid<D: DriveModel>(
     model: &Relay<'_, D>,
     settings: &Settings,
     which: Which,
@@ -458,7 +459,7 @@ fn rigid<D: Drive>(
     modes: Modes,
     e: f64,
     rec: &mut Tally,
-) -> Stop {
+) -> StopMode {
     let no_blade = model.build.blade.is_none();
     // The velocity components of the body that hits, and its sign toward
     // the stop.
@@ -471,9 +472,9 @@ fn rigid<D: Drive>(
     let w = e * v.abs();
     let mut open = modes;
     match which {
-        Which::Contact => open.contact = Stop::Open,
-        Which::Pole => open.pole = Stop::Open,
-        Which::Rest => open.rest = Stop::Open,
+        Which::Contact => open.contact = StopMode::Open,
+        Which::Pole => open.pole = StopMode::Open,
+        Which::Rest => open.rest = StopMode::Open,
     }
     let set_v = |y: &mut Y, value: f64| {
         y[idx] = value;
@@ -496,7 +497,7 @@ fn rigid<D: Drive>(
     };
     if pressed {
         set_v(y, 0.0);
-        Stop::Pressed
+        StopMode::Pressed
     } else {
         if let Some(last) = list.last_mut() {
             release(last, t, -w);
@@ -512,6 +513,6 @@ fn rigid<D: Drive>(
         if which == Which::Rest {
             rec.lift_offs.push(t);
         }
-        Stop::Open
+        StopMode::Open
     }
 }
