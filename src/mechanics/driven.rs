@@ -166,14 +166,14 @@ pub(crate) fn sign_change(f: impl Fn(f64) -> f64, lo: f64, hi: f64) -> Option<f6
 }
 
 /// A step split at the velocity zero it may contain.
-pub(crate) struct Parts {
+pub(crate) struct MonotoneParts {
     bounds: [(f64, f64); 2],
     n: usize,
     /// (time, state) of the turning point, if any.
     pub turn: Option<(f64, State)>,
 }
 
-impl Parts {
+impl MonotoneParts {
     /// The one or two time spans on which x is monotonic, in order.
     pub fn spans(&self) -> &[(f64, f64)] {
         &self.bounds[..self.n]
@@ -182,7 +182,7 @@ impl Parts {
 
 /// The step split at the velocity zero it may contain: up to two parts,
 /// each with x monotonic, and the turning point if any.
-pub(crate) fn monotone_parts(step: &Dopri5Step<3>) -> Parts {
+pub(crate) fn monotone_parts(step: &Dopri5Step<3>) -> MonotoneParts {
     let (v0, v1) = (step.y0[1], step.y1[1]);
     if (v0 > 0.0 && v1 < 0.0) || (v0 < 0.0 && v1 > 0.0) {
         let up = v0 > 0.0;
@@ -195,13 +195,13 @@ pub(crate) fn monotone_parts(step: &Dopri5Step<3>) -> Parts {
             step.t1,
         );
         let yz = step.at(tz);
-        Parts {
+        MonotoneParts {
             bounds: [(step.t0, tz), (tz, step.t1)],
             n: 2,
             turn: Some((tz, yz)),
         }
     } else {
-        Parts {
+        MonotoneParts {
             bounds: [(step.t0, step.t1), (0.0, 0.0)],
             n: 1,
             turn: None,

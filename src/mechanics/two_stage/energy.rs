@@ -29,7 +29,7 @@
 //! Minima of a convex function of one variable are found by golden
 //! section; of two, by golden section nested in golden section.
 
-use super::model::{Modes, Relay, Y};
+use super::model::{Relay, StopModes, Y};
 use super::relay::Release;
 use crate::mechanics::driven::DriveModel;
 use crate::mechanics::surface::{Surface, surface_energy};
@@ -59,7 +59,7 @@ impl EnergyBound {
         model: &Relay<'_, D>,
         t: f64,
         y: &Y,
-        _modes: Modes,
+        _modes: StopModes,
     ) -> bool {
         let frozen = Frozen::at(model, t, y);
         let e = frozen.energy(y);
@@ -73,7 +73,7 @@ impl EnergyBound {
         model: &Relay<'_, D>,
         t: f64,
         y: &Y,
-        _modes: Modes,
+        _modes: StopModes,
     ) -> bool {
         if y[2] > 0.0 {
             return false;

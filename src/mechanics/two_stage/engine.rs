@@ -16,7 +16,7 @@
 //! adjacent floats. At the event the state is set exactly on the surface
 //! and the integrator restarts in the new mode.
 use super::linear::{LinearSystem, propagate};
-use super::model::{Modes, Relay, StopMode, Which, Y, law};
+use super::model::{Relay, StopMode, StopModes, Which, Y, law};
 use super::propagation::{Propagation, Tally, decided, finish, start};
 use super::relay::{Release, TwoStage, validate_all};
 pub use super::run::Horizon;
@@ -40,7 +40,7 @@ const SAMPLES: usize = 4;
 
 impl<D: DriveModel> Relay<'_, D> {
     /// The first event in `(t0, t1]` on `dense`: (time, which).
-    fn first_event(&self, dense: &Dense<5>, t1: f64, modes: Modes) -> Option<(f64, Which)> {
+    fn first_event(&self, dense: &Dense<5>, t1: f64, modes: StopModes) -> Option<(f64, Which)> {
         const ALL: [Which; 3] = [Which::Contact, Which::Pole, Which::Rest];
         let t0 = dense.t0;
         let mut lo = t0;
@@ -160,7 +160,7 @@ fn sample<D: DriveModel>(
     model: &Relay<'_, D>,
     dense: &Dense<5>,
     t1: f64,
-    modes: Modes,
+    modes: StopModes,
     rec: &mut Tally,
 ) {
     let t0 = dense.t0;

@@ -32,7 +32,7 @@ use std::sync::Arc;
 use nalgebra::{Matrix4, Vector4};
 
 use super::mode::{Form, LinearMode, Poly, Taylor, W};
-use super::model::{Modes, Relay, StopMode, Which, Y};
+use super::model::{Relay, StopMode, StopModes, Which, Y};
 use super::propagation::{Propagation, decided};
 use super::relay::Release;
 use super::run::Horizon;
@@ -195,7 +195,7 @@ impl LinearSystem {
 
     /// The event functions of `modes` in `mode`, each positive while the
     /// mode lasts.
-    fn guards(&self, mode: &LinearMode, modes: Modes) -> Vec<(Which, Guard)> {
+    fn guards(&self, mode: &LinearMode, modes: StopModes) -> Vec<(Which, Guard)> {
         let ub = mode.form([0.0, 0.0, 1.0, 0.0], 0.0);
         let push = mode.form([0.0, 0.0, self.s0, self.r0], 0.0);
         let mut out = vec![(
@@ -261,7 +261,7 @@ impl LinearSystem {
     }
 
     /// Whether the energy bound decides the closing at state `y`.
-    fn decided(&self, y: &Y, modes: Modes, touched: bool) -> Option<Outcome> {
+    fn decided(&self, y: &Y, modes: StopModes, touched: bool) -> Option<Outcome> {
         if !touched || self.by_force {
             return None;
         }

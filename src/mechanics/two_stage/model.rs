@@ -23,7 +23,7 @@ pub(crate) enum StopMode {
 
 /// The three stops' modes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct Modes {
+pub(crate) struct StopModes {
     pub(crate) contact: StopMode,
     pub(crate) pole: StopMode,
     pub(crate) rest: StopMode,
@@ -84,7 +84,7 @@ impl<D: DriveModel> Relay<'_, D> {
         }
     }
 
-    fn contact_force(&self, y: &Y, modes: Modes) -> f64 {
+    fn contact_force(&self, y: &Y, modes: StopModes) -> f64 {
         if modes.contact == StopMode::Engaged {
             law(&self.contact, y[2], y[3])
         } else {
@@ -92,14 +92,14 @@ impl<D: DriveModel> Relay<'_, D> {
         }
     }
 
-    fn pole_force(&self, y: &Y, modes: Modes) -> f64 {
+    fn pole_force(&self, y: &Y, modes: StopModes) -> f64 {
         match (&self.build.pole_face, modes.pole) {
             (Some(p), StopMode::Engaged) => law(&p.surface, y[0] - p.overtravel, y[1]),
             _ => 0.0,
         }
     }
 
-    fn rest_force(&self, y: &Y, modes: Modes) -> f64 {
+    fn rest_force(&self, y: &Y, modes: StopModes) -> f64 {
         match (&self.back, modes.rest) {
             (Some(b), StopMode::Engaged) => law(b, -(self.g() + y[0]), -y[1]),
             _ => 0.0,
@@ -108,7 +108,7 @@ impl<D: DriveModel> Relay<'_, D> {
 
     /// N, the force toward closing on the armature from everything but
     /// its stops' constraints (and, without a blade, the contact).
-    pub(super) fn armature_push(&self, t: f64, y: &Y, modes: Modes) -> f64 {
+    pub(super) fn armature_push(&self, t: f64, y: &Y, modes: StopModes) -> f64 {
         let m = self.m;
         let x = self.g() + y[0];
         let mut f = self.drive.force(t, x, y[4])
@@ -124,13 +124,13 @@ impl<D: DriveModel> Relay<'_, D> {
         f
     }
 
-    fn armature_held(&self, modes: Modes) -> bool {
+    fn armature_held(&self, modes: StopModes) -> bool {
         modes.pole == StopMode::Pressed
             || modes.rest == StopMode::Pressed
             || (self.build.blade.is_none() && modes.contact == StopMode::Pressed)
     }
 
-    pub(crate) fn rate(&self, t: f64, y: &Y, modes: Modes) -> Y {
+    pub(crate) fn rate(&self, t: f64, y: &Y, modes: StopModes) -> Y {
         let x = self.g() + y[0];
         let held = self.armature_held(modes);
         let (ua, aa) = if held {
@@ -151,7 +151,7 @@ impl<D: DriveModel> Relay<'_, D> {
 
     /// The event function of `which` in `modes`: positive while the mode
     /// lasts.
-    pub(super) fn event(&self, which: Which, t: f64, y: &Y, modes: Modes) -> f64 {
+    pub(super) fn event(&self, which: Which, t: f64, y: &Y, modes: StopModes) -> f64 {
         let force_rule = |release: Release, s: &Surface| {
             release == Release::Force && !matches!(s, Surface::Rigid { .. })
         };
@@ -200,7 +200,7 @@ impl<D: DriveModel> Relay<'_, D> {
 
     /// The acceleration of `which`'s body toward its stop in `modes` (the
     /// stop open), m/s².
-    pub(super) fn toward(&self, which: Which, t: f64, y: &Y, modes: Modes) -> f64 {
+    pub(super) fn toward(&self, which: Which, t: f64, y: &Y, modes: StopModes) -> f64 {
         let r = self.rate(t, y, modes);
         match which {
             Which::Contact => r[3],

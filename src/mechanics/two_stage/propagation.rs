@@ -6,7 +6,7 @@
 //! returns.
 
 use super::energy::EnergyBound;
-use super::model::{Modes, Relay, StopMode, Which, Y};
+use super::model::{Relay, StopMode, StopModes, Which, Y};
 use super::run::{Horizon, TwoStageRun};
 use super::span::Span;
 use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome};
@@ -38,7 +38,7 @@ impl Tally {
     /// Take in the state `y` in `modes`: the engaged contact's force
     /// (`force(y)`), the opening after a release, the reach before the
     /// first touch.
-    pub(crate) fn observe(&mut self, gap: f64, modes: Modes, y: &Y, force: impl Fn(&Y) -> f64) {
+    pub(crate) fn observe(&mut self, gap: f64, modes: StopModes, y: &Y, force: impl Fn(&Y) -> f64) {
         match modes.contact {
             StopMode::Engaged | StopMode::Pressed => {
                 let f = force(y);
@@ -84,7 +84,7 @@ fn release(impact: &mut Impact, t: f64, v: f64) {
 pub(crate) struct Propagation {
     pub t: f64,
     pub y: Y,
-    pub modes: Modes,
+    pub modes: StopModes,
     pub rec: Tally,
     pub pieces: Vec<Span>,
     pub steps: usize,
@@ -141,7 +141,7 @@ pub(super) fn start<D: DriveModel>(model: &Relay<'_, D>, e0: f64) -> Propagation
     let g = m.gap;
     let x0 = m.initial_position;
     let mut y = Y::new(x0 - g, m.initial_velocity, x0 - g, m.initial_velocity, e0);
-    let mut modes = Modes {
+    let mut modes = StopModes {
         contact: StopMode::Open,
         pole: StopMode::Open,
         rest: StopMode::Open,
@@ -262,7 +262,7 @@ pub(crate) fn closing_summary<D: DriveModel>(
     bound: &mut EnergyBound,
     rec: &mut Tally,
     ending: Option<Outcome>,
-    (t, y, modes): (f64, Y, Modes),
+    (t, y, modes): (f64, Y, StopModes),
     t_end: f64,
 ) -> Chatter {
     let impacts = std::mem::take(&mut rec.contact);
@@ -313,7 +313,7 @@ pub(crate) fn decided<D: DriveModel>(
     bound: &mut EnergyBound,
     t: f64,
     y: &Y,
-    modes: Modes,
+    modes: StopModes,
     rec: &Tally,
 ) -> Option<Outcome> {
     if rec.contact.is_empty() || !bound.due() {
@@ -334,9 +334,9 @@ pub(crate) fn transition<D: DriveModel>(
     which: Which,
     t: f64,
     y: &mut Y,
-    mut modes: Modes,
+    mut modes: StopModes,
     rec: &mut Tally,
-) -> Modes {
+) -> StopModes {
     let g = model.g();
     let no_blade = model.build.blade.is_none();
     match which {
@@ -456,7 +456,7 @@ fn rigid<D: DriveModel>(
     which: Which,
     t: f64,
     y: &mut Y,
-    modes: Modes,
+    modes: StopModes,
     e: f64,
     rec: &mut Tally,
 ) -> StopMode {

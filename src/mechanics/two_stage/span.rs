@@ -5,7 +5,7 @@
 use std::sync::Arc;
 
 use super::mode::{LinearMode, W};
-use super::model::{Modes, StopMode, Y};
+use super::model::{StopMode, StopModes, Y};
 use crate::mechanics::dop853::Dense;
 
 /// How a piece's state is had between its ends.
@@ -26,11 +26,11 @@ pub(crate) struct Span {
     pub t0: f64,
     pub t1: f64,
     pub y1: Y,
-    pub modes: Modes,
+    pub modes: StopModes,
 }
 
 impl Span {
-    pub(crate) fn dense(dense: Dense<5>, t1: f64, y1: Y, modes: Modes) -> Span {
+    pub(crate) fn dense(dense: Dense<5>, t1: f64, y1: Y, modes: StopModes) -> Span {
         Span {
             t0: dense.t0,
             motion: Interpolant::Dense(Box::new(dense)),
