@@ -237,7 +237,7 @@ pub fn direct_closing(
     settings: &Settings,
 ) -> Result<(Chatter, Option<crate::mechanics::two_stage::TwoStageRun>), CoilError> {
     use crate::mechanics::two_stage::engine::run_relay;
-    use crate::mechanics::two_stage::model::Relay;
+    use crate::mechanics::two_stage::model::RelayModel;
     if build.is_one_mass() {
         return Ok((
             simulate_direct(coil, source, mechanics, surface, settings)?.chatter,
@@ -260,7 +260,7 @@ pub fn direct_closing(
         });
     }
     let drive = CoilDrive::new(coil, source, m.gap);
-    let model = Relay {
+    let model = RelayModel {
         m: &m,
         build,
         contact: *surface,

@@ -43,12 +43,12 @@
 //! (m), velocities are positive toward it, and contact forces are the
 //! force the fixed contact puts on the moving one, positive pushing back.
 
+pub mod contact_force;
 pub mod cycle;
 pub mod dop853;
 pub mod driven;
 pub mod engine;
 mod error;
-pub mod force;
 pub mod forced;
 pub mod hunt_crossley;
 pub mod integrate;
@@ -61,9 +61,12 @@ pub mod surface;
 pub mod trajectory;
 pub mod two_stage;
 
+/// The old name of [`contact_force`].
+#[doc(hidden)]
+pub use contact_force as force;
+pub use contact_force::contact_forces;
 pub use engine::{ImpactResponse, ResponseEnd, critical_impact_speed, impact_response, simulate};
 pub use error::{DriveError, MAX_CONTACT_STEPS, MAX_DRIVEN_STEPS, MAX_EVENTS, MechanicsError};
-pub use force::contact_forces;
 pub use parameters::{Dimensionless, Mechanics, Settings, validate};
 pub use surface::Surface;
 pub use trajectory::{Drive, Trajectory, TrajectoryEvent, TrajectoryEventKind, simulate_drive};

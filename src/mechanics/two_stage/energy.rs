@@ -29,7 +29,7 @@
 //! Minima of a convex function of one variable are found by golden
 //! section; of two, by golden section nested in golden section.
 
-use super::model::{Relay, StopModes, Y};
+use super::model::{RelayModel, StopModes, Y};
 use super::relay::Release;
 use crate::mechanics::driven::DriveModel;
 use crate::mechanics::surface::{Surface, surface_energy};
@@ -56,7 +56,7 @@ impl EnergyBound {
     /// Whether the closed contact can never release again.
     pub(crate) fn cannot_release<D: DriveModel>(
         &mut self,
-        model: &Relay<'_, D>,
+        model: &RelayModel<'_, D>,
         t: f64,
         y: &Y,
         _modes: StopModes,
@@ -70,7 +70,7 @@ impl EnergyBound {
     /// Whether the open contact can never be reached again.
     pub(crate) fn cannot_reach<D: DriveModel>(
         &mut self,
-        model: &Relay<'_, D>,
+        model: &RelayModel<'_, D>,
         t: f64,
         y: &Y,
         _modes: StopModes,
@@ -87,7 +87,7 @@ impl EnergyBound {
 
 /// The model with its drive frozen at (t, e).
 struct Frozen<'m, 'a, D> {
-    model: &'m Relay<'a, D>,
+    model: &'m RelayModel<'a, D>,
     t: f64,
     e: f64,
     /// m, the range of armature positions to search.
@@ -96,7 +96,7 @@ struct Frozen<'m, 'a, D> {
 }
 
 impl<'m, 'a, D: DriveModel> Frozen<'m, 'a, D> {
-    fn at(model: &'m Relay<'a, D>, t: f64, y: &Y) -> Self {
+    fn at(model: &'m RelayModel<'a, D>, t: f64, y: &Y) -> Self {
         let m = model.m;
         let g = m.gap;
         let o = model.build.pole_face.map_or(0.0, |p| p.overtravel);

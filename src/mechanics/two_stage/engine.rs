@@ -16,7 +16,7 @@
 //! adjacent floats. At the event the state is set exactly on the surface
 //! and the integrator restarts in the new mode.
 use super::linear::{LinearSystem, propagate};
-use super::model::{Relay, StopMode, StopModes, Which, Y, law};
+use super::model::{RelayModel, StopMode, StopModes, Which, Y, law};
 use super::propagation::{Propagation, Tally, decided, finish, start};
 use super::relay::{Release, TwoStage, validate_all};
 pub use super::run::Horizon;
@@ -38,7 +38,7 @@ pub(crate) const RTOL: f64 = 1e-11;
 /// Sample points per step at which the event functions are checked.
 const SAMPLES: usize = 4;
 
-impl<D: DriveModel> Relay<'_, D> {
+impl<D: DriveModel> RelayModel<'_, D> {
     /// The first event in `(t0, t1]` on `dense`: (time, which).
     fn first_event(&self, dense: &Dense<5>, t1: f64, modes: StopModes) -> Option<(f64, Which)> {
         const ALL: [Which; 3] = [Which::Contact, Which::Pole, Which::Rest];
@@ -72,7 +72,7 @@ impl<D: DriveModel> Relay<'_, D> {
 /// Simulate the relay of `model` from the drive's state `e0` to
 /// `horizon`. Parameters must have been validated.
 pub(crate) fn run_relay<D: DriveModel>(
-    model: &Relay<'_, D>,
+    model: &RelayModel<'_, D>,
     settings: &Settings,
     e0: f64,
     horizon: Horizon,
@@ -87,7 +87,7 @@ pub(crate) fn run_relay<D: DriveModel>(
 
 /// DOP853 from event to event, to the horizon.
 fn integrate<D: DriveModel>(
-    model: &Relay<'_, D>,
+    model: &RelayModel<'_, D>,
     settings: &Settings,
     horizon: Horizon,
     p: &mut Propagation,
@@ -144,7 +144,7 @@ fn integrate<D: DriveModel>(
 
 /// The error when the armature has pressed through to the magnet's pole
 /// (the drive's model ends there) at `time`.
-fn pole_limit<D: DriveModel>(model: &Relay<'_, D>, y: &Y, time: f64) -> Option<DriveError> {
+fn pole_limit<D: DriveModel>(model: &RelayModel<'_, D>, y: &Y, time: f64) -> Option<DriveError> {
     let pole = model.drive.pole();
     let position = model.g() + y[0];
     (position >= pole).then_some(DriveError::ArmatureAtPole {
@@ -157,7 +157,7 @@ fn pole_limit<D: DriveModel>(model: &Relay<'_, D>, y: &Y, time: f64) -> Option<D
 /// Peak and minimum contact forces and the largest opening after each
 /// release, sampled on the dense output of a step up to `t1`.
 fn sample<D: DriveModel>(
-    model: &Relay<'_, D>,
+    model: &RelayModel<'_, D>,
     dense: &Dense<5>,
     t1: f64,
     modes: StopModes,
@@ -178,7 +178,7 @@ fn sample<D: DriveModel>(
 }
 
 /// Tolerances for the state's components.
-fn tolerance<D: DriveModel>(model: &Relay<'_, D>) -> StepTolerance<5> {
+fn tolerance<D: DriveModel>(model: &RelayModel<'_, D>) -> StepTolerance<5> {
     let g = model.g();
     let omega = (model.m.stiffness / model.m.mass).sqrt();
     StepTolerance {
@@ -194,7 +194,7 @@ fn tolerance<D: DriveModel>(model: &Relay<'_, D>) -> StepTolerance<5> {
 }
 
 /// rad/s, the fastest natural frequency in the model (the first trial step).
-fn fastest<D: DriveModel>(model: &Relay<'_, D>) -> f64 {
+fn fastest<D: DriveModel>(model: &RelayModel<'_, D>) -> f64 {
     let m = model.m;
     let mut w = (m.stiffness / m.mass).sqrt();
     let mass_at_contact = model.build.blade.map_or(m.mass, |b| b.mass);
@@ -305,7 +305,7 @@ pub fn simulate_two_stage(
                 force: m.force,
                 time_scale: (m.mass / m.stiffness).sqrt(),
             };
-            let model = Relay {
+            let model = RelayModel {
                 m,
                 build,
                 contact: stops.make,
@@ -324,7 +324,7 @@ pub fn simulate_two_stage(
                 });
             }
             let forced = Forced::new(m, force);
-            let model = Relay {
+            let model = RelayModel {
                 m,
                 build,
                 contact: stops.make,

@@ -31,8 +31,8 @@ use std::sync::Arc;
 
 use nalgebra::{Matrix4, Vector4};
 
-use super::mode::{Form, LinearMode, Poly, Taylor, W};
-use super::model::{Relay, StopMode, StopModes, Which, Y};
+use super::linear_mode::{Form, LinearMode, Poly, Taylor, W};
+use super::model::{RelayModel, StopMode, StopModes, Which, Y};
 use super::propagation::{Propagation, decided};
 use super::relay::Release;
 use super::run::Horizon;
@@ -93,7 +93,7 @@ impl LinearSystem {
     /// The linear system of `model`, when it is one: a constant force (no
     /// rest stop), a blade, a Kelvin–Voigt contact, and a Kelvin–Voigt
     /// pole face or none.
-    pub(crate) fn of<D: DriveModel>(model: &Relay<'_, D>) -> Option<LinearSystem> {
+    pub(crate) fn of<D: DriveModel>(model: &RelayModel<'_, D>) -> Option<LinearSystem> {
         let force = model.drive.constant()?;
         let blade = model.build.blade?;
         if model.rest {
@@ -360,7 +360,7 @@ fn first_event(
 /// Propagate `p` exactly from event to event, to the horizon.
 pub(crate) fn propagate<D: DriveModel>(
     system: &LinearSystem,
-    model: &Relay<'_, D>,
+    model: &RelayModel<'_, D>,
     settings: &Settings,
     horizon: Horizon,
     p: &mut Propagation,

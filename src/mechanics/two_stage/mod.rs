@@ -32,7 +32,7 @@
 //!
 //! The files run one way: the relay as built (`relay.rs`), the model its
 //! engines share (`model.rs`: state, modes, equations of motion), one
-//! linear mode (`mode.rs`), the motion piece by piece (`span.rs`), the
+//! linear mode (`linear_mode.rs`), the motion piece by piece (`span.rs`), the
 //! run's result (`run.rs`), the energy bound (`energy.rs`), a run in
 //! progress (`propagation.rs`: events, records, endings), the exact
 //! propagator (`linear.rs`) and the integrating one with the entry points
@@ -41,7 +41,7 @@
 pub(crate) mod energy;
 pub mod engine;
 pub(crate) mod linear;
-mod mode;
+mod linear_mode;
 pub(crate) mod model;
 mod propagation;
 mod relay;

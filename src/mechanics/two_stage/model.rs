@@ -1,5 +1,5 @@
 //! The two-stage relay as its engines see it: the state vector, the
-//! modes of its three stops, and the relay with its drive ([`Relay`]):
+//! modes of its three stops, and the relay with its drive ([`RelayModel`]):
 //! the forces on the armature and the blade, the equations of motion in
 //! each mode and the event function of each stop.
 
@@ -38,7 +38,7 @@ pub(crate) enum Which {
 }
 
 /// The model: parameters and the drive.
-pub(crate) struct Relay<'a, D> {
+pub(crate) struct RelayModel<'a, D> {
     pub m: &'a Mechanics,
     pub build: &'a TwoStage,
     pub contact: Surface,
@@ -68,7 +68,7 @@ pub(super) fn law(surface: &Surface, delta: f64, rate: f64) -> f64 {
     }
 }
 
-impl<D: DriveModel> Relay<'_, D> {
+impl<D: DriveModel> RelayModel<'_, D> {
     pub(super) fn g(&self) -> f64 {
         self.m.gap
     }

@@ -6,7 +6,7 @@
 //! returns.
 
 use super::energy::EnergyBound;
-use super::model::{Relay, StopMode, StopModes, Which, Y};
+use super::model::{RelayModel, StopMode, StopModes, Which, Y};
 use super::run::{Horizon, TwoStageRun};
 use super::span::Span;
 use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome};
@@ -97,7 +97,7 @@ impl Propagation {
     /// Apply the event of `which` at `t` (state `y` there, before it).
     pub(crate) fn event<D: DriveModel>(
         &mut self,
-        model: &Relay<'_, D>,
+        model: &RelayModel<'_, D>,
         settings: &Settings,
         which: Which,
         t: f64,
@@ -136,7 +136,7 @@ impl Propagation {
 }
 
 /// The state at t = 0: on the rest stop when the drive does not lift it.
-pub(super) fn start<D: DriveModel>(model: &Relay<'_, D>, e0: f64) -> Propagation {
+pub(super) fn start<D: DriveModel>(model: &RelayModel<'_, D>, e0: f64) -> Propagation {
     let m = model.m;
     let g = m.gap;
     let x0 = m.initial_position;
@@ -194,7 +194,7 @@ pub(super) fn start<D: DriveModel>(model: &Relay<'_, D>, e0: f64) -> Propagation
 
 /// The run's records, with the motion held where it stopped to `t_end`.
 pub(super) fn finish<D: DriveModel>(
-    model: &Relay<'_, D>,
+    model: &RelayModel<'_, D>,
     settings: &Settings,
     horizon: Horizon,
     mut p: Propagation,
@@ -258,7 +258,7 @@ pub(super) fn finish<D: DriveModel>(
 /// The closing's chatter: its ending decided by the energy bound, or read
 /// at the horizon.
 pub(crate) fn closing_summary<D: DriveModel>(
-    model: &Relay<'_, D>,
+    model: &RelayModel<'_, D>,
     bound: &mut EnergyBound,
     rec: &mut Tally,
     ending: Option<Outcome>,
@@ -309,7 +309,7 @@ pub(crate) fn closing_summary<D: DriveModel>(
 /// Whether a closing's ending is decided at `t`: the contact closed and
 /// unable to release, or open after touching and unable to reach it again.
 pub(crate) fn decided<D: DriveModel>(
-    model: &Relay<'_, D>,
+    model: &RelayModel<'_, D>,
     bound: &mut EnergyBound,
     t: f64,
     y: &Y,
@@ -329,7 +329,7 @@ pub(crate) fn decided<D: DriveModel>(
 /// Apply the event of `which` at `t` to the state and the records; the
 /// new modes.
 pub(crate) fn transition<D: DriveModel>(
-    model: &Relay<'_, D>,
+    model: &RelayModel<'_, D>,
     settings: &Settings,
     which: Which,
     t: f64,
@@ -451,7 +451,7 @@ pub(crate) fn transition<D: DriveModel>(
 /// `min_gap`). Returns the stop's new mode; records the rebound.
 #[allow(clippy::too_many_arguments)]
 fn rigid<D: DriveModel>(
-    model: &Relay<'_, D>,
+    model: &RelayModel<'_, D>,
     settings: &Settings,
     which: Which,
     t: f64,

@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use super::mode::{LinearMode, W};
+use super::linear_mode::{LinearMode, W};
 use super::model::{StopMode, StopModes, Y};
 use crate::mechanics::dop853::Dense;
 
