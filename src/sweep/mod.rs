@@ -40,9 +40,9 @@ pub mod verdict;
 
 pub use error::SweepError;
 pub use record::{ProbeRecord, SampleRecord, Shard};
-pub use run::{NoProgress, Progress, SweepMode, SweepOptions, evaluate, run, run_from};
+pub use run::{NoProgress, Progress, SweepMode, SweepOptions, run, run_from, run_sample};
 pub use sample::Sampler;
 pub use summary::{Collected, Summary};
 pub use verdict::SampleVerdict;
 #[allow(deprecated)]
-pub use {record::Record, run::Mode, verdict::Verdict};
+pub use {record::Record, run::Mode, run::evaluate, verdict::Verdict};

@@ -273,9 +273,9 @@ fn signals(scenario: &Scenario, options: &SweepOptions<'_>) -> Result<Vec<String
     })
 }
 
-/// Evaluate sample `index` of `sampler`'s sweep of `scenario` on its own
+/// Run sample `index` of `sampler`'s sweep of `scenario` on its own
 /// (the sweep's workers share one resolved plan instead).
-pub fn evaluate(
+pub fn run_sample(
     scenario: &Scenario,
     sampler: &Sampler,
     index: u64,
@@ -288,6 +288,17 @@ pub fn evaluate(
             ..blank(index)
         },
     }
+}
+
+/// The old name of [`run_sample`].
+#[deprecated(note = "renamed to `run_sample`")]
+pub fn evaluate(
+    scenario: &Scenario,
+    sampler: &Sampler,
+    index: u64,
+    options: &SweepOptions<'_>,
+) -> SampleRecord {
+    run_sample(scenario, sampler, index, options)
 }
 
 /// Sample `index`'s record before anything ran: every value absent.

@@ -205,7 +205,7 @@ fn samples_that_never_close_or_are_invalid_are_recorded_and_the_sweep_goes_on() 
     assert!(text.contains(",never_closes,0,,,,pass,"), "{text}");
 
     // A sample the scenario's rules refuse: recorded as an error row.
-    let record = sweep::evaluate(&s, &sampler, 0, &options);
+    let record = sweep::run_sample(&s, &sampler, 0, &options);
     assert_eq!(record.verdict, SampleVerdict::Pass);
     let bad = scenario("[sweep.vary]\n\"contact.r_closed\" = 0.5");
     let mut bad = bad;
