@@ -20,7 +20,7 @@ use std::process::Command;
 use chatterspice::scenario::{DEFAULT_SCENARIO_TOML, Scenario};
 use chatterspice::simulate;
 use chatterspice::spice::Ngspice;
-use chatterspice::sweep::{self, Mode, NoProgress, Sampler, SweepOptions};
+use chatterspice::sweep::{self, NoProgress, Sampler, SweepMode, SweepOptions};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 
 const VARY: &str = "[sweep.vary]\n\"mechanics.mass\" = 0.1\n\
@@ -35,7 +35,7 @@ fn mechanics(c: &mut Criterion) {
     let s = scenario();
     let samples = 10_000;
     let sampler = Sampler::new(&s, Some(samples), Some(1)).unwrap();
-    let mut options = SweepOptions::new(Mode::Mechanics);
+    let mut options = SweepOptions::new(SweepMode::Mechanics);
     options.jobs = NonZeroUsize::MIN;
     let mut group = c.benchmark_group("sweep");
     group.throughput(Throughput::Elements(samples));

@@ -23,8 +23,9 @@ pub enum Outcome {
     EndsOpen,
     /// Still chattering at `t_end`.
     EndOfTime,
-    /// Still chattering after [`crate::mechanics::MAX_EVENTS`] impacts: the
-    /// sequence is cut there (an undamped or perfectly elastic model).
+    /// Still chattering at the most impacts a simulation records (the
+    /// mechanics' `MAX_EVENTS`): the sequence is cut there (an undamped or
+    /// perfectly elastic model).
     EventLimit,
 }
 
@@ -230,6 +231,81 @@ impl Chatter {
             accumulation_time: None,
             t_end: last.map_or(0.0, |i| i.end),
             intervals,
+        }
+    }
+}
+
+/// Hand-built contact records for the tests of every stage that reads
+/// one (waveform, reports, checks): the engine is tested on its own, and
+/// these pin down every shape a record can take.
+#[cfg(test)]
+pub(crate) mod fixtures {
+    use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome};
+
+    fn interval(state: ContactState, start: f64, end: f64) -> Interval {
+        Interval { state, start, end }
+    }
+
+    /// Two bounces, then stuck on the third impact (Kelvin–Voigt-like).
+    pub fn stuck() -> Chatter {
+        use ContactState::{Closed, Open};
+        let bounce = |t: f64, v: f64, tr: f64, vr: f64, peak: f64, min: f64, gap: f64| Impact {
+            impact_time: t,
+            impact_velocity: v,
+            release_time: Some(tr),
+            release_velocity: Some(vr),
+            restitution: Some(-vr / v),
+            contact_time: Some(tr - t),
+            peak_force: Some(peak),
+            min_force: Some(min),
+            max_gap_after: Some(gap),
+        };
+        Chatter {
+            outcome: Outcome::Stuck,
+            first_impact: Some(0.0012),
+            settle_time: Some(0.0016),
+            bounce_count: 2,
+            impacts: vec![
+                bounce(0.0012, 0.31, 0.00121, -0.26, 2.1, -0.1, 3.0e-6),
+                bounce(0.0014, 0.2, 0.001405, -0.15, 1.25, -0.04, 1.0e-6),
+                Impact {
+                    impact_time: 0.0016,
+                    impact_velocity: 0.05,
+                    release_time: None,
+                    release_velocity: None,
+                    restitution: None,
+                    contact_time: None,
+                    peak_force: Some(0.6),
+                    min_force: Some(0.36),
+                    max_gap_after: None,
+                },
+            ],
+            intervals: vec![
+                interval(Open, 0.0, 0.0012),
+                interval(Closed, 0.0012, 0.00121),
+                interval(Open, 0.00121, 0.0014),
+                interval(Closed, 0.0014, 0.001405),
+                interval(Open, 0.001405, 0.0016),
+                interval(Closed, 0.0016, 0.02),
+            ],
+            shortfall: None,
+            accumulation_time: None,
+            t_end: 0.02,
+        }
+    }
+
+    /// The gap is beyond the overshoot: no impact at all.
+    pub fn never_closes() -> Chatter {
+        Chatter {
+            outcome: Outcome::NeverCloses,
+            first_impact: None,
+            settle_time: None,
+            bounce_count: 0,
+            impacts: vec![],
+            intervals: vec![interval(ContactState::Open, 0.0, 0.02)],
+            shortfall: Some(2.5e-5),
+            accumulation_time: None,
+            t_end: 0.02,
         }
     }
 }

@@ -28,7 +28,7 @@ use chatterspice::pipeline::{self, RunOptions};
 use chatterspice::report::{self, Format};
 use chatterspice::scenario::Scenario;
 use chatterspice::spice::Ngspice;
-use chatterspice::sweep::{self, Mode, Sampler, Shard, SweepOptions};
+use chatterspice::sweep::{self, Sampler, Shard, SweepMode, SweepOptions};
 use chatterspice::waveform::{ContactModel, Waveform, read_state_csv};
 
 /// Relay contact bounce from physics, into circuit simulation.
@@ -1038,8 +1038,8 @@ fn refuse_existing_sweep(
 /// How the sweep runs, from the command line.
 fn sweep_options<'n>(args: &SweepArgs, ngspice: Option<&'n Ngspice>) -> SweepOptions<'n> {
     let mut options = SweepOptions::new(match ngspice {
-        Some(n) => Mode::Circuit(n),
-        None => Mode::Mechanics,
+        Some(n) => SweepMode::Circuit(n),
+        None => SweepMode::Mechanics,
     });
     if let Some(jobs) = args.jobs {
         options.jobs = jobs;

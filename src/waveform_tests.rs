@@ -342,7 +342,7 @@ fn holm_parameters_are_checked_by_key() {
 
 /// A sequence with 3 bounce closures of different lengths, then closed.
 fn bouncing() -> Chatter {
-    let mut c = crate::report::fixtures::stuck();
+    let mut c = crate::chatter::fixtures::stuck();
     c.intervals = tiling(
         ContactState::Open,
         &[

@@ -36,7 +36,7 @@
 //! ngspice run is the fixed point of this cheap map, found by relaxation
 //! among the mechanics runs alone.
 
-use super::{Coil, CoilError};
+use super::magnet::{Coil, CoilError};
 use crate::mechanics::cycle::Stops;
 use crate::mechanics::two_stage::{TwoStage, driven_run};
 use crate::mechanics::{Mechanics, Settings, Trajectory};
@@ -56,12 +56,16 @@ pub struct CircuitRun<'a> {
 
 /// The coupling's tolerances.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Tolerances {
+pub struct CouplingTolerances {
     /// s, on the event times.
     pub events: f64,
     /// m, to which paths are thinned before they go to ngspice.
     pub path: f64,
 }
+
+/// The old name of [`CouplingTolerances`].
+#[deprecated(note = "renamed to `CouplingTolerances`")]
+pub type Tolerances = CouplingTolerances;
 
 /// How many mechanics runs the inner relaxation may take per ngspice run:
 /// each costs a few milliseconds, and the inner map contracts as fast as
@@ -87,7 +91,7 @@ pub fn settle(
     build: &TwoStage,
     stops: &Stops,
     settings: &Settings,
-    tolerances: Tolerances,
+    tolerances: CouplingTolerances,
 ) -> Result<(Trajectory, usize), CoilError> {
     let driver = Driver::of(coil, run);
     let base = flux_under(coil, run, &driver, run.path);
@@ -105,7 +109,7 @@ pub fn settle(
         let estimate: Vec<(f64, f64)> = (0..run.time.len())
             .map(|j| (run.time[j], run.flux[j] + phi[j] - base[j]))
             .collect();
-        let flux_at = super::samples::Cursor::new(&estimate);
+        let flux_at = super::samples::Interpolator::new(&estimate);
         let pull = |t: f64, _x: f64| coil.force_from_flux(flux_at.at(t));
         let next = driven_run(mechanics, build, stops, settings, &pull)?;
         let moved = super::samples::event_change(current.chatter(), next.chatter()).max(
@@ -141,7 +145,7 @@ fn flux_under(coil: &Coil, run: &CircuitRun, driver: &Driver, path: &[(f64, f64)
     let k = coil.permeance_length();
     let a = coil.air_gap + coil.iron_gap;
     // dψ/dt = u − c ψ with c = (R − s)(a − x)/k (see [`Driver`]).
-    let x = super::samples::Cursor::new(path);
+    let x = super::samples::Interpolator::new(path);
     let rate = |j: usize| (coil.resistance - driver.slope[j]) * (a - x.at(run.time[j])) / k;
     let mut psi = first;
     let mut c0 = rate(0);
@@ -180,7 +184,7 @@ impl Driver {
         let n = run.time.len();
         let k = coil.permeance_length();
         let a = coil.air_gap + coil.iron_gap;
-        let x = super::samples::Cursor::new(run.path);
+        let x = super::samples::Interpolator::new(run.path);
         let current: Vec<f64> = (0..n)
             .map(|j| run.flux[j] * (a - x.at(run.time[j])) / k)
             .collect();

@@ -24,11 +24,11 @@
 //! `∫V i dt = ∫R i² dt + Δ(½ L i²) + ∫F_m ẋ dt`, and the mechanical work
 //! goes into the armature's energy and its losses.
 
-use super::{Coil, CoilError};
+use super::magnet::{Coil, CoilError};
 use crate::chatter::Chatter;
-use crate::mechanics::cycle;
-use crate::mechanics::driven::{self, Drive, Piece, State, StepKind};
-use crate::mechanics::trajectory::Segment;
+use crate::mechanics::cycle::{self, ClosingRun};
+use crate::mechanics::driven::{self, DriveModel, Piece, State, StepKind};
+use crate::mechanics::segment::Segment;
 use crate::mechanics::{self, Mechanics, Settings, Surface};
 
 /// The ideal voltage source the coil is switched onto at t = 0.
@@ -236,7 +236,8 @@ pub fn direct_closing(
     surface: &Surface,
     settings: &Settings,
 ) -> Result<(Chatter, Option<crate::mechanics::two_stage::TwoStageRun>), CoilError> {
-    use crate::mechanics::two_stage::engine::{Relay, run};
+    use crate::mechanics::two_stage::engine::run_relay;
+    use crate::mechanics::two_stage::model::RelayModel;
     if build.is_one_mass() {
         return Ok((
             simulate_direct(coil, source, mechanics, surface, settings)?.chatter,
@@ -259,7 +260,7 @@ pub fn direct_closing(
         });
     }
     let drive = CoilDrive::new(coil, source, m.gap);
-    let model = Relay {
+    let model = RelayModel {
         m: &m,
         build,
         contact: *surface,
@@ -267,7 +268,7 @@ pub fn direct_closing(
         rest: true,
         drive: &drive,
     };
-    let out = run(
+    let out = run_relay(
         &model,
         settings,
         0.0,
@@ -314,7 +315,7 @@ impl CoilDrive {
         (self.rate(0.0, x, y[2]) * (self.a - x) - y[2] * y[1]) / self.k
     }
 
-    fn events(&self, run: &driven::Run, m: &Mechanics) -> CoilEvents {
+    fn events(&self, run: &ClosingRun, m: &Mechanics) -> CoilEvents {
         let first = run.chatter.impacts.first();
         let first_make = first.map(|i| i.impact_time);
         let tau0 = self.coil.inductance(0.0) / self.resistance;
@@ -369,7 +370,7 @@ impl CoilDrive {
     /// The energy balance, each integral by 5-point Gauss–Legendre on each
     /// step's interpolant (which is smooth inside a step: events end
     /// steps).
-    fn energy(&self, run: &driven::Run, m: &Mechanics, surface: &Surface) -> EnergyBalance {
+    fn energy(&self, run: &ClosingRun, m: &Mechanics, surface: &Surface) -> EnergyBalance {
         const GL5: [(f64, f64); 5] = [
             (-0.906_179_845_938_664, 0.236_926_885_056_189_1),
             (-0.538_469_310_105_683_1, 0.478_628_670_499_366_5),
@@ -420,7 +421,7 @@ impl CoilDrive {
     }
 }
 
-impl Drive for CoilDrive {
+impl DriveModel for CoilDrive {
     fn force(&self, _t: f64, _x: f64, psi: f64) -> f64 {
         0.5 * psi * psi / self.k
     }

@@ -31,7 +31,7 @@
 //! pole face, or the contact position without one): below it the
 //! armature leaves the closed position.
 
-use super::Coil;
+use super::magnet::Coil;
 use crate::mechanics::Mechanics;
 
 /// A contact blade that the armature deflects once the contacts touch

@@ -78,15 +78,19 @@ pub fn event_change(a: &Chatter, b: &Chatter) -> f64 {
 /// and after the last, for a caller that asks at times close to the last
 /// (an integrator stepping through the record): it first tries the
 /// interval of the previous call and its neighbour before searching.
-pub struct Cursor<'a> {
+pub struct Interpolator<'a> {
     samples: &'a [(f64, f64)],
     hint: std::cell::Cell<usize>,
 }
 
-impl<'a> Cursor<'a> {
-    /// A cursor over `samples`, (time, value) pairs in increasing time.
+/// The old name of [`Interpolator`].
+#[deprecated(note = "renamed to `Interpolator`")]
+pub type Cursor<'a> = Interpolator<'a>;
+
+impl<'a> Interpolator<'a> {
+    /// An interpolator over `samples`, (time, value) pairs in increasing time.
     pub fn new(samples: &'a [(f64, f64)]) -> Self {
-        Cursor {
+        Interpolator {
             samples,
             hint: std::cell::Cell::new(1),
         }

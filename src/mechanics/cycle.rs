@@ -5,11 +5,11 @@
 //! for as many pulses as the drive gives (docs/model.md §7).
 //!
 //! This is the one engine for every drive that varies in time or
-//! position. Run as a cycle (`run`) nothing ends before `t_end`: a
+//! position. ClosingRun as a cycle (`run`) nothing ends before `t_end`: a
 //! stuck contact stays in its contact phase and releases by the same rule
 //! that ends every contact (the moving contact back at the surface, moving
 //! out), so the break of the normally-open (NO) contact is found where the
-//! pull no longer holds it. Run as one closing (`run_closing`) it stops
+//! pull no longer holds it. ClosingRun as one closing (`run_closing`) it stops
 //! where the closing's ending is decided, on the understanding that the
 //! drive does not weaken afterwards (`closing`: the sticking test and the
 //! endings at the horizon).
@@ -44,18 +44,22 @@
 //! them, bisected on the interpolant.
 //!
 //! Every accepted step is kept, cut at its event, as a segment of the
-//! armature's [`super::Trajectory`]; a closing hands the same steps on as
-//! its record (`Run`).
+//! armature's trajectory; a closing hands the same steps on as
+//! its record (`ClosingRun`).
 
-use super::DriveError;
-use super::driven::{self, Drive, Run, State, first_true, monotone_parts, state_on};
-use super::integrate::{Dopri5, Step, Tolerance};
-use super::surface::surface_force;
-use super::trajectory::{Segment, path_of};
-use super::{Mechanics, Settings, Surface};
+use super::driven::{self, DriveModel, State, first_true, monotone_parts, state_on};
+use super::error::{DriveError, MAX_DRIVEN_STEPS, MAX_EVENTS, MechanicsError};
+use super::integrate::Dopri5Step;
+pub use super::parameters::Stops;
+use super::parameters::{Mechanics, Settings};
+use super::segment::{Segment, path_of};
+use super::surface::Surface;
 use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome};
+pub(crate) use closing::ClosingRun;
+use model::{CycleTally, Ending, Model, Phase, PhaseEnd, Track};
 
 mod closing;
+mod model;
 
 /// One stroke of the armature: from leaving the rest stop (lift-off) to
 /// leaving it again, or to the end of the run. All times in s from t = 0.
@@ -114,22 +118,13 @@ pub struct Cycle {
     pub strokes: Vec<Stroke>,
     /// (s, m): the armature's path, at every accepted step and event.
     pub path: Vec<(f64, f64)>,
-    /// The motion itself, step by step, for [`super::Trajectory`].
+    /// The motion itself, step by step, for the armature's trajectory.
     pub(crate) segments: Vec<Segment>,
-}
-
-/// How the armature meets the two stops.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Stops {
-    /// The fixed NO contact at x = g.
-    pub make: Surface,
-    /// The rest stop at x = 0; `None`: inelastic, held at once.
-    pub back: Option<Surface>,
 }
 
 /// Simulate from t = 0 to `settings.t_end` under `drive`, from the
 /// drive's state `e0`. Parameters must have been validated.
-pub(crate) fn run<D: Drive>(
+pub(crate) fn run_cycle<D: DriveModel>(
     m: &Mechanics,
     stops: &Stops,
     settings: &Settings,
@@ -142,23 +137,22 @@ pub(crate) fn run<D: Drive>(
 /// One closing under `drive` onto `surface`, from the drive's state
 /// `e0`: the same engine, stopped where the closing's ending is decided
 /// ([`closing`]). Parameters must have been validated.
-pub(crate) fn run_closing<D: Drive>(
+pub(crate) fn run_closing<D: DriveModel>(
     m: &Mechanics,
     surface: &Surface,
     settings: &Settings,
     drive: &D,
     e0: f64,
-) -> Result<Run, DriveError> {
+) -> Result<ClosingRun, DriveError> {
     let stops = Stops {
         make: *surface,
         back: None,
     };
-    Ok(closing::finish(simulated(
-        m, &stops, settings, drive, e0, true,
-    )?))
+    let sim = simulated(m, &stops, settings, drive, e0, true)?;
+    Ok(closing::finish(&sim.model, sim.rec))
 }
 
-fn simulated<'a, D: Drive>(
+fn simulated<'a, D: DriveModel>(
     m: &Mechanics,
     stops: &Stops,
     settings: &Settings,
@@ -166,7 +160,7 @@ fn simulated<'a, D: Drive>(
     e0: f64,
     closing: bool,
 ) -> Result<Sim<'a, D>, DriveError> {
-    let tol = driven::start(m, drive, e0)?;
+    let tol = driven::start_tolerance(m, drive, e0)?;
     let x0 = m.initial_position;
     let held = x0 == 0.0 && m.initial_velocity <= 0.0;
     let back_state = if held {
@@ -183,7 +177,7 @@ fn simulated<'a, D: Drive>(
             tol,
             closing,
         },
-        rec: Record {
+        rec: CycleTally {
             make: Track::new(ContactState::Open),
             back: Track::new(back_state),
             log: Vec::new(),
@@ -198,371 +192,46 @@ fn simulated<'a, D: Drive>(
     Ok(sim)
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Phase {
-    Held,
-    Flight,
-    Make,
-    Pressed,
-    Back,
-}
-
-/// What ended a phase.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Event {
-    Lift,
-    TouchMake,
-    TouchBack,
-    ReleaseMake,
-    ReleaseBack,
-    Break,
-    Horizon,
-    /// A closing's contact has stuck for good ([`closing`] only).
-    Stuck,
-}
-
-/// One contact's record: its intervals and impacts.
-struct Track {
-    intervals: Vec<Interval>,
-    impacts: Vec<Impact>,
-    state: ContactState,
-    since: f64,
-    /// The last release: (s, smallest distance reached since, in m, from
-    /// this contact's surface). Cleared at the next touch.
-    released: Option<(f64, f64)>,
-}
-
-impl Track {
-    fn new(state: ContactState) -> Self {
-        Track {
-            intervals: Vec::new(),
-            impacts: Vec::new(),
-            state,
-            since: 0.0,
-            released: None,
-        }
-    }
-
-    fn change(&mut self, t: f64, to: ContactState) {
-        if self.state != to {
-            self.intervals.push(Interval {
-                state: self.state,
-                start: self.since,
-                end: t,
-            });
-            self.state = to;
-            self.since = t;
-        }
-    }
-
-    /// A touch at `t` at `speed` (> 0): the contact closes.
-    fn touch(&mut self, t: f64, speed: f64) {
-        if let (Some((_, farthest)), Some(last)) = (self.released.take(), self.impacts.last_mut()) {
-            last.max_gap_after = Some(farthest);
-        }
-        self.change(t, ContactState::Closed);
-        self.impacts.push(Impact::touch(t, speed));
-    }
-
-    /// The contact opens at `t`, separating at `speed` (> 0).
-    fn release(&mut self, t: f64, speed: f64) {
-        self.change(t, ContactState::Open);
-        if let Some(last) = self.impacts.last_mut() {
-            last.release_time = Some(t);
-            last.release_velocity = Some(-speed);
-            last.restitution = Some(speed / last.impact_velocity);
-            last.contact_time = Some(t - last.impact_time);
-        }
-        self.released = Some((t, 0.0));
-    }
-
-    /// The opening since the last release is below resolution: the
-    /// contact is taken as closed since the last touch. The cycle goes on
-    /// from there as one contact, and forgets the release; a closing stops
-    /// there and keeps it on the last impact's record (its release, and
-    /// the opening it made, as the step-force engine reports a resolved
-    /// sequence).
-    fn unresolve(&mut self, keep_release: bool) {
-        self.released = None;
-        let Some(closed) = self.intervals.pop() else {
-            return;
-        };
-        debug_assert_eq!(closed.state, ContactState::Closed);
-        self.state = ContactState::Closed;
-        self.since = closed.start;
-        if keep_release {
-            return;
-        }
-        if let Some(last) = self.impacts.last_mut() {
-            last.release_time = None;
-            last.release_velocity = None;
-            last.restitution = None;
-            last.contact_time = None;
-        }
-    }
-
-    /// The force on the contact now in its last impact's record.
-    fn see_force(&mut self, f: f64) {
-        if let Some(last) = self.impacts.last_mut() {
-            last.peak_force = Some(last.peak_force.map_or(f, |p| p.max(f)));
-            last.min_force = Some(last.min_force.map_or(f, |p| p.min(f)));
-        }
-    }
-
-    /// Note how far from the surface the armature got.
-    fn see_distance(&mut self, d: f64) {
-        if let Some((_, farthest)) = &mut self.released {
-            *farthest = farthest.max(d);
-        }
-    }
-
-    fn finish(mut self, t_end: f64) -> (Vec<Interval>, Vec<Impact>) {
-        self.intervals.push(Interval {
-            state: self.state,
-            start: self.since.min(t_end),
-            end: t_end,
-        });
-        (self.intervals, self.impacts)
-    }
-}
-
-/// The relay, its stops and the drive: everything the right-hand side
-/// needs.
-struct Model<'a, D> {
-    m: Mechanics,
-    stops: Stops,
-    settings: Settings,
-    drive: &'a D,
-    tol: Tolerance<3>,
-    /// Stop where one closing's ending is decided ([`closing`]).
-    closing: bool,
-}
-
-/// What the run has produced so far.
-struct Record {
-    make: Track,
-    back: Track,
-    /// Every touch, release and lift-off, in order.
-    log: Vec<(f64, Event)>,
-    /// Every accepted step, cut at its event (held ones too).
-    segments: Vec<Segment>,
-    /// m, the largest x reached.
-    reach: f64,
-    /// J, kinetic energy taken by rigid impacts and inelastic landings.
-    jump_loss: f64,
-    /// How a closing ended, once it has ([`closing`] only).
-    ending: Option<closing::Ending>,
-}
-
-impl Record {
-    /// The armature passed through `x`; the gap is `g`.
-    fn see_position(&mut self, x: f64, g: f64) {
-        self.reach = self.reach.max(x);
-        self.make.see_distance(g - x);
-        self.back.see_distance(x);
-    }
-}
-
 struct Sim<'a, D> {
     model: Model<'a, D>,
-    rec: Record,
+    rec: CycleTally,
 }
 
-impl<D: Drive> Model<'_, D> {
-    fn g(&self) -> f64 {
-        self.m.gap
-    }
-
-    /// N, the drive at (t, x, e) less the spring at x and the preload:
-    /// > 0 pushes toward closing.
-    fn net(&self, t: f64, x: f64, e: f64) -> f64 {
-        self.drive.force(t, x, e) - self.m.preload - self.m.stiffness * x
-    }
-
-    /// N, the drive at (t, y) less the preload.
-    fn drive_net(&self, t: f64, y: &State) -> f64 {
-        self.drive.force(t, self.g() + y[0], y[2]) - self.m.preload
-    }
-
-    /// N, the NO contact's force at u (> 0 in it) and rate v.
-    fn make_force(&self, y: &State) -> f64 {
-        surface_force(&self.stops.make, y[0], y[1])
-    }
-
-    /// N, the back stop's force at x = g + u (< 0 in it), pushing +x.
-    ///
-    /// Out of line, so that `rhs` is small enough to be inlined into the
-    /// integrator's stepper (measured on a closing of 1139 steps: 215 µs
-    /// so, 280 µs with `rhs` called).
-    #[inline(never)]
-    fn back_force(&self, y: &State) -> f64 {
-        match self.stops.back {
-            Some(s) => surface_force(&s, -(self.g() + y[0]), -y[1]),
-            None => 0.0,
-        }
-    }
-
-    #[inline(always)]
-    fn rhs(&self, phase: Phase, t: f64, y: &State) -> State {
-        let g = self.g();
-        match phase {
-            Phase::Held => State::new(0.0, 0.0, self.drive.rate(t, 0.0, y[2])),
-            Phase::Pressed => State::new(0.0, 0.0, self.drive.rate(t, g, y[2])),
-            Phase::Flight | Phase::Make | Phase::Back => {
-                let x = g + y[0];
-                let contact = match phase {
-                    Phase::Make => -self.make_force(y),
-                    Phase::Back => self.back_force(y),
-                    _ => 0.0,
-                };
-                let a = (self.net(t, x, y[2]) - self.m.damping * y[1] + contact) / self.m.mass;
-                State::new(y[1], a, self.drive.rate(t, x, y[2]))
-            }
-        }
-    }
-
-    /// N/s, the rate of the contact force of `phase` (make or back)
-    /// along the motion at (t, y).
-    fn force_rate(&self, phase: Phase, t: f64, y: &State) -> f64 {
-        let a = self.rhs(phase, t, y)[1];
-        // Penetration, its rate and acceleration into the surface.
-        let (surface, d, dd, ddd) = match phase {
-            Phase::Make => (Some(self.stops.make), y[0], y[1], a),
-            _ => (self.stops.back, -(self.g() + y[0]), -y[1], -a),
-        };
-        match surface {
-            Some(Surface::KelvinVoigt { stiffness, damping }) => stiffness * dd + damping * ddd,
-            Some(Surface::HuntCrossley {
-                stiffness,
-                exponent,
-                chi,
-            }) if d > 0.0 && 1.0 + chi * dd > 0.0 => {
-                stiffness
-                    * (exponent * d.powf(exponent - 1.0) * dd * (1.0 + chi * dd)
-                        + d.powf(exponent) * chi * ddd)
-            }
-            _ => 0.0,
-        }
-    }
-
-    /// N, the force on a held armature at (t, y) from what holds it: the
-    /// rest stop against the preload's excess over the drive, or the make
-    /// contact against the drive's excess over the preload and spring.
-    fn held_force(&self, phase: Phase, t: f64, y: &State) -> f64 {
-        match phase {
-            Phase::Held => self.m.preload - self.drive.force(t, 0.0, y[2]),
-            _ => self.net(t, self.g(), y[2]),
-        }
-    }
-
-    /// Whether a held phase still holds at (t, y): the preload keeps the
-    /// armature on the rest stop, or the drive keeps it pressed on the NO
-    /// contact.
-    fn holds(&self, phase: Phase, t: f64, y: &State) -> bool {
-        match phase {
-            Phase::Held => self.drive.force(t, 0.0, y[2]) <= self.m.preload,
-            _ => self.net(t, self.g(), y[2]) >= 0.0,
-        }
-    }
-
-    /// s, the time scale of a phase, for the first trial step.
-    fn scale(&self, phase: Phase, speed: f64) -> f64 {
-        let m = &self.m;
-        let free = (m.mass / m.stiffness).sqrt();
-        let surface = match phase {
-            Phase::Held | Phase::Pressed => return self.drive.time_scale(),
-            Phase::Flight => return free,
-            Phase::Make => Some(self.stops.make),
-            Phase::Back => self.stops.back,
-        };
-        match surface {
-            Some(Surface::KelvinVoigt { stiffness, .. }) => {
-                (m.mass / (m.stiffness + stiffness)).sqrt()
-            }
-            Some(Surface::HuntCrossley {
-                stiffness,
-                exponent,
-                ..
-            }) if speed > 0.0 => {
-                // The depth at which the surface alone stops the impact,
-                // crossed at the impact speed.
-                let depth = ((exponent + 1.0) * m.mass * speed * speed / (2.0 * stiffness))
-                    .powf(1.0 / (exponent + 1.0));
-                (depth / speed).min(free)
-            }
-            _ => free,
-        }
-    }
-
-    fn solver(
-        &self,
-        phase: Phase,
-        t: f64,
-        y: State,
-    ) -> Dopri5<3, impl Fn(f64, &State) -> State + '_> {
-        let h0 = 1e-2 * self.scale(phase, y[1].abs());
-        Dopri5::new(
-            move |t, y: &State| self.rhs(phase, t, y),
-            t,
-            y,
-            h0,
-            self.tol,
-        )
-    }
-
-    /// Whether the opening since `track`'s last release, touched again at
-    /// `t`, is below resolution.
-    /// `t` and the state `y` there give the scale of the motion: the gap,
-    /// or the drive's equilibrium if that lies farther.
-    fn unresolved(&self, track: &Track, t: f64, y: &State) -> bool {
-        let Some((released, farthest)) = track.released else {
-            return false;
-        };
-        let s = &self.settings;
-        let x_eq = self.drive_net(t, y) / self.m.stiffness;
-        let min_gap = s.min_gap.max(1e3 * f64::EPSILON * x_eq.abs().max(self.g()));
-        let min_open = s.min_open_time.max(1e3 * f64::EPSILON * t);
-        t - released < min_open || farthest < min_gap
-    }
-}
-
-impl<D: Drive> Sim<'_, D> {
-    /// Run the phases from `phase` at (0, y) to `t_end`.
+impl<D: DriveModel> Sim<'_, D> {
+    /// ClosingRun the phases from `phase` at (0, y) to `t_end`.
     fn simulate(&mut self, mut phase: Phase, mut y: State) -> Result<(), DriveError> {
         let mut t = 0.0;
         loop {
             let events = self.rec.make.impacts.len() + self.rec.back.impacts.len();
-            if events >= crate::mechanics::MAX_EVENTS {
-                return Err(
-                    crate::mechanics::MechanicsError::TooManyEvents { time: t, events }.into(),
-                );
+            if events >= MAX_EVENTS {
+                return Err(MechanicsError::TooManyEvents { time: t, events }.into());
             }
             let (event, te, mut ye) = self.phase(phase, t, y)?;
-            if self.model.closing && event == Event::Horizon {
+            if self.model.closing && event == PhaseEnd::Horizon {
                 let ending = closing::at_horizon(&self.model, &mut self.rec, phase, te, ye);
                 self.rec.ending = Some(ending);
             }
             let rec = &mut self.rec;
             phase = match event {
-                Event::Horizon | Event::Stuck => return Ok(()),
-                Event::Lift => {
-                    rec.log.push((te, Event::Lift));
+                PhaseEnd::Horizon | PhaseEnd::Stuck => return Ok(()),
+                PhaseEnd::Lift => {
+                    rec.log.push((te, PhaseEnd::Lift));
                     rec.back.change(te, ContactState::Open);
                     rec.back.released = Some((te, 0.0));
                     Phase::Flight
                 }
-                Event::ReleaseMake | Event::Break => {
-                    rec.log.push((te, Event::ReleaseMake));
+                PhaseEnd::ReleaseMake | PhaseEnd::Break => {
+                    rec.log.push((te, PhaseEnd::ReleaseMake));
                     rec.make.release(te, (-ye[1]).max(0.0));
                     Phase::Flight
                 }
-                Event::ReleaseBack => {
-                    rec.log.push((te, Event::ReleaseBack));
+                PhaseEnd::ReleaseBack => {
+                    rec.log.push((te, PhaseEnd::ReleaseBack));
                     rec.back.release(te, ye[1].max(0.0));
                     Phase::Flight
                 }
-                Event::TouchMake => self.touch_make(te, &mut ye),
-                Event::TouchBack => self.touch_back(te, &mut ye),
+                PhaseEnd::TouchMake => self.touch_make(te, &mut ye),
+                PhaseEnd::TouchBack => self.touch_back(te, &mut ye),
             };
             if self.rec.ending.is_some() {
                 return Ok(());
@@ -591,7 +260,7 @@ impl<D: Drive> Sim<'_, D> {
                 _ => Phase::Make,
             };
         }
-        rec.log.push((t, Event::TouchMake));
+        rec.log.push((t, PhaseEnd::TouchMake));
         rec.make.touch(t, speed);
         match model.stops.make {
             Surface::Rigid { restitution } => {
@@ -602,12 +271,12 @@ impl<D: Drive> Sim<'_, D> {
                     if self.model.closing && phase == Phase::Pressed {
                         // Held against the surface by the static
                         // overtravel force: stuck for good.
-                        self.rec.ending = Some(closing::Ending::Stuck { end: (t, *y) });
+                        self.rec.ending = Some(Ending::Stuck { end: (t, *y) });
                     }
                     return phase;
                 }
                 y[1] = -out;
-                rec.log.push((t, Event::ReleaseMake));
+                rec.log.push((t, PhaseEnd::ReleaseMake));
                 rec.make.release(t, out);
                 Phase::Flight
             }
@@ -626,7 +295,7 @@ impl<D: Drive> Sim<'_, D> {
             self.rec.make.see_force(held_by);
             Phase::Pressed
         } else {
-            self.rec.log.push((t, Event::ReleaseMake));
+            self.rec.log.push((t, PhaseEnd::ReleaseMake));
             self.rec.make.release(t, 0.0);
             Phase::Flight
         }
@@ -658,7 +327,7 @@ impl<D: Drive> Sim<'_, D> {
             rec.jump_loss += 0.5 * mass * speed * speed;
             return rest(y);
         }
-        rec.log.push((t, Event::TouchBack));
+        rec.log.push((t, PhaseEnd::TouchBack));
         rec.back.touch(t, speed);
         let out = match model.stops.back {
             None => 0.0,
@@ -673,7 +342,7 @@ impl<D: Drive> Sim<'_, D> {
             return rest(y);
         }
         y[1] = out;
-        rec.log.push((t, Event::ReleaseBack));
+        rec.log.push((t, PhaseEnd::ReleaseBack));
         rec.back.release(t, out);
         Phase::Flight
     }
@@ -685,18 +354,18 @@ impl<D: Drive> Sim<'_, D> {
         phase: Phase,
         t0: f64,
         y0: State,
-    ) -> Result<(Event, f64, State), DriveError> {
+    ) -> Result<(PhaseEnd, f64, State), DriveError> {
         let (model, rec) = (&self.model, &mut self.rec);
         let g = model.g();
         let t_end = model.settings.t_end;
         if t0 >= t_end {
-            return Ok((Event::Horizon, t0, y0));
+            return Ok((PhaseEnd::Horizon, t0, y0));
         }
         let held = matches!(phase, Phase::Held | Phase::Pressed);
         let (level, ends) = if phase == Phase::Held {
-            (-g, Event::Lift)
+            (-g, PhaseEnd::Lift)
         } else {
-            (0.0, Event::Break)
+            (0.0, PhaseEnd::Break)
         };
         if held && !model.holds(phase, t0, &y0) {
             return Ok((ends, t0, y0));
@@ -746,10 +415,10 @@ impl<D: Drive> Sim<'_, D> {
             } else {
                 rec.segments.push(Segment::integrated(step, te, ye, side));
             }
-            if rec.segments.len() > crate::mechanics::MAX_DRIVEN_STEPS {
+            if rec.segments.len() > MAX_DRIVEN_STEPS {
                 let m = &model.m;
                 return Err(DriveError::TooManySteps {
-                    steps: crate::mechanics::MAX_DRIVEN_STEPS,
+                    steps: MAX_DRIVEN_STEPS,
                     time: te,
                     t_end,
                     mass: m.mass,
@@ -761,7 +430,7 @@ impl<D: Drive> Sim<'_, D> {
                 return Ok(found);
             }
             if step.t1 >= t_end {
-                return Ok((Event::Horizon, step.t1, step.y1));
+                return Ok((PhaseEnd::Horizon, step.t1, step.y1));
             }
         }
     }
@@ -819,12 +488,12 @@ fn rest(y: &mut State) -> Phase {
 
 /// The first event of a moving phase inside `step`, with the bookkeeping
 /// of the step (reach, distances, contact forces).
-fn moving_event<D: Drive>(
+fn moving_event<D: DriveModel>(
     model: &Model<'_, D>,
-    rec: &mut Record,
+    rec: &mut CycleTally,
     phase: Phase,
-    step: &Step<3>,
-) -> Result<Option<(Event, f64, State)>, DriveError> {
+    step: &Dopri5Step<3>,
+) -> Result<Option<(PhaseEnd, f64, State)>, DriveError> {
     let g = model.g();
     let parts = monotone_parts(step);
     // A crossing of `level` (in u) in the given direction on a monotonic
@@ -854,10 +523,10 @@ fn moving_event<D: Drive>(
     for &(a, b) in parts.spans() {
         found = match phase {
             Phase::Flight => crossing(a, b, 0.0, true)
-                .map(|(t, y)| (Event::TouchMake, t, y))
-                .or_else(|| crossing(a, b, -g, false).map(|(t, y)| (Event::TouchBack, t, y))),
-            Phase::Make => crossing(a, b, 0.0, false).map(|(t, y)| (Event::ReleaseMake, t, y)),
-            Phase::Back => crossing(a, b, -g, true).map(|(t, y)| (Event::ReleaseBack, t, y)),
+                .map(|(t, y)| (PhaseEnd::TouchMake, t, y))
+                .or_else(|| crossing(a, b, -g, false).map(|(t, y)| (PhaseEnd::TouchBack, t, y))),
+            Phase::Make => crossing(a, b, 0.0, false).map(|(t, y)| (PhaseEnd::ReleaseMake, t, y)),
+            Phase::Back => crossing(a, b, -g, true).map(|(t, y)| (PhaseEnd::ReleaseBack, t, y)),
             Phase::Held | Phase::Pressed => None,
         };
         if found.is_some() {
@@ -874,7 +543,7 @@ fn moving_event<D: Drive>(
         rec.see_position(g + yz[0], g);
     }
     rec.see_position(g + y_last[0], g);
-    let track_force = |rec: &mut Record, side: Phase| {
+    let track_force = |rec: &mut CycleTally, side: Phase| {
         // The force at the end, and at its extremum inside the step: a
         // zero of its rate, bisected on the interpolant.
         let rate = |t: f64| {
@@ -911,15 +580,15 @@ fn moving_event<D: Drive>(
 /// s, the lift-offs in an event log: every departure from a held rest,
 /// and every release from the back stop after which the armature next
 /// touches the NO contact (the others are NC bounces).
-fn lift_offs(log: &[(f64, Event)]) -> Vec<f64> {
+fn lift_offs(log: &[(f64, PhaseEnd)]) -> Vec<f64> {
     let mut out = Vec::new();
     for (k, &(t, event)) in log.iter().enumerate() {
         let lifts = match event {
-            Event::Lift => true,
-            Event::ReleaseBack => log[k + 1..]
+            PhaseEnd::Lift => true,
+            PhaseEnd::ReleaseBack => log[k + 1..]
                 .iter()
-                .find(|(_, e)| matches!(e, Event::TouchMake | Event::TouchBack))
-                .is_some_and(|(_, e)| *e == Event::TouchMake),
+                .find(|(_, e)| matches!(e, PhaseEnd::TouchMake | PhaseEnd::TouchBack))
+                .is_some_and(|(_, e)| *e == PhaseEnd::TouchMake),
             _ => false,
         };
         if lifts {

@@ -22,8 +22,8 @@
 
 use nalgebra::SVector;
 
-use super::MechanicsError;
-use super::integrate::{Tolerance, trial_step};
+use super::error::MechanicsError;
+use super::step_control::{StepTolerance, trial_step};
 
 const C2: f64 = 0.526001519587677318785587544488e-01;
 const C3: f64 = 0.789002279381515978178381316732e-01;
@@ -266,7 +266,7 @@ where
     F: Fn(f64, &SVector<f64, N>) -> SVector<f64, N>,
 {
     f: F,
-    tol: Tolerance<N>,
+    tol: StepTolerance<N>,
     t: f64,
     y: SVector<f64, N>,
     /// f(t, y), reused as the first stage (first same as last).
@@ -290,7 +290,7 @@ where
 {
     /// Start at (`t0`, `y0`) with a first trial step `h0` (> 0), every
     /// component controlled.
-    pub fn new(f: F, t0: f64, y0: SVector<f64, N>, h0: f64, tol: Tolerance<N>) -> Self {
+    pub fn new(f: F, t0: f64, y0: SVector<f64, N>, h0: f64, tol: StepTolerance<N>) -> Self {
         let k1 = f(t0, &y0);
         Dop853 {
             f,
@@ -658,7 +658,7 @@ mod tests {
     /// conditions that scalar or linear problems do not). Returns the state
     /// at every multiple of `h / 2`: step ends, and dense output between.
     fn duffing_fixed(h: f64) -> Vec<Vector2<f64>> {
-        let loose = Tolerance {
+        let loose = StepTolerance {
             rtol: 1e10,
             atol: Vector2::new(1e10, 1e10),
         };
@@ -709,7 +709,7 @@ mod tests {
     fn a_quadrature_left_out_of_the_control_stays_accurate() {
         // ẍ = −x from (1, 0) with q' = x: q = sin t. Only (x, ẋ) set the
         // steps (M = 2).
-        let tol = Tolerance {
+        let tol = StepTolerance {
             rtol: 1e-9,
             atol: nalgebra::Vector3::new(1e-9, 1e-9, f64::NAN),
         };
@@ -729,7 +729,7 @@ mod tests {
 
     fn oscillator(rtol: f64) -> (f64, f64, usize) {
         // ẍ = −x, x(0) = 1: x = cos t.
-        let tol = Tolerance {
+        let tol = StepTolerance {
             rtol,
             atol: Vector2::new(rtol, rtol),
         };

@@ -1,8 +1,8 @@
-//! What the integrated engine ([`super::cycle`]) shares with its users:
-//! the `Drive` trait (a force that varies in time and position and may
-//! carry a state of its own, such as the coil's flux), the state it
-//! integrates, the record of a closing (`Run`, `Piece`) and the
-//! event-location numerics.
+//! What the integrated engines (the cycle engine and the two-stage
+//! engine) share with their users: the `DriveModel` trait (a force that
+//! varies in time and position and may carry a state of its own, such as
+//! the coil's flux), the state the cycle engine integrates, a view of one
+//! of its steps (`Piece`) and the event-location numerics.
 //!
 //! The state is `(u, v, e)`: `u = x − g` (m, the position relative to the
 //! fixed contact, so that the µm penetrations keep their precision), the
@@ -22,11 +22,9 @@
 
 use nalgebra::Vector3;
 
-use super::DriveError;
-use super::Mechanics;
-use super::integrate::{Step, Tolerance};
-use super::trajectory::Segment;
-use crate::chatter::Chatter;
+use super::error::DriveError;
+use super::integrate::{Dopri5Step, StepTolerance};
+use super::parameters::Mechanics;
 
 /// `(u = x − g, v, e)`: m, m/s, and the drive's own state.
 pub(crate) type State = Vector3<f64>;
@@ -35,8 +33,11 @@ pub(crate) type State = Vector3<f64>;
 /// whole sequence agree with the closed-form engine to ~1e-9.
 pub(crate) const RTOL: f64 = 1e-11;
 
-/// What pushes the armature toward the fixed contact.
-pub(crate) trait Drive {
+/// What pushes the armature toward the fixed contact, as the integrated
+/// engines take it: a force with a state of its own and the work the
+/// sticking tests need. A trajectory's public `Drive` (a step, or a force
+/// `F(t, x)`) becomes one of these; so does the coil on its source.
+pub(crate) trait DriveModel {
     /// N, the force toward closing at time `t` (s), position `x` (m) and
     /// drive state `e`.
     fn force(&self, t: f64, x: f64, e: f64) -> f64;
@@ -55,7 +56,7 @@ pub(crate) trait Drive {
     /// J, the work of the drive with its state `e` held (its own dynamics
     /// stopped) on an armature moving from `from` to `to` (m): the
     /// potential of the energy bound that ends a two-stage closing. By
-    /// default [`Drive::frozen_work`].
+    /// default [`DriveModel::frozen_work`].
     fn held_work(&self, t: f64, e: f64, from: f64, to: f64) -> f64 {
         self.frozen_work(t, e, from, to)
     }
@@ -76,12 +77,11 @@ pub(crate) enum StepKind {
 
 /// One accepted step, cut at the event that ended its phase: valid on
 /// `[step.t0, t1]`, where the state is `y1` (the exact event state for
-/// the last step of a phase). A view of a trajectory's segment
-/// ([`super::trajectory`]).
+/// the last step of a phase). A view of a trajectory's segment.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Piece<'a> {
     pub phase: StepKind,
-    pub step: &'a Step<3>,
+    pub step: &'a Dopri5Step<3>,
     pub t1: f64,
     pub y1: State,
 }
@@ -107,28 +107,13 @@ impl Piece<'_> {
     }
 }
 
-/// A finished run.
-pub(crate) struct Run {
-    pub chatter: Chatter,
-    /// s, the first lift-off from the rest stop (`None` if it never lifts
-    /// or did not start on it).
-    pub lift_off: Option<f64>,
-    /// Every accepted step in time order, cut at events: they tile
-    /// `[0, end]`; each is a [`Piece`] ([`Segment::piece`]).
-    pub steps: Vec<Segment>,
-    /// J, kinetic energy taken by rigid impacts and inelastic landings.
-    pub jump_loss: f64,
-    /// (s, state) where the run stopped.
-    pub end: (f64, State),
-}
-
 /// The integration tolerance for `m` under `drive`, once the drive is
 /// known to be finite where the run starts (drive state `e0`).
-pub(crate) fn start<D: Drive>(
+pub(crate) fn start_tolerance<D: DriveModel>(
     m: &Mechanics,
     drive: &D,
     e0: f64,
-) -> Result<Tolerance<3>, DriveError> {
+) -> Result<StepTolerance<3>, DriveError> {
     let x0 = m.initial_position;
     let f0 = drive.force(0.0, x0, e0);
     if !f0.is_finite() {
@@ -139,7 +124,7 @@ pub(crate) fn start<D: Drive>(
         });
     }
     let omega = (m.stiffness / m.mass).sqrt();
-    Ok(Tolerance {
+    Ok(StepTolerance {
         rtol: RTOL,
         atol: State::new(RTOL * m.gap, RTOL * m.gap * omega, RTOL * drive.e_scale()),
     })
@@ -181,14 +166,14 @@ pub(crate) fn sign_change(f: impl Fn(f64) -> f64, lo: f64, hi: f64) -> Option<f6
 }
 
 /// A step split at the velocity zero it may contain.
-pub(crate) struct Parts {
+pub(crate) struct MonotoneParts {
     bounds: [(f64, f64); 2],
     n: usize,
     /// (time, state) of the turning point, if any.
     pub turn: Option<(f64, State)>,
 }
 
-impl Parts {
+impl MonotoneParts {
     /// The one or two time spans on which x is monotonic, in order.
     pub fn spans(&self) -> &[(f64, f64)] {
         &self.bounds[..self.n]
@@ -197,7 +182,7 @@ impl Parts {
 
 /// The step split at the velocity zero it may contain: up to two parts,
 /// each with x monotonic, and the turning point if any.
-pub(crate) fn monotone_parts(step: &Step<3>) -> Parts {
+pub(crate) fn monotone_parts(step: &Dopri5Step<3>) -> MonotoneParts {
     let (v0, v1) = (step.y0[1], step.y1[1]);
     if (v0 > 0.0 && v1 < 0.0) || (v0 < 0.0 && v1 > 0.0) {
         let up = v0 > 0.0;
@@ -210,13 +195,13 @@ pub(crate) fn monotone_parts(step: &Step<3>) -> Parts {
             step.t1,
         );
         let yz = step.at(tz);
-        Parts {
+        MonotoneParts {
             bounds: [(step.t0, tz), (tz, step.t1)],
             n: 2,
             turn: Some((tz, yz)),
         }
     } else {
-        Parts {
+        MonotoneParts {
             bounds: [(step.t0, step.t1), (0.0, 0.0)],
             n: 1,
             turn: None,
@@ -225,7 +210,7 @@ pub(crate) fn monotone_parts(step: &Step<3>) -> Parts {
 }
 
 /// The state on `step` at `t`, exact at its ends.
-pub(crate) fn state_on(step: &Step<3>, t: f64) -> State {
+pub(crate) fn state_on(step: &Dopri5Step<3>, t: f64) -> State {
     if t == step.t0 {
         step.y0
     } else if t == step.t1 {

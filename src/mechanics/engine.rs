@@ -23,9 +23,12 @@
 //! series of ratio e, so the tail sums to `T/(1 − e)` from the first
 //! skipped flight `T`: that is the reported accumulation time.
 
+use super::error::{MAX_EVENTS, MechanicsError};
 use super::hunt_crossley::{HcContact, HcEnd};
 use super::linear::{LinearPiece, Mode, Shift, Zeros};
-use super::{Mechanics, MechanicsError, Settings, Surface};
+pub use super::parameters::validate;
+use super::parameters::{Mechanics, Settings};
+use super::surface::Surface;
 use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome, bounces};
 
 /// Simulate one closing: the chatter sequence from t = 0 to an ending of
@@ -38,122 +41,6 @@ pub fn simulate(
 ) -> Result<Chatter, MechanicsError> {
     validate(mechanics, surface, settings)?;
     Engine::new(mechanics, surface, settings).run()
-}
-
-/// `value` of key `name` is finite and `ok`, or the error naming the key
-/// and what it must satisfy.
-pub(crate) fn check(
-    name: &'static str,
-    value: f64,
-    ok: bool,
-    requirement: &'static str,
-) -> Result<(), MechanicsError> {
-    if value.is_finite() && ok {
-        Ok(())
-    } else {
-        Err(MechanicsError::InvalidParameter {
-            name,
-            value,
-            requirement,
-        })
-    }
-}
-
-/// Check every parameter the engine relies on.
-pub fn validate(m: &Mechanics, surface: &Surface, s: &Settings) -> Result<(), MechanicsError> {
-    check("mechanics.mass", m.mass, m.mass > 0.0, "a mass in kg, > 0")?;
-    check(
-        "mechanics.stiffness",
-        m.stiffness,
-        m.stiffness > 0.0,
-        "a suspension stiffness in N/m, > 0",
-    )?;
-    check(
-        "mechanics.damping",
-        m.damping,
-        m.damping >= 0.0,
-        "a damping in N·s/m, ≥ 0",
-    )?;
-    check("mechanics.force", m.force, true, "a finite force in N")?;
-    check("mechanics.gap", m.gap, m.gap > 0.0, "a gap in m, > 0")?;
-    check(
-        "mechanics.initial_position",
-        m.initial_position,
-        m.initial_position < m.gap,
-        "a position in m below the gap (the contact starts open)",
-    )?;
-    check(
-        "mechanics.initial_velocity",
-        m.initial_velocity,
-        true,
-        "a finite velocity in m/s",
-    )?;
-    check(
-        "mechanics.preload",
-        m.preload,
-        m.preload >= 0.0,
-        "a preload in N, ≥ 0",
-    )?;
-    match *surface {
-        Surface::Rigid { restitution } => check(
-            "surface.restitution",
-            restitution,
-            (0.0..=1.0).contains(&restitution),
-            "a coefficient of restitution in [0, 1]",
-        )?,
-        Surface::KelvinVoigt { stiffness, damping } => {
-            check(
-                "surface.stiffness",
-                stiffness,
-                stiffness > 0.0,
-                "a surface stiffness in N/m, > 0",
-            )?;
-            check(
-                "surface.damping",
-                damping,
-                damping >= 0.0,
-                "a surface damping in N·s/m, ≥ 0",
-            )?;
-        }
-        Surface::HuntCrossley {
-            stiffness,
-            exponent,
-            chi,
-        } => {
-            check(
-                "surface.stiffness",
-                stiffness,
-                stiffness > 0.0,
-                "a surface stiffness in N/mⁿ, > 0",
-            )?;
-            check(
-                "surface.exponent",
-                exponent,
-                (1.0..=3.0).contains(&exponent),
-                "an exponent n in [1, 3] (1: linear spring, 1.5: Hertz)",
-            )?;
-            check("surface.chi", chi, chi >= 0.0, "χ = λ/k in s/m, ≥ 0")?;
-        }
-    }
-    check(
-        "simulation.t_end",
-        s.t_end,
-        s.t_end > 0.0,
-        "a horizon in s, > 0",
-    )?;
-    check(
-        "simulation.min_open_time",
-        s.min_open_time,
-        s.min_open_time >= 0.0,
-        "a time in s, ≥ 0",
-    )?;
-    check(
-        "simulation.min_gap",
-        s.min_gap,
-        s.min_gap >= 0.0,
-        "a distance in m, ≥ 0",
-    )?;
-    Ok(())
 }
 
 /// How one contact phase ended.
@@ -211,7 +98,7 @@ impl<'a> Engine<'a> {
         let (mut t, mut x, mut v) = (0.0, m.initial_position, m.initial_velocity);
         let mut open_since = 0.0;
         loop {
-            if self.impacts.len() >= super::MAX_EVENTS {
+            if self.impacts.len() >= MAX_EVENTS {
                 return Ok(self.finish_open(Outcome::EventLimit, open_since, None));
             }
             // Flight from (t, x, v).

@@ -2,17 +2,18 @@
 //!
 //! This is the mechanical half of the waveform-relaxation coupling with
 //! ngspice: the circuit gives the coil current `i(t)`, the coil turns it
-//! into `F_m(i(t), x)` ([`crate::coil::Coil::force`]), and this integrates the
-//! armature under it, with the same events, surface laws and endings as
-//! the step-force engine, by the one integrated engine ([`super::cycle`]:
-//! the whole cycle, or one closing stopped at its ending). With a
-//! constant force it reproduces [`crate::mechanics::simulate`].
+//! into its pull `F_m(i(t), x)`, and this integrates the armature under
+//! it, with the same events, surface laws and endings as the step-force
+//! engine, by the one integrated engine ([`super::cycle`]: the whole
+//! cycle, or one closing stopped at its ending). With a constant force it
+//! reproduces [`super::engine::simulate`].
 
-use super::DriveError;
-use super::cycle::{self, Cycle, Stops};
-use super::driven::Drive;
-use super::trajectory::{Segment, path_of};
-use super::{self as mechanics, Mechanics, Settings, Surface};
+use super::cycle::{self, Cycle};
+use super::driven::DriveModel;
+use super::error::DriveError;
+use super::parameters::{self, Mechanics, Settings, Stops};
+use super::segment::{Segment, path_of};
+use super::surface::Surface;
 use crate::chatter::Chatter;
 
 /// Simulate one closing under `force(t, x)` (s, m → N, toward closing),
@@ -71,7 +72,7 @@ pub fn simulate_cycle(
     let surfaces: Vec<&Surface> = std::iter::once(&stops.make).chain(&stops.back).collect();
     validate(mechanics, &surfaces, settings)?;
     let drive = Forced::new(mechanics, force);
-    cycle::run(mechanics, stops, settings, &drive, 0.0)
+    cycle::run_cycle(mechanics, stops, settings, &drive, 0.0)
 }
 
 /// The engine's checks of the relay (its `force` unused: the drive
@@ -87,7 +88,7 @@ fn validate(
         ..*mechanics
     };
     for surface in surfaces {
-        mechanics::validate(&unforced, surface, settings)?;
+        parameters::validate(&unforced, surface, settings)?;
     }
     if mechanics.initial_position < 0.0 {
         return Err(DriveError::InvalidParameter {
@@ -135,7 +136,7 @@ impl<F: Fn(f64, f64) -> f64> Forced<F> {
     }
 }
 
-impl<F: Fn(f64, f64) -> f64> Drive for Forced<F> {
+impl<F: Fn(f64, f64) -> f64> DriveModel for Forced<F> {
     fn force(&self, t: f64, x: f64, _e: f64) -> f64 {
         (self.force)(t, x)
     }

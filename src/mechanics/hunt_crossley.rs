@@ -38,9 +38,10 @@
 use nalgebra::Vector3;
 
 use super::dop853::{Dense, Dop853, Dop853Step};
-use super::integrate::Tolerance;
+use super::error::{MAX_CONTACT_STEPS, MechanicsError};
+use super::parameters::Mechanics;
 use super::root;
-use super::{Mechanics, MechanicsError};
+use super::step_control::StepTolerance;
 
 /// Everything the contact integration needs (SI units).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -215,7 +216,7 @@ impl HcContact {
         let u_scale = depth.sqrt();
         let s_scale = t_scale / u_scale;
         let rtol = 1e-9;
-        let tol = Tolerance {
+        let tol = StepTolerance {
             rtol,
             // (The solver controls u and v only; t's entry goes unread.)
             atol: HcState::new(rtol * u_scale, rtol * v_hit, rtol * t_scale),
@@ -249,10 +250,10 @@ impl HcContact {
         let mut steps = 0usize;
         loop {
             steps += 1;
-            if steps > super::MAX_CONTACT_STEPS {
+            if steps > MAX_CONTACT_STEPS {
                 return Err(MechanicsError::ContactTooLong {
                     time: solver.y()[2],
-                    steps: super::MAX_CONTACT_STEPS,
+                    steps: MAX_CONTACT_STEPS,
                 });
             }
             let step = match solver.step(f64::INFINITY) {

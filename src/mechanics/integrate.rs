@@ -1,7 +1,7 @@
 //! Adaptive Runge–Kutta integration with dense output, for the pieces of
 //! motion that have no closed form (later, a force that varies in time).
 //! The Hunt–Crossley contact, which needs tight tolerances, uses the
-//! higher-order [`super::dop853`] instead; [`Tolerance`] serves both.
+//! higher-order method of `dop853` instead; [`StepTolerance`] serves both.
 //!
 //! The method is Dormand–Prince 5(4) with its 4th-order continuous
 //! extension (Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.5–6). It is
@@ -11,27 +11,19 @@
 //! stack-allocated `SVector` step is a few dozen flops.
 //!
 //! The caller owns the loop ([`Dopri5::step`] returns one accepted
-//! [`Step`]), checks its events on the step, and stops when it likes; so
+//! [`Dopri5Step`]), checks its events on the step, and stops when it likes; so
 //! events are bracketed by the step and polished on the interpolant.
 
 use nalgebra::SVector;
 
-use super::MechanicsError;
-
-/// Tolerances: a step is accepted when every component's error estimate
-/// is within `atol[i] + rtol·|y[i]|`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Tolerance<const N: usize> {
-    /// The relative tolerance, the same for every component.
-    pub rtol: f64,
-    /// The absolute tolerance of each component, in its unit.
-    pub atol: SVector<f64, N>,
-}
+use super::error::MechanicsError;
+pub use super::step_control::StepTolerance;
+use super::step_control::trial_step;
 
 /// One accepted step from `t0` to `t1`, with the coefficients of its
 /// continuous extension.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Step<const N: usize> {
+pub struct Dopri5Step<const N: usize> {
     /// The independent variable at the start of the step.
     pub t0: f64,
     /// The independent variable at the end of the step.
@@ -43,7 +35,7 @@ pub struct Step<const N: usize> {
     cont: [SVector<f64, N>; 4],
 }
 
-impl<const N: usize> Step<N> {
+impl<const N: usize> Dopri5Step<N> {
     /// The dense-output state at `t` ∈ [t0, t1] (4th order accurate).
     pub fn at(&self, t: f64) -> SVector<f64, N> {
         let h = self.t1 - self.t0;
@@ -54,13 +46,21 @@ impl<const N: usize> Step<N> {
     }
 }
 
+/// The old name of [`StepTolerance`].
+#[deprecated(note = "renamed to `StepTolerance`")]
+pub type Tolerance<const N: usize> = StepTolerance<N>;
+
+/// The old name of [`Dopri5Step`].
+#[deprecated(note = "renamed to `Dopri5Step`")]
+pub type Step<const N: usize> = Dopri5Step<N>;
+
 /// Dormand–Prince 5(4) stepper for `ẏ = f(t, y)`.
 pub struct Dopri5<const N: usize, F>
 where
     F: Fn(f64, &SVector<f64, N>) -> SVector<f64, N>,
 {
     f: F,
-    tol: Tolerance<N>,
+    tol: StepTolerance<N>,
     t: f64,
     y: SVector<f64, N>,
     /// f(t, y), reused as the first stage (first same as last).
@@ -68,29 +68,6 @@ where
     h: f64,
     /// Number of right-hand-side evaluations so far.
     pub evaluations: usize,
-}
-
-/// The step to try from `t` with the controller's `h`: cut to land on
-/// `t_stop` (then `true`: the last), and an error when the controller has
-/// shrunk it to rounding level before getting there.
-#[inline(always)]
-pub(crate) fn trial_step(h: f64, t: f64, t_stop: f64) -> Result<(f64, bool), MechanicsError> {
-    // A step that is not a positive finite number (the state overflowed,
-    // or an open-ended integration was handed one) would repeat forever:
-    // `min` drops a NaN, and 0.1 × ∞ is ∞.
-    if !(h.is_finite() && h > 0.0 && t.is_finite()) {
-        return Err(MechanicsError::StepSizeTooSmall { time: t, step: h });
-    }
-    let mut h = h.min(t_stop - t);
-    let last = h >= t_stop - t;
-    if last {
-        h = t_stop - t;
-    }
-    let too_small = h.is_nan() || h <= 16.0 * f64::EPSILON * t.abs().max(h.abs());
-    if too_small && !last {
-        return Err(MechanicsError::StepSizeTooSmall { time: t, step: h });
-    }
-    Ok((h, last))
 }
 
 // Butcher tableau of Dormand & Prince (1980).
@@ -139,7 +116,7 @@ where
 {
     /// Start at (`t0`, `y0`) with a first trial step `h0` (> 0): the
     /// controller corrects a poor guess within a few steps.
-    pub fn new(f: F, t0: f64, y0: SVector<f64, N>, h0: f64, tol: Tolerance<N>) -> Self {
+    pub fn new(f: F, t0: f64, y0: SVector<f64, N>, h0: f64, tol: StepTolerance<N>) -> Self {
         let k1 = f(t0, &y0);
         Dopri5 {
             f,
@@ -163,7 +140,7 @@ where
     }
 
     /// Advance one accepted step, never past `t_stop`.
-    pub fn step(&mut self, t_stop: f64) -> Result<Step<N>, MechanicsError> {
+    pub fn step(&mut self, t_stop: f64) -> Result<Dopri5Step<N>, MechanicsError> {
         let f = &self.f;
         let (t, y, k1) = (self.t, self.y, self.k1);
         loop {
@@ -206,7 +183,7 @@ where
                 let bspl = k1 * h - dy;
                 let c4 = dy - k7 * h - bspl;
                 let c5 = (k1 * D1 + k3 * D3 + k4 * D4 + k5 * D5 + k6 * D6 + k7 * D7) * h;
-                let step = Step {
+                let step = Dopri5Step {
                     t0: t,
                     t1,
                     y0: y,
@@ -233,7 +210,7 @@ mod tests {
 
     fn oscillator_error(rtol: f64) -> f64 {
         // ẍ = −x, x(0) = 1: x = cos t.
-        let tol = Tolerance {
+        let tol = StepTolerance {
             rtol,
             atol: Vector2::new(rtol, rtol),
         };
@@ -271,7 +248,7 @@ mod tests {
 
     #[test]
     fn steps_end_exactly_at_the_stop_time() {
-        let tol = Tolerance {
+        let tol = StepTolerance {
             rtol: 1e-8,
             atol: SVector::<f64, 1>::new(1e-12),
         };

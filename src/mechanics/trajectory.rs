@@ -5,7 +5,7 @@
 //! [`simulate_drive`] runs the engine that fits the drive:
 //!
 //! - [`Drive::Step`], the constant force `mechanics.force` from t = 0: the
-//!   exact event engine ([`super::simulate`]). Between its events the
+//!   exact event engine ([`simulate`]). Between its events the
 //!   motion is rebuilt from the exact event states: closed-form flight and
 //!   Kelvin–Voigt contact pieces, and each Hunt–Crossley contact integrated
 //!   again by the very steps that found its release. The step model has no
@@ -21,17 +21,17 @@
 //! records (the chatter of the normally-open contact, and of the rest stop
 //! as the normally-closed one).
 
-use super::cycle::{Cycle, Stops, Stroke};
-use super::driven::{Piece, State, StepKind, state_on};
-use super::engine::{free_flight, kelvin_voigt_contact};
+use super::cycle::{Cycle, Stroke};
+use super::driven::state_on;
+use super::engine::{free_flight, kelvin_voigt_contact, simulate};
+use super::error::{DriveError, MechanicsError};
 use super::forced::simulate_cycle;
-use super::hunt_crossley::{HcContact, HcStep};
-use super::integrate::Step;
+use super::hunt_crossley::HcContact;
 use super::linear::LinearPiece;
-use super::surface::surface_force;
-use super::two_stage::TwoStageRun;
-use super::two_stage::engine::Span as StagedSpan;
-use super::{DriveError, Mechanics, MechanicsError, Settings, Surface};
+use super::parameters::{Mechanics, Settings, Stops};
+use super::segment::{Motion, Segment, Side, path_of};
+use super::surface::{Surface, surface_force};
+use super::two_stage::run::TwoStageRun;
 use crate::chatter::{Chatter, ContactState, Impact};
 
 /// What pushes the armature toward the fixed contact.
@@ -60,7 +60,7 @@ impl std::fmt::Debug for Drive<'_> {
 ///
 /// ```
 /// use chatterspice::mechanics::cycle::Stops;
-/// use chatterspice::mechanics::{Drive, EventKind, simulate_drive};
+/// use chatterspice::mechanics::{Drive, TrajectoryEventKind, simulate_drive};
 /// use chatterspice::{Mechanics, Settings, Surface};
 ///
 /// let relay = Mechanics { mass: 1e-4, stiffness: 5000.0, damping: 0.07, force: 1.0,
@@ -81,10 +81,11 @@ impl std::fmt::Debug for Drive<'_> {
 /// let held = Mechanics { preload: 0.1, ..relay };
 /// let settings = Settings { t_end: 0.03, ..Settings::default() };
 /// let cycle = simulate_drive(&held, &stops, &settings, Drive::Force(&pulse))?;
-/// let kinds: Vec<EventKind> = cycle.events().iter().map(|e| e.kind).collect();
-/// assert_eq!(kinds.first(), Some(&EventKind::LiftOff));
-/// assert!(kinds.contains(&EventKind::Settled) && kinds.contains(&EventKind::Release));
-/// assert_eq!(kinds.last(), Some(&EventKind::Landing));
+/// let kinds: Vec<TrajectoryEventKind> = cycle.events().iter().map(|e| e.kind).collect();
+/// assert_eq!(kinds.first(), Some(&TrajectoryEventKind::LiftOff));
+/// assert!(kinds.contains(&TrajectoryEventKind::Settled));
+/// assert!(kinds.contains(&TrajectoryEventKind::Release));
+/// assert_eq!(kinds.last(), Some(&TrajectoryEventKind::Landing));
 /// assert_eq!(cycle.gap(0.029), relay.gap);
 /// # Ok::<(), chatterspice::mechanics::DriveError>(())
 /// ```
@@ -106,7 +107,7 @@ pub fn simulate_drive(
 /// What happened at an event.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
-pub enum EventKind {
+pub enum TrajectoryEventKind {
     /// The armature leaves its rest stop on its way to the contact.
     LiftOff,
     /// The moving contact touches the fixed one.
@@ -128,11 +129,11 @@ pub enum EventKind {
 
 /// One event of a trajectory.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
-pub struct Event {
+pub struct TrajectoryEvent {
     /// s
     pub time: f64,
     /// What happened.
-    pub kind: EventKind,
+    pub kind: TrajectoryEventKind,
     /// m, the position (the gap for contact events, 0 on the rest stop).
     pub position: f64,
     /// m/s, the velocity just before the event for a touch or a landing,
@@ -141,149 +142,13 @@ pub struct Event {
     pub velocity: f64,
 }
 
-/// Which surface pushes on the armature over a segment.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Side {
-    Open,
-    Make,
-    Back,
-}
+/// The old name of [`TrajectoryEventKind`].
+#[deprecated(note = "renamed to `TrajectoryEventKind`")]
+pub type EventKind = TrajectoryEventKind;
 
-/// How the armature moves over a segment.
-#[derive(Debug, Clone, PartialEq)]
-enum Motion {
-    /// At rest at `x` (m) under a constant contact force (N): the step
-    /// drive's armature held on the rest stop or pressed on a rigid
-    /// contact.
-    Rest { x: f64, force: f64 },
-    /// Held at `x` (m) by the rest stop or a rigid contact over one
-    /// integrator step of the drive's own state, exact at its end `y1`;
-    /// the contact force (N) linear from `forces.0` at the start to
-    /// `forces.1` at the end.
-    Held {
-        x: f64,
-        step: Step<3>,
-        y1: State,
-        forces: (f64, f64),
-    },
-    /// A closed-form piece of the step drive, on its own clock from the
-    /// segment's start.
-    Linear(LinearPiece),
-    /// One integrator step in (u = x − g, v, drive state), exact at its
-    /// end `y1`.
-    Integrated { step: Step<3>, y1: State },
-    /// One step of a Hunt–Crossley contact under the step drive, touched
-    /// at `touch` (s).
-    Contact { step: HcStep, touch: f64 },
-    /// One step of the two-stage engine: the state is
-    /// `(u_a, v_a, u_b, v_b, e)`; the contact point is the blade's.
-    Staged(Box<StagedSpan>),
-}
-
-/// A stretch of the trajectory between two instants.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Segment {
-    t0: f64,
-    t1: f64,
-    side: Side,
-    motion: Motion,
-}
-
-impl Segment {
-    /// The armature at rest at `x` over [t0, t1], pushed by `force` (N)
-    /// of the surface it rests on (`on_contact`: the make contact, else
-    /// the rest stop).
-    fn rest(t0: f64, t1: f64, x: f64, on_contact: bool, force: f64) -> Self {
-        Segment {
-            t0,
-            t1,
-            side: if on_contact { Side::Make } else { Side::Back },
-            motion: Motion::Rest { x, force },
-        }
-    }
-
-    /// One integrator step of a held armature at `x`, cut at `t1` where
-    /// the drive's state is `y1`, pushed by the surface it rests on
-    /// (`on_contact`: the make contact, else the rest stop) with `forces`
-    /// (N) at the step's start and at `t1`.
-    pub(crate) fn held(
-        step: Step<3>,
-        t1: f64,
-        y1: State,
-        x: f64,
-        on_contact: bool,
-        forces: (f64, f64),
-    ) -> Self {
-        Segment {
-            t0: step.t0,
-            t1,
-            side: if on_contact { Side::Make } else { Side::Back },
-            motion: Motion::Held {
-                x,
-                step,
-                y1,
-                forces,
-            },
-        }
-    }
-
-    /// One integrator step of the cycle, cut at `t1` where the state is
-    /// `y1`; `side` is 0 in flight, 1 on the make contact, −1 on the rest
-    /// stop.
-    pub(crate) fn integrated(step: Step<3>, t1: f64, y1: State, side: i8) -> Self {
-        Segment {
-            t0: step.t0,
-            t1,
-            side: match side {
-                1 => Side::Make,
-                -1 => Side::Back,
-                _ => Side::Open,
-            },
-            motion: Motion::Integrated { step, y1 },
-        }
-    }
-
-    /// The integrator step under this segment as a closing records it:
-    /// held, in flight or in the make contact; `None` for a closed-form
-    /// piece and for the back stop's contact, which a closing never has.
-    pub(crate) fn piece(&self) -> Option<Piece<'_>> {
-        let (phase, step, y1) = match &self.motion {
-            Motion::Held { step, y1, .. } => (StepKind::Held, step, y1),
-            Motion::Integrated { step, y1 } if self.side == Side::Open => {
-                (StepKind::Flight, step, y1)
-            }
-            Motion::Integrated { step, y1 } if self.side == Side::Make => {
-                (StepKind::Contact, step, y1)
-            }
-            _ => return None,
-        };
-        Some(Piece {
-            phase,
-            step,
-            t1: self.t1,
-            y1: *y1,
-        })
-    }
-
-    /// s, where the segment starts and ends.
-    pub(crate) fn span(&self) -> (f64, f64) {
-        (self.t0, self.t1)
-    }
-
-    /// (s, m): the end of the segment and the position there, for a
-    /// contact at `g`.
-    pub(crate) fn end_position(&self, g: f64) -> (f64, f64) {
-        let x = match &self.motion {
-            Motion::Rest { x, .. } | Motion::Held { x, .. } => *x,
-            Motion::Linear(piece) => piece.state(self.t1 - self.t0).0,
-            Motion::Integrated { y1, .. } => g + y1[0],
-            Motion::Contact { step, touch } => g + step.at(self.t1 - touch).0,
-            // The armature, whose position sets the coil's inductance.
-            Motion::Staged(piece) => g + piece.y1[0],
-        };
-        (self.t1, x)
-    }
-}
+/// The old name of [`TrajectoryEvent`].
+#[deprecated(note = "renamed to `TrajectoryEvent`")]
+pub type Event = TrajectoryEvent;
 
 /// The armature's motion from t = 0 to the horizon.
 #[derive(Debug, Clone, PartialEq)]
@@ -294,7 +159,7 @@ pub struct Trajectory {
     back_surface: Option<Surface>,
     /// Tiling [0, t_end] in order.
     segments: Vec<Segment>,
-    events: Vec<Event>,
+    events: Vec<TrajectoryEvent>,
     make: Chatter,
     back: Option<Chatter>,
     strokes: Vec<Stroke>,
@@ -391,7 +256,7 @@ impl Trajectory {
     }
 
     /// Every event in time order.
-    pub fn events(&self) -> &[Event] {
+    pub fn events(&self) -> &[TrajectoryEvent] {
         &self.events
     }
 
@@ -501,16 +366,16 @@ impl Trajectory {
     ) -> Self {
         let mut events = contact_events(&cycle.make, m.gap);
         for b in &cycle.back.impacts {
-            events.push(Event {
+            events.push(TrajectoryEvent {
                 time: b.impact_time,
-                kind: EventKind::Landing,
+                kind: TrajectoryEventKind::Landing,
                 position: 0.0,
                 velocity: -b.impact_velocity,
             });
             if let (Some(t), Some(v)) = (b.release_time, b.release_velocity) {
-                events.push(Event {
+                events.push(TrajectoryEvent {
                     time: t,
-                    kind: EventKind::Rebound,
+                    kind: TrajectoryEventKind::Rebound,
                     position: 0.0,
                     velocity: -v,
                 });
@@ -519,11 +384,11 @@ impl Trajectory {
         for s in &cycle.strokes {
             let rebound = events
                 .iter()
-                .any(|e| e.kind == EventKind::Rebound && e.time == s.lift_off);
+                .any(|e| e.kind == TrajectoryEventKind::Rebound && e.time == s.lift_off);
             if !rebound {
-                events.push(Event {
+                events.push(TrajectoryEvent {
                     time: s.lift_off,
-                    kind: EventKind::LiftOff,
+                    kind: TrajectoryEventKind::LiftOff,
                     position: 0.0,
                     velocity: 0.0,
                 });
@@ -549,7 +414,7 @@ impl Trajectory {
 }
 
 impl Trajectory {
-    /// The trajectory of a two-stage run ([`super::two_stage`]): the
+    /// The trajectory of a two-stage run ([`TwoStageRun`]): the
     /// contact point is the blade's; [`Trajectory::armature`] and
     /// [`Trajectory::path`] follow the armature.
     pub fn of_two_stage(
@@ -561,33 +426,33 @@ impl Trajectory {
         let g = m.gap;
         let mut events = contact_events(&run.contact, g);
         for p in &run.pole_face {
-            events.push(Event {
+            events.push(TrajectoryEvent {
                 time: p.impact_time,
-                kind: EventKind::PoleFace,
+                kind: TrajectoryEventKind::PoleFace,
                 position: run.state(p.impact_time, g).0,
                 velocity: p.impact_velocity,
             });
             if let (Some(t), Some(v)) = (p.release_time, p.release_velocity) {
-                events.push(Event {
+                events.push(TrajectoryEvent {
                     time: t,
-                    kind: EventKind::PoleFaceRelease,
+                    kind: TrajectoryEventKind::PoleFaceRelease,
                     position: run.state(t, g).0,
                     velocity: v,
                 });
             }
         }
         for &t in run.strokes.iter().map(|s| &s.lift_off) {
-            events.push(Event {
+            events.push(TrajectoryEvent {
                 time: t,
-                kind: EventKind::LiftOff,
+                kind: TrajectoryEventKind::LiftOff,
                 position: 0.0,
                 velocity: 0.0,
             });
         }
         for b in &run.back.impacts {
-            events.push(Event {
+            events.push(TrajectoryEvent {
                 time: b.impact_time,
-                kind: EventKind::Landing,
+                kind: TrajectoryEventKind::Landing,
                 position: 0.0,
                 velocity: -b.impact_velocity,
             });
@@ -626,14 +491,14 @@ impl Trajectory {
     }
 
     /// The step-force closing of `m` onto `surface`: the exact engine's
-    /// record ([`super::simulate`]), with the motion between its events
+    /// record ([`simulate`]), with the motion between its events
     /// rebuilt from the exact event states.
     pub fn of_step(
         m: &Mechanics,
         surface: &Surface,
         settings: &Settings,
     ) -> Result<Trajectory, MechanicsError> {
-        let chatter = super::simulate(m, surface, settings)?;
+        let chatter = simulate(m, surface, settings)?;
         step_trajectory(m, surface, settings, chatter)
     }
 }
@@ -656,9 +521,9 @@ fn step_trajectory(
         let held = m.preload - m.force;
         segments.push(Segment::rest(0.0, t_end, 0.0, false, held));
     } else if m.initial_position == 0.0 && m.initial_velocity == 0.0 {
-        events.push(Event {
+        events.push(TrajectoryEvent {
             time: 0.0,
-            kind: EventKind::LiftOff,
+            kind: TrajectoryEventKind::LiftOff,
             position: 0.0,
             velocity: 0.0,
         });
@@ -779,19 +644,19 @@ fn contact_segments(
 }
 
 /// Touch and release events of a contact record at the gap `g`.
-fn contact_events(chatter: &Chatter, g: f64) -> Vec<Event> {
+fn contact_events(chatter: &Chatter, g: f64) -> Vec<TrajectoryEvent> {
     let mut events = Vec::with_capacity(2 * chatter.impacts.len() + 2);
     for i in &chatter.impacts {
-        events.push(Event {
+        events.push(TrajectoryEvent {
             time: i.impact_time,
-            kind: EventKind::Touch,
+            kind: TrajectoryEventKind::Touch,
             position: g,
             velocity: i.impact_velocity,
         });
         if let (Some(t), Some(v)) = (i.release_time, i.release_velocity) {
-            events.push(Event {
+            events.push(TrajectoryEvent {
                 time: t,
-                kind: EventKind::Release,
+                kind: TrajectoryEventKind::Release,
                 position: g,
                 velocity: v,
             });
@@ -800,10 +665,10 @@ fn contact_events(chatter: &Chatter, g: f64) -> Vec<Event> {
     events
 }
 
-fn settled(time: f64, g: f64) -> Event {
-    Event {
+fn settled(time: f64, g: f64) -> TrajectoryEvent {
+    TrajectoryEvent {
         time,
-        kind: EventKind::Settled,
+        kind: TrajectoryEventKind::Settled,
         position: g,
         velocity: 0.0,
     }
@@ -811,33 +676,19 @@ fn settled(time: f64, g: f64) -> Event {
 
 /// In time order; at one instant, in the order things happen (a lift-off
 /// before a touch, a touch before its release or its settling).
-fn sort(events: &mut [Event]) {
-    let rank = |k: EventKind| match k {
-        EventKind::Landing => 0,
-        EventKind::Rebound | EventKind::LiftOff => 1,
-        EventKind::Touch => 2,
-        EventKind::Settled => 3,
-        EventKind::Release => 4,
-        EventKind::PoleFace => 5,
-        EventKind::PoleFaceRelease => 6,
+fn sort(events: &mut [TrajectoryEvent]) {
+    let rank = |k: TrajectoryEventKind| match k {
+        TrajectoryEventKind::Landing => 0,
+        TrajectoryEventKind::Rebound | TrajectoryEventKind::LiftOff => 1,
+        TrajectoryEventKind::Touch => 2,
+        TrajectoryEventKind::Settled => 3,
+        TrajectoryEventKind::Release => 4,
+        TrajectoryEventKind::PoleFace => 5,
+        TrajectoryEventKind::PoleFaceRelease => 6,
     };
     events.sort_by(|a, b| {
         a.time
             .total_cmp(&b.time)
             .then(rank(a.kind).cmp(&rank(b.kind)))
     });
-}
-
-/// (s, m): `start`, then the position at the end of every segment (the
-/// contact at `g`), strictly increasing in time.
-pub(crate) fn path_of(start: (f64, f64), segments: &[Segment], g: f64) -> Vec<(f64, f64)> {
-    let mut out = Vec::with_capacity(segments.len() + 1);
-    out.push(start);
-    for segment in segments {
-        let (t, x) = segment.end_position(g);
-        if out.last().is_none_or(|&(tp, _)| t > tp) {
-            out.push((t, x));
-        }
-    }
-    out
 }

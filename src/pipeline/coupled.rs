@@ -33,10 +33,10 @@ use thiserror::Error;
 use crate::arc::ArcVectors;
 use crate::arc::GapProfile;
 use crate::chatter::{Chatter, ContactState, Interval};
-use crate::coil::accelerate::{CircuitRun, Tolerances, settle};
+use crate::coil::accelerate::{CircuitRun, CouplingTolerances, settle};
 #[cfg(test)]
 use crate::coil::samples::interpolate_at;
-use crate::coil::samples::{Cursor, back_of, event_change, thin};
+use crate::coil::samples::{Interpolator, back_of, event_change, thin};
 use crate::coil::timing::{Operation, Switching, operations};
 use crate::coil::{Coil, CoilError};
 use crate::mechanics::Mechanics;
@@ -480,7 +480,7 @@ pub fn run_coupled_plan(
             iteration,
             vector: psi.clone(),
         })?;
-        let flux_at = Cursor::new(&flux);
+        let flux_at = Interpolator::new(&flux);
         let pull = |t: f64, _x: f64| coil.force_from_flux(flux_at.at(t));
         let cycle = driven_run(&mechanics, &build, &stops, &settings, &pull).map_err(|source| {
             CouplingError::Coil {
@@ -531,7 +531,7 @@ pub fn run_coupled_plan(
                 &build,
                 &stops,
                 &settings,
-                Tolerances {
+                CouplingTolerances {
                     events: options.tolerance,
                     path: thinning,
                 },
@@ -665,7 +665,7 @@ mod tests {
                 (t, (f64::from(k) * 0.37).sin())
             })
             .collect();
-        let cursor = Cursor::new(&samples);
+        let cursor = Interpolator::new(&samples);
         // Forward, backward, repeated, out of range, exactly on samples.
         let mut times: Vec<f64> = (0..2000).map(|k| f64::from(k) * 1.1e-4 - 0.01).collect();
         times.extend(times.clone().into_iter().rev());

@@ -11,7 +11,7 @@
 //! - [`mod@run`]: every sample through [`pipeline::run`](crate::pipeline::run)
 //!   (mechanics → contact → netlist → ngspice → analysis) or through the
 //!   mechanics alone, on several threads, each sample's outcome a
-//!   [`Record`] — a failing sample (never closes, ngspice error, timeout)
+//!   [`SampleRecord`] — a failing sample (never closes, ngspice error, timeout)
 //!   is a record too, and the sweep goes on;
 //! - [`table`]: the records as `sweep.csv`, one row per sample in index
 //!   order, and [`table::merge`] that joins the CSVs of shards;
@@ -39,8 +39,10 @@ pub mod table;
 pub mod verdict;
 
 pub use error::SweepError;
-pub use record::{ProbeRecord, Record, Shard};
-pub use run::{Mode, NoProgress, Progress, SweepOptions, evaluate, run, run_from};
+pub use record::{ProbeRecord, SampleRecord, Shard};
+pub use run::{NoProgress, Progress, SweepMode, SweepOptions, run, run_from, run_sample};
 pub use sample::Sampler;
 pub use summary::{Collected, Summary};
-pub use verdict::Verdict;
+pub use verdict::SampleVerdict;
+#[allow(deprecated)]
+pub use {record::Record, run::Mode, run::evaluate, verdict::Verdict};

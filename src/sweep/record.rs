@@ -5,7 +5,7 @@ use std::fmt;
 use std::str::FromStr;
 
 use super::error::SweepError;
-use super::verdict::Verdict;
+use super::verdict::SampleVerdict;
 use crate::chatter::Outcome;
 
 /// The slice `K/N` of a sweep: the indices `i` with `i % N == K − 1`.
@@ -82,7 +82,7 @@ pub struct ProbeRecord {
 
 /// What one sample gave: a row of `sweep.csv`.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Record {
+pub struct SampleRecord {
     /// The sample's index in the sweep, from 0.
     pub index: u64,
     /// The varied keys' values, in [`Sampler::keys`](super::sample::Sampler::keys) order.
@@ -114,14 +114,18 @@ pub struct Record {
     /// results; empty otherwise.
     pub probes: Vec<ProbeRecord>,
     /// Whether the sample passed its limits, failed one, or could not run.
-    pub verdict: Verdict,
+    pub verdict: SampleVerdict,
     /// The keys of the limits that failed, in the scenario's order.
     pub failed_limits: Vec<String>,
     /// Why the sample failed: the error and its causes, one line.
     pub error: Option<String>,
 }
 
-impl Record {
+/// The old name of [`SampleRecord`].
+#[deprecated(note = "renamed to `SampleRecord`")]
+pub type Record = SampleRecord;
+
+impl SampleRecord {
     /// Whether the contact ended closed for good.
     pub fn closed(&self) -> bool {
         self.outcome.is_some_and(Outcome::is_closed)

@@ -20,8 +20,8 @@ use csv::{ByteRecord, ReaderBuilder};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use super::record::{ProbeRecord, Record, Shard};
-use super::verdict::Verdict;
+use super::record::{ProbeRecord, SampleRecord, Shard};
+use super::verdict::SampleVerdict;
 use crate::chatter::Outcome;
 
 /// Which sweep a CSV holds rows of.
@@ -258,7 +258,7 @@ pub fn finished_rows(
     signals: usize,
     columns: super::table::Columns,
     shard: Shard,
-) -> Result<(Vec<u8>, Vec<Record>), ResumeError> {
+) -> Result<(Vec<u8>, Vec<SampleRecord>), ResumeError> {
     read_rows(path, header, keys, signals, columns, Some(shard))
 }
 
@@ -270,7 +270,7 @@ pub fn all_rows(
     keys: usize,
     signals: usize,
     columns: super::table::Columns,
-) -> Result<Vec<Record>, ResumeError> {
+) -> Result<Vec<SampleRecord>, ResumeError> {
     read_rows(path, header, keys, signals, columns, None).map(|(_, records)| records)
 }
 
@@ -283,7 +283,7 @@ fn read_rows(
     signals: usize,
     columns: super::table::Columns,
     shard: Option<Shard>,
-) -> Result<(Vec<u8>, Vec<Record>), ResumeError> {
+) -> Result<(Vec<u8>, Vec<SampleRecord>), ResumeError> {
     let bytes =
         crate::input::read_limited(path, u64::MAX).map_err(|source| ResumeError::ReadCsv {
             path: path.to_owned(),
@@ -342,7 +342,7 @@ fn parse_row(
     keys: usize,
     signals: usize,
     columns: super::table::Columns,
-) -> Result<Record, String> {
+) -> Result<SampleRecord, String> {
     let mut cells = row
         .iter()
         .map(|c| std::str::from_utf8(c).unwrap_or("\u{fffd}"));
@@ -412,11 +412,11 @@ fn parse_row(
         }
     }
     let verdict_cell = next();
-    let verdict =
-        Verdict::parse(verdict_cell).ok_or_else(|| format!("`{verdict_cell}` is not a verdict"))?;
+    let verdict = SampleVerdict::parse(verdict_cell)
+        .ok_or_else(|| format!("`{verdict_cell}` is not a verdict"))?;
     let failed_limits = next().split_whitespace().map(str::to_owned).collect();
     let error = Some(next()).filter(|e| !e.is_empty()).map(str::to_owned);
-    Ok(Record {
+    Ok(SampleRecord {
         index,
         values,
         outcome,
@@ -459,8 +459,8 @@ mod tests {
     use super::*;
     use crate::sweep::table::{self, Columns};
 
-    fn record(index: u64) -> Record {
-        Record {
+    fn record(index: u64) -> SampleRecord {
+        SampleRecord {
             index,
             values: vec![1.5e-4 + index as f64 * 1e-7, 0.1],
             outcome: Some(Outcome::Stuck),
@@ -480,7 +480,7 @@ mod tests {
                 lockout: Some(2e-4),
                 stable_for: Some(1e-4),
             }],
-            verdict: Verdict::Fail,
+            verdict: SampleVerdict::Fail,
             failed_limits: vec!["limits.max_bounces".into(), "probe[0].max_edges".into()],
             error: None,
         }
@@ -499,7 +499,7 @@ mod tests {
         let mut failed = record(2);
         failed.outcome = None;
         failed.probes.clear();
-        failed.verdict = Verdict::Error;
+        failed.verdict = SampleVerdict::Error;
         failed.error = Some("ngspice failed: timeout, after 60 s".into());
         let records = vec![record(0), record(1), failed];
         let mut bytes = header.clone();

@@ -33,26 +33,30 @@ use crate::scenario::Scenario;
 use crate::spice::Runner;
 
 use super::error::SweepError;
-use super::record::{ProbeRecord, Record, Shard};
+use super::record::{ProbeRecord, SampleRecord, Shard};
 use super::sample::Sampler;
 use super::summary::Collected;
 use super::table;
-use super::verdict::{Verdict, verdict};
+use super::verdict::{SampleVerdict, verdict};
 
 /// What each sample runs.
 #[derive(Clone, Copy)]
-pub enum Mode<'r> {
+pub enum SweepMode<'r> {
     /// The mechanics alone: outcome, bounces, times; no probes.
     Mechanics,
     /// The whole pipeline with this runner (e.g. [`Ngspice`](crate::spice::Ngspice)).
     Circuit(&'r dyn Runner),
 }
 
-impl std::fmt::Debug for Mode<'_> {
+/// The old name of [`SweepMode`].
+#[deprecated(note = "renamed to `SweepMode`")]
+pub type Mode<'r> = SweepMode<'r>;
+
+impl std::fmt::Debug for SweepMode<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            Mode::Mechanics => f.write_str("Mechanics"),
-            Mode::Circuit(_) => f.write_str("Circuit(..)"),
+            SweepMode::Mechanics => f.write_str("Mechanics"),
+            SweepMode::Circuit(_) => f.write_str("Circuit(..)"),
         }
     }
 }
@@ -61,7 +65,7 @@ impl std::fmt::Debug for Mode<'_> {
 #[derive(Debug, Clone)]
 pub struct SweepOptions<'r> {
     /// The mechanics alone, or the whole pipeline through a runner.
-    pub mode: Mode<'r>,
+    pub mode: SweepMode<'r>,
     /// Threads evaluating samples (with ngspice: ngspice processes at once).
     pub jobs: NonZeroUsize,
     /// The slice of the samples to run ([`Shard::WHOLE`] for all).
@@ -73,7 +77,7 @@ pub struct SweepOptions<'r> {
 
 impl SweepOptions<'_> {
     /// `mode` on one thread per core, the whole sweep.
-    pub fn new(mode: Mode<'_>) -> SweepOptions<'_> {
+    pub fn new(mode: SweepMode<'_>) -> SweepOptions<'_> {
         SweepOptions {
             mode,
             jobs: std::thread::available_parallelism().unwrap_or(NonZeroUsize::MIN),
@@ -109,10 +113,10 @@ pub struct NoProgress;
 impl Progress for NoProgress {}
 
 /// Samples per chunk a worker claims.
-fn chunk_len(mode: Mode<'_>) -> u64 {
+fn chunk_len(mode: SweepMode<'_>) -> u64 {
     match mode {
-        Mode::Mechanics => 512,
-        Mode::Circuit(_) => 1,
+        SweepMode::Mechanics => 512,
+        SweepMode::Circuit(_) => 1,
     }
 }
 
@@ -148,7 +152,7 @@ pub fn layout(
 }
 
 fn columns(scenario: &Scenario, options: &SweepOptions<'_>) -> table::Columns {
-    let circuit = matches!(options.mode, Mode::Circuit(_));
+    let circuit = matches!(options.mode, SweepMode::Circuit(_));
     table::Columns {
         coil: scenario.coil.is_some(),
         ideal: options.run.compare_ideal && circuit,
@@ -166,7 +170,7 @@ pub fn run_from(
     options: &SweepOptions<'_>,
     out: &mut dyn Write,
     progress: &dyn Progress,
-    done: Vec<Record>,
+    done: Vec<SampleRecord>,
 ) -> Result<Collected, SweepError> {
     let signals = signals(scenario, options)?;
     // Resolved once, the netlist read once (a netlist that cannot be read
@@ -195,7 +199,7 @@ pub fn run_from(
     let next = AtomicU64::new(0);
     let stop = AtomicBool::new(false);
     let jobs = options.jobs.get();
-    let (tx, rx) = mpsc::sync_channel::<(u64, Vec<u8>, Vec<Record>)>(4 * jobs);
+    let (tx, rx) = mpsc::sync_channel::<(u64, Vec<u8>, Vec<SampleRecord>)>(4 * jobs);
     let written = std::thread::scope(|scope| {
         for _ in 0..jobs {
             let tx = tx.clone();
@@ -208,7 +212,7 @@ pub fn run_from(
                         break;
                     }
                     let positions = first + c * chunk..(first + (c + 1) * chunk).min(total);
-                    let records: Vec<Record> = positions
+                    let records: Vec<SampleRecord> = positions
                         .map(|p| worker.evaluate(options.shard.sample(p)))
                         .collect();
                     let rows = table::rows(&records, sampler.keys().len(), probes, columns);
@@ -247,18 +251,18 @@ pub fn run_from(
 /// The probed signals of a sweep, or why it cannot run.
 fn signals(scenario: &Scenario, options: &SweepOptions<'_>) -> Result<Vec<String>, SweepError> {
     Ok(match options.mode {
-        Mode::Mechanics if scenario.coil.is_some() => {
+        SweepMode::Mechanics if scenario.coil.is_some() => {
             return Err(SweepError::CoilNeedsCircuit {
                 path: scenario.origin.clone(),
             });
         }
-        Mode::Mechanics if scenario.limits.is_some_and(|l| l.has_arc_limits()) => {
+        SweepMode::Mechanics if scenario.limits.is_some_and(|l| l.has_arc_limits()) => {
             return Err(SweepError::ArcLimitsNeedCircuit {
                 path: scenario.origin.clone(),
             });
         }
-        Mode::Mechanics => Vec::new(),
-        Mode::Circuit(_) => {
+        SweepMode::Mechanics => Vec::new(),
+        SweepMode::Circuit(_) => {
             if scenario.circuit.is_none() || scenario.probes.is_empty() {
                 return Err(SweepError::NeedsCircuit {
                     path: scenario.origin.clone(),
@@ -269,26 +273,37 @@ fn signals(scenario: &Scenario, options: &SweepOptions<'_>) -> Result<Vec<String
     })
 }
 
-/// Evaluate sample `index` of `sampler`'s sweep of `scenario` on its own
+/// Run sample `index` of `sampler`'s sweep of `scenario` on its own
 /// (the sweep's workers share one resolved plan instead).
-pub fn evaluate(
+pub fn run_sample(
     scenario: &Scenario,
     sampler: &Sampler,
     index: u64,
     options: &SweepOptions<'_>,
-) -> Record {
+) -> SampleRecord {
     match base_plan(scenario, options) {
         Ok(base) => Worker::new(&base, sampler, options).evaluate(index),
-        Err(e) => Record {
+        Err(e) => SampleRecord {
             error: Some(one_line(&e)),
             ..blank(index)
         },
     }
 }
 
+/// The old name of [`run_sample`].
+#[deprecated(note = "renamed to `run_sample`")]
+pub fn evaluate(
+    scenario: &Scenario,
+    sampler: &Sampler,
+    index: u64,
+    options: &SweepOptions<'_>,
+) -> SampleRecord {
+    run_sample(scenario, sampler, index, options)
+}
+
 /// Sample `index`'s record before anything ran: every value absent.
-fn blank(index: u64) -> Record {
-    Record {
+fn blank(index: u64) -> SampleRecord {
+    SampleRecord {
         index,
         values: Vec::new(),
         outcome: None,
@@ -302,7 +317,7 @@ fn blank(index: u64) -> Record {
         arc_energy: None,
         breakdowns: None,
         probes: Vec::new(),
-        verdict: Verdict::Error,
+        verdict: SampleVerdict::Error,
         failed_limits: Vec::new(),
         error: None,
     }
@@ -312,8 +327,8 @@ fn blank(index: u64) -> Record {
 /// sweep, not at all for the mechanics alone.
 fn base_plan(scenario: &Scenario, options: &SweepOptions<'_>) -> Result<Plan, SweepError> {
     Ok(match options.mode {
-        Mode::Circuit(_) => Plan::new(scenario.clone())?,
-        Mode::Mechanics => Plan::without_circuit(scenario.clone())?,
+        SweepMode::Circuit(_) => Plan::new(scenario.clone())?,
+        SweepMode::Mechanics => Plan::without_circuit(scenario.clone())?,
     })
 }
 
@@ -340,7 +355,7 @@ impl<'a, 'r> Worker<'a, 'r> {
         }
     }
 
-    fn evaluate(&mut self, index: u64) -> Record {
+    fn evaluate(&mut self, index: u64) -> SampleRecord {
         let mut record = blank(index);
         if let Err(e) = self.sampler.values(index, &mut self.values) {
             record.error = Some(one_line(&e));
@@ -363,7 +378,7 @@ impl<'a, 'r> Worker<'a, 'r> {
         if scenario.coil.is_some() {
             // The relay moves only in its circuit: the coupled run gives
             // the chatter too.
-            let Mode::Circuit(runner) = self.options.mode else {
+            let SweepMode::Circuit(runner) = self.options.mode else {
                 record.error = Some("a coil-driven relay needs the circuit".to_owned());
                 return record;
             };
@@ -413,10 +428,11 @@ impl<'a, 'r> Worker<'a, 'r> {
         };
         record_chatter(&mut record, &chatter);
         match self.options.mode {
-            Mode::Mechanics => {
+            SweepMode::Mechanics => {
                 (record.verdict, record.failed_limits) = verdict(scenario, &chatter, None);
             }
-            Mode::Circuit(runner) => match pipeline::run_plan(plan, runner, &self.options.run) {
+            SweepMode::Circuit(runner) => match pipeline::run_plan(plan, runner, &self.options.run)
+            {
                 Ok(result) => {
                     record_probes(&mut record, &result);
                     (record.verdict, record.failed_limits) =
@@ -430,7 +446,7 @@ impl<'a, 'r> Worker<'a, 'r> {
 }
 
 /// The chatter's columns of a record.
-fn record_chatter(record: &mut Record, chatter: &Chatter) {
+fn record_chatter(record: &mut SampleRecord, chatter: &Chatter) {
     record.outcome = Some(chatter.outcome);
     record.bounce_count = Some(chatter.bounce_count);
     record.first_impact = chatter.first_impact;
@@ -443,7 +459,7 @@ fn record_chatter(record: &mut Record, chatter: &Chatter) {
 }
 
 /// The probes' columns of a record.
-fn record_probes(record: &mut Record, result: &RunResult) {
+fn record_probes(record: &mut SampleRecord, result: &RunResult) {
     record.probes = result
         .probes
         .iter()

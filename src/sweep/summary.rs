@@ -19,9 +19,9 @@ use crate::chatter::Outcome;
 use crate::report::units::prefix;
 
 use super::error::SweepError;
-use super::record::Record;
+use super::record::SampleRecord;
 use super::sample::Sampler;
-use super::verdict::Verdict;
+use super::verdict::SampleVerdict;
 
 /// How bad a sample is, compared field by field: (could not run, failed a
 /// limit, did not end closed, edges, bounce time).
@@ -58,7 +58,7 @@ pub struct Collected {
     /// `[probe][sample]`, max |value|.
     pub peak: Vec<Vec<Option<f64>>>,
     /// Each sample's verdict.
-    pub verdict: Vec<Verdict>,
+    pub verdict: Vec<SampleVerdict>,
     /// Samples that failed each limit, by limit key.
     pub failed_limits: BTreeMap<String, u64>,
     /// The first errors, with their sample index.
@@ -79,7 +79,7 @@ impl Collected {
     }
 
     /// Add the next sample.
-    pub fn add(&mut self, r: &Record) {
+    pub fn add(&mut self, r: &SampleRecord) {
         self.index.push(r.index);
         self.outcome.push(r.outcome);
         self.bounce_count
@@ -140,8 +140,8 @@ impl Collected {
         for v in &self.verdict {
             *verdicts.entry(v.as_str()).or_insert(0) += 1;
         }
-        let count = |v: Verdict| self.verdict.iter().filter(|&&x| x == v).count() as u64;
-        let (failing, errors) = (count(Verdict::Fail), count(Verdict::Error));
+        let count = |v: SampleVerdict| self.verdict.iter().filter(|&&x| x == v).count() as u64;
+        let (failing, errors) = (count(SampleVerdict::Fail), count(SampleVerdict::Error));
         let probes = self
             .signals
             .iter()
@@ -219,8 +219,8 @@ impl Collected {
                 .map(|e| u64::from(e[i].unwrap_or(0)))
                 .sum();
             (
-                self.verdict[i] == Verdict::Error,
-                self.verdict[i] == Verdict::Fail,
+                self.verdict[i] == SampleVerdict::Error,
+                self.verdict[i] == SampleVerdict::Fail,
                 !self.outcome[i].is_some_and(Outcome::is_closed),
                 edges,
                 self.bounce_time[i].unwrap_or(0.0),

@@ -28,7 +28,7 @@ use std::path::PathBuf;
 use csv::{ByteRecord, ReaderBuilder, Writer};
 use thiserror::Error;
 
-use super::record::Record;
+use super::record::SampleRecord;
 
 /// The columns before the probes', after the varied keys.
 pub const OUTCOME_COLUMNS: [&str; 5] = [
@@ -102,7 +102,7 @@ pub fn width(keys: usize, signals: usize, columns: Columns) -> usize {
 /// probes, each `\n`-terminated. A record without values or probes (a
 /// sample that failed before them) has empty cells there, so every row
 /// has the header's width.
-pub fn rows(records: &[Record], keys: usize, probes: usize, columns: Columns) -> Vec<u8> {
+pub fn rows(records: &[SampleRecord], keys: usize, probes: usize, columns: Columns) -> Vec<u8> {
     let Columns { coil, ideal, arc } = columns;
     let mut w = Writer::from_writer(Vec::with_capacity(records.len() * 96));
     let mut cell = String::new();
@@ -435,11 +435,11 @@ pub fn merge<R: Read>(
 mod tests {
     use super::*;
     use crate::chatter::Outcome;
-    use crate::sweep::{ProbeRecord, Verdict};
+    use crate::sweep::{ProbeRecord, SampleVerdict};
     use std::io::Cursor;
 
-    fn record(index: u64) -> Record {
-        Record {
+    fn record(index: u64) -> SampleRecord {
+        SampleRecord {
             index,
             values: vec![1.5e-4, 0.25],
             outcome: Some(Outcome::Stuck),
@@ -459,7 +459,7 @@ mod tests {
                 lockout: None,
                 stable_for: None,
             }],
-            verdict: Verdict::Pass,
+            verdict: SampleVerdict::Pass,
             failed_limits: vec![],
             error: None,
         }
@@ -478,7 +478,7 @@ mod tests {
         failed.probes.clear();
         failed.outcome = None;
         failed.bounce_count = None;
-        failed.verdict = Verdict::Error;
+        failed.verdict = SampleVerdict::Error;
         failed.error = Some("ngspice failed: timeout, 60 s".to_owned());
         failed.probes = vec![];
         let text = String::from_utf8(rows(&[record(0)], 2, 1, Columns::default())).unwrap();
@@ -496,9 +496,9 @@ mod tests {
 
     fn csv_of(indices: &[u64]) -> Vec<u8> {
         let mut out = header(&["k".to_owned()], &[], Columns::default());
-        let records: Vec<Record> = indices
+        let records: Vec<SampleRecord> = indices
             .iter()
-            .map(|&i| Record {
+            .map(|&i| SampleRecord {
                 probes: vec![],
                 values: vec![i as f64],
                 ..record(i)

@@ -6,7 +6,7 @@
 //! `--mechanics-only` sweep has no circuit, so it holds the chatter
 //! against `[limits]` alone and ignores probe limits. Without limits every
 //! sample that ran passes. A sample that could not run is
-//! [`Verdict::Error`], whatever its limits.
+//! [`SampleVerdict::Error`], whatever its limits.
 
 use crate::chatter::Chatter;
 use crate::check;
@@ -15,7 +15,7 @@ use crate::scenario::Scenario;
 
 /// The `verdict` column of `sweep.csv`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub enum Verdict {
+pub enum SampleVerdict {
     /// The sample ran and every limit held (or it had none).
     Pass,
     /// A limit failed.
@@ -24,22 +24,26 @@ pub enum Verdict {
     Error,
 }
 
-impl Verdict {
+/// The old name of [`SampleVerdict`].
+#[deprecated(note = "renamed to `SampleVerdict`")]
+pub type Verdict = SampleVerdict;
+
+impl SampleVerdict {
     /// The name in the CSV and the JSON.
     pub fn as_str(self) -> &'static str {
         match self {
-            Verdict::Pass => "pass",
-            Verdict::Fail => "fail",
-            Verdict::Error => "error",
+            SampleVerdict::Pass => "pass",
+            SampleVerdict::Fail => "fail",
+            SampleVerdict::Error => "error",
         }
     }
 
-    /// The verdict named `text` (as written by [`Verdict::as_str`]).
-    pub fn parse(text: &str) -> Option<Verdict> {
+    /// The verdict named `text` (as written by [`SampleVerdict::as_str`]).
+    pub fn parse(text: &str) -> Option<SampleVerdict> {
         match text {
-            "pass" => Some(Verdict::Pass),
-            "fail" => Some(Verdict::Fail),
-            "error" => Some(Verdict::Error),
+            "pass" => Some(SampleVerdict::Pass),
+            "fail" => Some(SampleVerdict::Fail),
+            "error" => Some(SampleVerdict::Error),
             _ => None,
         }
     }
@@ -52,18 +56,18 @@ pub fn verdict(
     scenario: &Scenario,
     chatter: &Chatter,
     run: Option<&RunResult>,
-) -> (Verdict, Vec<String>) {
+) -> (SampleVerdict, Vec<String>) {
     let checked = match run {
         Some(run) => check::evaluate(scenario, run),
         None => match &scenario.limits {
             Some(limits) => check::Verdict::new(check::relay_checks(limits, chatter, &[])),
-            None => return (Verdict::Pass, Vec::new()),
+            None => return (SampleVerdict::Pass, Vec::new()),
         },
     };
     let failed: Vec<String> = checked.failures().map(|c| c.key.clone()).collect();
     if failed.is_empty() {
-        (Verdict::Pass, failed)
+        (SampleVerdict::Pass, failed)
     } else {
-        (Verdict::Fail, failed)
+        (SampleVerdict::Fail, failed)
     }
 }

@@ -6,7 +6,9 @@ use std::num::NonZeroUsize;
 use std::path::Path;
 
 use chatterspice::scenario::{DEFAULT_SCENARIO_TOML, Scenario};
-use chatterspice::sweep::{self, Mode, NoProgress, Sampler, Shard, SweepOptions, Verdict};
+use chatterspice::sweep::{
+    self, NoProgress, SampleVerdict, Sampler, Shard, SweepMode, SweepOptions,
+};
 
 /// The built-in relay with `sweep` (TOML) appended, placed beside the
 /// built-in scenario so that its netlist resolves.
@@ -142,7 +144,7 @@ fn a_grid_steps_the_outer_key_slowest() {
 }
 
 fn csv_of(s: &Scenario, sampler: &Sampler, jobs: usize, shard: Shard) -> Vec<u8> {
-    let mut options = SweepOptions::new(Mode::Mechanics);
+    let mut options = SweepOptions::new(SweepMode::Mechanics);
     options.jobs = NonZeroUsize::new(jobs).unwrap();
     options.shard = shard;
     let mut out = Vec::new();
@@ -188,7 +190,7 @@ fn samples_that_never_close_or_are_invalid_are_recorded_and_the_sweep_goes_on() 
     // k0 = 7 > 2): it never closes.
     let s = scenario("[sweep.grid]\n\"mechanics.force\" = { from = 0.1, to = 1.0, steps = 10 }");
     let sampler = Sampler::new(&s, None, None).unwrap();
-    let options = SweepOptions::new(Mode::Mechanics);
+    let options = SweepOptions::new(SweepMode::Mechanics);
     let mut out = Vec::new();
     let collected = sweep::run(&s, &sampler, &options, &mut out, &NoProgress).unwrap();
     let summary = collected.summary(&sampler).unwrap();
@@ -203,8 +205,8 @@ fn samples_that_never_close_or_are_invalid_are_recorded_and_the_sweep_goes_on() 
     assert!(text.contains(",never_closes,0,,,,pass,"), "{text}");
 
     // A sample the scenario's rules refuse: recorded as an error row.
-    let record = sweep::evaluate(&s, &sampler, 0, &options);
-    assert_eq!(record.verdict, Verdict::Pass);
+    let record = sweep::run_sample(&s, &sampler, 0, &options);
+    assert_eq!(record.verdict, SampleVerdict::Pass);
     let bad = scenario("[sweep.vary]\n\"contact.r_closed\" = 0.5");
     let mut bad = bad;
     bad.set_number("contact.r_open", 0.051).unwrap();
@@ -234,7 +236,7 @@ fn the_summary_finds_the_worst_sample_and_the_plot_draws() {
     let collected = sweep::run(
         &s,
         &sampler,
-        &SweepOptions::new(Mode::Mechanics),
+        &SweepOptions::new(SweepMode::Mechanics),
         &mut out,
         &NoProgress,
     )
@@ -275,7 +277,7 @@ impl std::io::Write for Full {
 fn a_failing_output_stops_the_sweep_with_an_error_instead_of_hanging() {
     let s = scenario("[sweep.vary]\n\"mechanics.mass\" = 0.1");
     let sampler = Sampler::new(&s, Some(1_000_000), None).unwrap();
-    let mut options = SweepOptions::new(Mode::Mechanics);
+    let mut options = SweepOptions::new(SweepMode::Mechanics);
     options.jobs = NonZeroUsize::new(2).unwrap();
     let err = sweep::run(
         &s,

@@ -7,7 +7,7 @@ use chatterspice::chatter::{ContactState, Outcome};
 use chatterspice::mechanics::cycle::Stops;
 use chatterspice::mechanics::surface::hunt_crossley_chi;
 use chatterspice::mechanics::{
-    Drive, EventKind, Mechanics, Settings, Surface, Trajectory, simulate_drive,
+    Drive, Mechanics, Settings, Surface, Trajectory, TrajectoryEventKind, simulate_drive,
 };
 
 /// The model's Kelvin–Voigt reference: 18 contacts, stuck.
@@ -204,7 +204,7 @@ fn a_constant_force_and_the_step_give_the_same_motion() {
         let touches = |tr: &Trajectory| {
             tr.events()
                 .iter()
-                .filter(|e| e.kind == EventKind::Touch)
+                .filter(|e| e.kind == TrajectoryEventKind::Touch)
                 .map(|e| e.time)
                 .collect::<Vec<_>>()
         };
@@ -222,12 +222,12 @@ fn the_events_are_the_records_in_time_order() {
     let tr = step(&m, s, &st);
     let events = tr.events();
     assert!(events.windows(2).all(|w| w[0].time <= w[1].time));
-    let count = |k: EventKind| events.iter().filter(|e| e.kind == k).count();
+    let count = |k: TrajectoryEventKind| events.iter().filter(|e| e.kind == k).count();
     let chatter = tr.chatter();
-    assert_eq!(count(EventKind::LiftOff), 1);
-    assert_eq!(count(EventKind::Touch), chatter.impacts.len());
+    assert_eq!(count(TrajectoryEventKind::LiftOff), 1);
+    assert_eq!(count(TrajectoryEventKind::Touch), chatter.impacts.len());
     assert_eq!(
-        count(EventKind::Release),
+        count(TrajectoryEventKind::Release),
         chatter
             .impacts
             .iter()
@@ -236,7 +236,7 @@ fn the_events_are_the_records_in_time_order() {
     );
     let settled: Vec<_> = events
         .iter()
-        .filter(|e| e.kind == EventKind::Settled)
+        .filter(|e| e.kind == TrajectoryEventKind::Settled)
         .collect();
     assert_eq!(settled.len(), 1);
     assert_eq!(Some(settled[0].time), chatter.settle_time);
@@ -267,10 +267,10 @@ fn a_pulse_gives_the_whole_cycle_with_its_forces() {
     };
     let pulse = |t: f64, _x: f64| if (2e-4..5e-3).contains(&t) { 1.0 } else { 0.0 };
     let tr = simulate_drive(&m, &stops, &st, Drive::Force(&pulse)).unwrap();
-    let kinds: Vec<EventKind> = tr.events().iter().map(|e| e.kind).collect();
-    assert_eq!(kinds.first(), Some(&EventKind::LiftOff));
-    assert!(kinds.contains(&EventKind::Settled));
-    assert_eq!(kinds.last(), Some(&EventKind::Landing));
+    let kinds: Vec<TrajectoryEventKind> = tr.events().iter().map(|e| e.kind).collect();
+    assert_eq!(kinds.first(), Some(&TrajectoryEventKind::LiftOff));
+    assert!(kinds.contains(&TrajectoryEventKind::Settled));
+    assert_eq!(kinds.last(), Some(&TrajectoryEventKind::Landing));
     let lift = tr.events()[0].time;
     assert!((lift - 2e-4).abs() < 1e-9, "{lift}");
     // Held on the rest stop before: the stop carries the preload.

@@ -23,7 +23,7 @@
 //! (`W_s` the surface's stored energy) never increases in contact, and a
 //! release needs `M = ½mv² ≥ 0` at δ = 0; so `M < 0` means stuck for good.
 //! A drive that varies has no such invariant, so the test is quasi-static:
-//! the drive is frozen where it stands ([`Drive::frozen_work`]) and the
+//! the drive is frozen where it stands ([`DriveModel::frozen_work`]) and the
 //! contact is stuck when, under that frozen drive, it could not reach the
 //! edge of the surface again. It is checked at step ends once moving out
 //! (past the deepest point, so the force peak has been seen). This is
@@ -37,39 +37,31 @@
 //! For a constant drive the endings are exact, which is what makes the
 //! results equal the step-force engine's.
 
-use super::{Event, Model, Phase, Record, Sim, Track};
+use super::model::{CycleTally, Ending, Model, Phase, PhaseEnd, Track};
 use crate::chatter::{Chatter, Outcome, bounces};
-use crate::mechanics::Surface;
-use crate::mechanics::driven::{Drive, Run, State};
-use crate::mechanics::integrate::Step;
+use crate::mechanics::driven::{DriveModel, State};
+use crate::mechanics::integrate::Dopri5Step;
 use crate::mechanics::linear::LinearPiece;
-use crate::mechanics::surface::surface_energy;
+use crate::mechanics::segment::Segment;
+use crate::mechanics::surface::{Surface, surface_energy};
 
-/// How a closing ended, and where the run stopped: (s, state).
-#[derive(Debug, Clone, Copy)]
-pub(crate) enum Ending {
-    /// Closed for good from the last touch.
-    Stuck { end: (f64, State) },
-    /// The opening that ended at `end` is below resolution: closed from
-    /// the touch before it; `accumulation` (s) for a rigid surface.
-    Resolved {
-        accumulation: Option<f64>,
-        end: (f64, State),
-    },
-    /// Open at the horizon; `reaches`: the frozen drive would still
-    /// close the contact; `reach` (m): the largest x, counting the
-    /// frozen motion's.
-    Open {
-        reaches: bool,
-        reach: f64,
-        end: (f64, State),
-    },
-    /// In a contact at the horizon that may still release.
-    InContact { end: (f64, State) },
+/// A finished closing.
+pub(crate) struct ClosingRun {
+    pub chatter: Chatter,
+    /// s, the first lift-off from the rest stop (`None` if it never lifts
+    /// or did not start on it).
+    pub lift_off: Option<f64>,
+    /// Every accepted step in time order, cut at events: they tile
+    /// `[0, end]`; each is a `Piece` ([`Segment::piece`]).
+    pub steps: Vec<Segment>,
+    /// J, kinetic energy taken by rigid impacts and inelastic landings.
+    pub jump_loss: f64,
+    /// (s, state) where the run stopped.
+    pub end: (f64, State),
 }
 
 /// J, the sticking margin `M` at (t, y) in the make contact.
-fn margin<D: Drive>(model: &Model<'_, D>, t: f64, y: &State) -> f64 {
+fn margin<D: DriveModel>(model: &Model<'_, D>, t: f64, y: &State) -> f64 {
     let m = &model.m;
     let (u, v) = (y[0], y[1]);
     let g = m.gap;
@@ -83,7 +75,7 @@ fn margin<D: Drive>(model: &Model<'_, D>, t: f64, y: &State) -> f64 {
 /// The closed-form Kelvin–Voigt contact from (t, y) with the drive
 /// frozen there, with the surface's stiffness and damping; `None` for
 /// another surface.
-fn frozen_kv_piece<D: Drive>(
+fn frozen_kv_piece<D: DriveModel>(
     model: &Model<'_, D>,
     t: f64,
     y: &State,
@@ -108,7 +100,7 @@ fn frozen_kv_piece<D: Drive>(
 /// oscillating toward the static value; with the drive frozen the rest is
 /// a linear piece whose first two force extrema (a maximum and a minimum)
 /// bound all later ones, as in the step-force engine.
-fn kv_tail<D: Drive>(model: &Model<'_, D>, track: &mut Track, t: f64, y: &State) {
+fn kv_tail<D: DriveModel>(model: &Model<'_, D>, track: &mut Track, t: f64, y: &State) {
     let Some((piece, s0, r0)) = frozen_kv_piece(model, t, y) else {
         return;
     };
@@ -122,11 +114,11 @@ fn kv_tail<D: Drive>(model: &Model<'_, D>, track: &mut Track, t: f64, y: &State)
 
 /// After a make-contact `step` with no event: the stuck ending, if the
 /// contact can no longer release.
-pub(super) fn stuck_after<D: Drive>(
+pub(super) fn stuck_after<D: DriveModel>(
     model: &Model<'_, D>,
-    rec: &mut Record,
-    step: &Step<3>,
-) -> Option<(Event, f64, State)> {
+    rec: &mut CycleTally,
+    step: &Dopri5Step<3>,
+) -> Option<(PhaseEnd, f64, State)> {
     let (t1, y1) = (step.t1, step.y1);
     let v_hit = rec.make.impacts.last().map_or(0.0, |i| i.impact_velocity);
     // With a margin, so that rounding can never call a contact stuck that
@@ -135,16 +127,16 @@ pub(super) fn stuck_after<D: Drive>(
     if y1[1] < 0.0 && margin(model, t1, &y1) < -stick_margin {
         kv_tail(model, &mut rec.make, t1, &y1);
         rec.ending = Some(Ending::Stuck { end: (t1, y1) });
-        return Some((Event::Stuck, t1, y1));
+        return Some((PhaseEnd::Stuck, t1, y1));
     }
     None
 }
 
 /// The opening since the last release touched again at (t, y) is below
 /// resolution: closed since the touch before it.
-pub(super) fn resolved<D: Drive>(
+pub(super) fn resolved<D: DriveModel>(
     model: &Model<'_, D>,
-    rec: &mut Record,
+    rec: &mut CycleTally,
     t: f64,
     y: State,
 ) -> Ending {
@@ -167,9 +159,9 @@ pub(super) fn resolved<D: Drive>(
 }
 
 /// The closing reached the horizon at (t, y) in `phase`.
-pub(super) fn at_horizon<D: Drive>(
+pub(super) fn at_horizon<D: DriveModel>(
     model: &Model<'_, D>,
-    rec: &mut Record,
+    rec: &mut CycleTally,
     phase: Phase,
     t: f64,
     y: State,
@@ -234,10 +226,9 @@ pub(super) fn at_horizon<D: Drive>(
 }
 
 /// The closing's record from the run that stopped at its ending.
-pub(super) fn finish<D: Drive>(sim: Sim<'_, D>) -> Run {
-    let t_end = sim.model.settings.t_end;
-    let g = sim.model.g();
-    let rec = sim.rec;
+pub(super) fn finish<D: DriveModel>(model: &Model<'_, D>, rec: CycleTally) -> ClosingRun {
+    let t_end = model.settings.t_end;
+    let g = model.g();
     let ending = rec.ending.expect("a closing stops at its ending");
     let since = rec.make.since;
     let (outcome, settle_time, accumulation_time, end) = match ending {
@@ -261,10 +252,10 @@ pub(super) fn finish<D: Drive>(sim: Sim<'_, D>) -> Run {
     let lift_off = rec
         .log
         .iter()
-        .find(|(_, e)| *e == Event::Lift)
+        .find(|(_, e)| *e == PhaseEnd::Lift)
         .map(|&(t, _)| t);
     let (intervals, impacts) = rec.make.finish(t_end);
-    Run {
+    ClosingRun {
         chatter: Chatter {
             outcome,
             first_impact: impacts.first().map(|i| i.impact_time),

@@ -29,11 +29,10 @@
 //! Minima of a convex function of one variable are found by golden
 //! section; of two, by golden section nested in golden section.
 
-use super::super::Surface;
-use super::super::driven::Drive;
-use super::super::surface::surface_energy;
-use super::Release;
-use super::engine::{Modes, Relay, Y};
+use super::model::{RelayModel, StopModes, Y};
+use super::relay::Release;
+use crate::mechanics::driven::DriveModel;
+use crate::mechanics::surface::{Surface, surface_energy};
 
 /// Golden-section iterations: the bracket shrinks by 0.618^80 ≈ 2e-17.
 const ITERATIONS: usize = 80;
@@ -55,12 +54,12 @@ impl EnergyBound {
     }
 
     /// Whether the closed contact can never release again.
-    pub(crate) fn cannot_release<D: Drive>(
+    pub(crate) fn cannot_release<D: DriveModel>(
         &mut self,
-        model: &Relay<'_, D>,
+        model: &RelayModel<'_, D>,
         t: f64,
         y: &Y,
-        _modes: Modes,
+        _modes: StopModes,
     ) -> bool {
         let frozen = Frozen::at(model, t, y);
         let e = frozen.energy(y);
@@ -69,12 +68,12 @@ impl EnergyBound {
     }
 
     /// Whether the open contact can never be reached again.
-    pub(crate) fn cannot_reach<D: Drive>(
+    pub(crate) fn cannot_reach<D: DriveModel>(
         &mut self,
-        model: &Relay<'_, D>,
+        model: &RelayModel<'_, D>,
         t: f64,
         y: &Y,
-        _modes: Modes,
+        _modes: StopModes,
     ) -> bool {
         if y[2] > 0.0 {
             return false;
@@ -88,7 +87,7 @@ impl EnergyBound {
 
 /// The model with its drive frozen at (t, e).
 struct Frozen<'m, 'a, D> {
-    model: &'m Relay<'a, D>,
+    model: &'m RelayModel<'a, D>,
     t: f64,
     e: f64,
     /// m, the range of armature positions to search.
@@ -96,8 +95,8 @@ struct Frozen<'m, 'a, D> {
     hi: f64,
 }
 
-impl<'m, 'a, D: Drive> Frozen<'m, 'a, D> {
-    fn at(model: &'m Relay<'a, D>, t: f64, y: &Y) -> Self {
+impl<'m, 'a, D: DriveModel> Frozen<'m, 'a, D> {
+    fn at(model: &'m RelayModel<'a, D>, t: f64, y: &Y) -> Self {
         let m = model.m;
         let g = m.gap;
         let o = model.build.pole_face.map_or(0.0, |p| p.overtravel);

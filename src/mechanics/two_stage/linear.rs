@@ -31,90 +31,17 @@ use std::sync::Arc;
 
 use nalgebra::{Matrix4, Vector4};
 
-use super::super::driven::Drive;
-use super::super::{DriveError, Settings, Surface};
-use super::Release;
-use super::engine::{Horizon, Interpolant, Modes, Progress, Relay, Span, Stop, Which, Y};
+use super::linear_mode::{Form, LinearMode, Poly, Taylor, W};
+use super::model::{RelayModel, StopMode, StopModes, Which, Y};
+use super::propagation::{Propagation, decided};
+use super::relay::Release;
+use super::run::Horizon;
+use super::span::{Interpolant, Span};
 use crate::chatter::Outcome;
-
-/// The scaled deviation from a mode's equilibrium.
-pub(crate) type W = Vector4<f64>;
-
-/// One linear mode: its scaled matrix, equilibrium and step propagator.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct LinearMode {
-    a: Matrix4<f64>,
-    /// `(u_a, v_a, u_b, v_b)` at equilibrium.
-    eq: Vector4<f64>,
-    /// rad/s, the velocity scale.
-    omega: f64,
-    /// `exp(a h)`.
-    phi: Matrix4<f64>,
-    /// s
-    h: f64,
-}
-
-impl LinearMode {
-    /// `w(τ)` from `w0` (τ within a step), by the step's Taylor series.
-    pub(crate) fn at(&self, w0: &W, tau: f64) -> W {
-        Taylor::new(self, w0).at(tau)
-    }
-
-    /// The state of `w`.
-    pub(crate) fn y_of(&self, w: &W) -> Y {
-        Y::new(
-            self.eq[0] + w[0],
-            self.eq[1] + self.omega * w[1],
-            self.eq[2] + w[2],
-            self.eq[3] + self.omega * w[3],
-            0.0,
-        )
-    }
-
-    /// The scaled deviation of state `y`.
-    pub(crate) fn w_of(&self, y: &Y) -> W {
-        W::new(
-            y[0] - self.eq[0],
-            (y[1] - self.eq[1]) / self.omega,
-            y[2] - self.eq[2],
-            (y[3] - self.eq[3]) / self.omega,
-        )
-    }
-
-    /// The linear form `c·y + d` as `k + q·w`.
-    fn form(&self, c: [f64; 4], d: f64) -> Form {
-        let scale = [1.0, self.omega, 1.0, self.omega];
-        Form {
-            k: c[0] * self.eq[0] + c[1] * self.eq[1] + c[2] * self.eq[2] + c[3] * self.eq[3] + d,
-            q: W::new(
-                c[0] * scale[0],
-                c[1] * scale[1],
-                c[2] * scale[2],
-                c[3] * scale[3],
-            ),
-        }
-    }
-}
-
-/// `k + q·w`: a linear function of the state.
-#[derive(Debug, Clone, Copy)]
-struct Form {
-    k: f64,
-    q: W,
-}
-
-impl Form {
-    fn value(&self, w: &W) -> f64 {
-        self.k + self.q.dot(w)
-    }
-
-    fn negated(self) -> Form {
-        Form {
-            k: -self.k,
-            q: -self.q,
-        }
-    }
-}
+use crate::mechanics::driven::DriveModel;
+use crate::mechanics::error::DriveError;
+use crate::mechanics::parameters::Settings;
+use crate::mechanics::surface::Surface;
 
 /// An event function: one form, or the larger or smaller of two.
 #[derive(Debug, Clone, Copy)]
@@ -166,7 +93,7 @@ impl LinearSystem {
     /// The linear system of `model`, when it is one: a constant force (no
     /// rest stop), a blade, a Kelvin–Voigt contact, and a Kelvin–Voigt
     /// pole face or none.
-    pub(crate) fn of<D: Drive>(model: &Relay<'_, D>) -> Option<LinearSystem> {
+    pub(crate) fn of<D: DriveModel>(model: &RelayModel<'_, D>) -> Option<LinearSystem> {
         let force = model.drive.constant()?;
         let blade = model.build.blade?;
         if model.rest {
@@ -268,14 +195,14 @@ impl LinearSystem {
 
     /// The event functions of `modes` in `mode`, each positive while the
     /// mode lasts.
-    fn guards(&self, mode: &LinearMode, modes: Modes) -> Vec<(Which, Guard)> {
+    fn guards(&self, mode: &LinearMode, modes: StopModes) -> Vec<(Which, Guard)> {
         let ub = mode.form([0.0, 0.0, 1.0, 0.0], 0.0);
         let push = mode.form([0.0, 0.0, self.s0, self.r0], 0.0);
         let mut out = vec![(
             Which::Contact,
             match (modes.contact, self.by_force) {
-                (Stop::Open, false) => Guard::One(ub.negated()),
-                (Stop::Open, true) => Guard::Max(ub.negated(), push.negated()),
+                (StopMode::Open, false) => Guard::One(ub.negated()),
+                (StopMode::Open, true) => Guard::Max(ub.negated(), push.negated()),
                 (_, false) => Guard::One(ub),
                 (_, true) => Guard::Min(ub, push),
             },
@@ -286,8 +213,8 @@ impl LinearSystem {
             out.push((
                 Which::Pole,
                 match (modes.pole, by_force) {
-                    (Stop::Open, false) => Guard::One(delta.negated()),
-                    (Stop::Open, true) => Guard::Max(delta.negated(), push.negated()),
+                    (StopMode::Open, false) => Guard::One(delta.negated()),
+                    (StopMode::Open, true) => Guard::Max(delta.negated(), push.negated()),
                     (_, false) => Guard::One(delta),
                     (_, true) => Guard::Min(delta, push),
                 },
@@ -334,7 +261,7 @@ impl LinearSystem {
     }
 
     /// Whether the energy bound decides the closing at state `y`.
-    fn decided(&self, y: &Y, modes: Modes, touched: bool) -> Option<Outcome> {
+    fn decided(&self, y: &Y, modes: StopModes, touched: bool) -> Option<Outcome> {
         if !touched || self.by_force {
             return None;
         }
@@ -345,119 +272,10 @@ impl LinearSystem {
             return None;
         }
         match modes.contact {
-            Stop::Open if y[2] < 0.0 => Some(Outcome::EndsOpen),
-            Stop::Open => None,
+            StopMode::Open if y[2] < 0.0 => Some(Outcome::EndsOpen),
+            StopMode::Open => None,
             _ => Some(Outcome::Stuck),
         }
-    }
-}
-
-/// Terms of the Taylor series kept per step: with `‖a h‖ ≤ 2.5` the
-/// first one left out is below 5e-18 of the first.
-const TERMS: usize = 28;
-
-/// One step's motion as a power series in τ: `w(τ) = Σ c_k τ^k`,
-/// `c_k = a^k w0 / k!`. Built only for steps where something must be
-/// located; any linear form of it is then a scalar polynomial.
-struct Taylor {
-    c: [W; TERMS],
-}
-
-impl Taylor {
-    fn new(mode: &LinearMode, w0: &W) -> Taylor {
-        let mut c = [W::zeros(); TERMS];
-        c[0] = *w0;
-        for k in 1..TERMS {
-            c[k] = mode.a * c[k - 1] / k as f64;
-        }
-        Taylor { c }
-    }
-
-    fn at(&self, tau: f64) -> W {
-        let mut w = self.c[TERMS - 1];
-        for k in (0..TERMS - 1).rev() {
-            w = w * tau + self.c[k];
-        }
-        w
-    }
-
-    fn poly(&self, form: &Form) -> Poly {
-        let mut p = [0.0; TERMS];
-        for (k, c) in self.c.iter().enumerate() {
-            p[k] = form.q.dot(c);
-        }
-        p[0] += form.k;
-        Poly { p }
-    }
-}
-
-/// A scalar polynomial in τ.
-#[derive(Clone, Copy)]
-struct Poly {
-    p: [f64; TERMS],
-}
-
-impl Poly {
-    fn value(&self, tau: f64) -> f64 {
-        self.p.iter().rev().fold(0.0, |acc, &c| acc * tau + c)
-    }
-
-    /// (value, rate) at τ.
-    fn jet(&self, tau: f64) -> (f64, f64) {
-        let (mut v, mut d) = (self.p[TERMS - 1], 0.0);
-        for k in (0..TERMS - 1).rev() {
-            d = d * tau + v;
-            v = v * tau + self.p[k];
-        }
-        (v, d)
-    }
-
-    fn derivative(&self) -> Poly {
-        let mut p = [0.0; TERMS];
-        for k in 1..TERMS {
-            p[k - 1] = self.p[k] * k as f64;
-        }
-        Poly { p }
-    }
-
-    /// τ in `[lo, hi]` where the polynomial is zero, given a sign change
-    /// between the ends: Newton's method kept inside the bracket,
-    /// bisection where it would leave it.
-    fn root(&self, mut lo: f64, mut hi: f64) -> f64 {
-        let positive_lo = self.value(lo) > 0.0;
-        let mut tau = 0.5 * (lo + hi);
-        for _ in 0..200 {
-            let (v, slope) = self.jet(tau);
-            if v == 0.0 {
-                return tau;
-            }
-            if (v > 0.0) == positive_lo {
-                lo = tau;
-            } else {
-                hi = tau;
-            }
-            let newton = tau - v / slope;
-            let next = if slope != 0.0 && newton > lo && newton < hi {
-                newton
-            } else {
-                0.5 * (lo + hi)
-            };
-            if (next - tau).abs() <= 2.0 * f64::EPSILON * hi || hi - lo <= 2.0 * f64::EPSILON * hi {
-                return next;
-            }
-            tau = next;
-        }
-        tau
-    }
-
-    /// The extremum inside `(0, h)`, where the rate changes sign.
-    fn extremum(&self, h: f64) -> Option<f64> {
-        let rate = self.derivative();
-        let (r0, r1) = (rate.value(0.0), rate.value(h));
-        if r0 == 0.0 || r1 == 0.0 || (r0 > 0.0) == (r1 > 0.0) {
-            return None;
-        }
-        Some(rate.root(0.0, h))
     }
 }
 
@@ -540,21 +358,24 @@ fn first_event(
 }
 
 /// Propagate `p` exactly from event to event, to the horizon.
-pub(crate) fn propagate<D: Drive>(
+pub(crate) fn propagate<D: DriveModel>(
     system: &LinearSystem,
-    model: &Relay<'_, D>,
+    model: &RelayModel<'_, D>,
     settings: &Settings,
     horizon: Horizon,
-    p: &mut Progress,
+    p: &mut Propagation,
 ) -> Result<(), DriveError> {
     let mut cache: [Option<Arc<LinearMode>>; 4] = [None, None, None, None];
     let force_form = |mode: &LinearMode| mode.form([0.0, 0.0, system.s0, system.r0], 0.0);
     while p.t < settings.t_end && p.ending.is_none() {
-        let key = usize::from(p.modes.contact != Stop::Open)
-            + 2 * usize::from(p.modes.pole != Stop::Open);
+        let key = usize::from(p.modes.contact != StopMode::Open)
+            + 2 * usize::from(p.modes.pole != StopMode::Open);
         let mode = cache[key]
             .get_or_insert_with(|| {
-                Arc::new(system.mode(p.modes.contact != Stop::Open, p.modes.pole != Stop::Open))
+                Arc::new(system.mode(
+                    p.modes.contact != StopMode::Open,
+                    p.modes.pole != StopMode::Open,
+                ))
             })
             .clone();
         let guards = system.guards(&mode, p.modes);
@@ -619,8 +440,7 @@ pub(crate) fn propagate<D: Drive>(
                     if horizon == Horizon::Closing
                         && system.by_force
                         && p.steps % 16 == 0
-                        && let Some(end) =
-                            super::engine::decided(model, &mut p.bound, p.t, &p.y, p.modes, &p.rec)
+                        && let Some(end) = decided(model, &mut p.bound, p.t, &p.y, p.modes, &p.rec)
                     {
                         p.ending = Some(end);
                         return Ok(());
@@ -640,7 +460,7 @@ pub(crate) fn propagate<D: Drive>(
 #[allow(clippy::too_many_arguments)] // one step's states, rates and forms, as the loop has them
 fn track(
     system: &LinearSystem,
-    p: &mut Progress,
+    p: &mut Propagation,
     mode: &LinearMode,
     (w0, w1): (&W, &W),
     (aw0, aw1): (&W, &W),
@@ -658,7 +478,7 @@ fn track(
     at(w1);
     // An opening's largest gap (or the reach before the first touch) and
     // a contact's peak and least force are where their rates turn.
-    let watched = if p.modes.contact == Stop::Open {
+    let watched = if p.modes.contact == StopMode::Open {
         ub
     } else {
         force

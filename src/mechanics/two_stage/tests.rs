@@ -4,7 +4,7 @@
 use super::*;
 use crate::chatter::Outcome;
 use crate::mechanics::cycle::Stops;
-use crate::mechanics::{Drive, Settings, simulate};
+use crate::mechanics::{Drive, Mechanics, Settings, Surface, simulate};
 
 /// The reference sequence of docs/model.md (m = s = 1, ζ = 0.05, F = 1,
 /// k0 = 0.9, β = 101, σ = 0.5192).

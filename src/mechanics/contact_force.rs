@@ -9,12 +9,13 @@
 
 use nalgebra::Vector2;
 
-use super::MechanicsError;
 use super::engine::kelvin_voigt_contact;
+use super::error::MechanicsError;
 use super::hunt_crossley::HcContact;
-use super::integrate::{Dopri5, Tolerance};
+use super::integrate::{Dopri5, StepTolerance};
 use super::linear::LinearPiece;
-use super::{Mechanics, Surface};
+use super::parameters::Mechanics;
+use super::surface::Surface;
 use crate::chatter::Chatter;
 
 /// The contact force (N, positive pressing the contacts together) at each
@@ -121,7 +122,7 @@ fn hunt_crossley_forces(
     let depth =
         ((n + 1.0) * hc.mass * v_hit * v_hit / (2.0 * hc.surface_stiffness)).powf(1.0 / (n + 1.0));
     let rtol = 1e-9;
-    let tol = Tolerance {
+    let tol = StepTolerance {
         rtol,
         atol: Vector2::new(rtol * depth, rtol * v_hit),
     };

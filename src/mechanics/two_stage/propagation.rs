@@ -1,0 +1,518 @@
+//! A two-stage run in progress, as both propagators drive it from event
+//! to event: where it is and in which modes ([`Propagation`]), what it has
+//! recorded ([`Tally`]),
+//! how an event changes the modes and the records ([`transition`]), when
+//! a closing's ending is decided ([`decided`]), and the records it
+//! returns.
+
+use super::energy::EnergyBound;
+use super::model::{RelayModel, StopMode, StopModes, Which, Y};
+use super::run::{Horizon, TwoStageRun};
+use super::span::Span;
+use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome};
+use crate::mechanics::cycle::{Stroke, strokes, summary};
+use crate::mechanics::dop853::Dense;
+use crate::mechanics::driven::DriveModel;
+use crate::mechanics::error::{DriveError, MAX_DRIVEN_STEPS, MAX_EVENTS};
+use crate::mechanics::parameters::{Mechanics, Settings};
+use crate::mechanics::surface::Surface;
+
+/// The records a run builds.
+pub(crate) struct Tally {
+    contact: Vec<Impact>,
+    intervals: Vec<Interval>,
+    pole: Vec<Impact>,
+    back: Vec<Impact>,
+    back_intervals: Vec<Interval>,
+    lift_offs: Vec<f64>,
+    /// m, the blade's farthest reach before its first touch.
+    reach: f64,
+}
+
+impl Tally {
+    /// Whether the contact has been touched.
+    pub(crate) fn contact_is_empty(&self) -> bool {
+        self.contact.is_empty()
+    }
+
+    /// Take in the state `y` in `modes`: the engaged contact's force
+    /// (`force(y)`), the opening after a release, the reach before the
+    /// first touch.
+    pub(crate) fn observe(&mut self, gap: f64, modes: StopModes, y: &Y, force: impl Fn(&Y) -> f64) {
+        match modes.contact {
+            StopMode::Engaged | StopMode::Pressed => {
+                let f = force(y);
+                if let Some(last) = self.contact.last_mut() {
+                    last.peak_force = Some(last.peak_force.map_or(f, |p: f64| p.max(f)));
+                    last.min_force = Some(last.min_force.map_or(f, |p: f64| p.min(f)));
+                }
+            }
+            StopMode::Open => match self.contact.last_mut() {
+                Some(last) => {
+                    let opening = (-y[2]).max(0.0);
+                    last.max_gap_after =
+                        Some(last.max_gap_after.map_or(opening, |p: f64| p.max(opening)));
+                }
+                None => self.reach = self.reach.max(gap + y[2]),
+            },
+        }
+    }
+
+    fn switch(intervals: &mut Vec<Interval>, t: f64, state: ContactState) {
+        if let Some(last) = intervals.last_mut() {
+            if last.state == state {
+                return;
+            }
+            last.end = t;
+        }
+        intervals.push(Interval {
+            state,
+            start: t,
+            end: t,
+        });
+    }
+}
+
+fn release(impact: &mut Impact, t: f64, v: f64) {
+    impact.release_time = Some(t);
+    impact.release_velocity = Some(v);
+    impact.contact_time = Some(t - impact.impact_time);
+    impact.restitution = (impact.impact_velocity > 0.0).then(|| -v / impact.impact_velocity);
+}
+
+/// A run in progress: where it is, in which modes, and what it recorded.
+pub(crate) struct Propagation {
+    pub t: f64,
+    pub y: Y,
+    pub modes: StopModes,
+    pub rec: Tally,
+    pub pieces: Vec<Span>,
+    pub steps: usize,
+    pub bound: EnergyBound,
+    /// The ending, when one was decided before the horizon.
+    pub ending: Option<Outcome>,
+}
+
+impl Propagation {
+    /// Apply the event of `which` at `t` (state `y` there, before it).
+    pub(crate) fn event<D: DriveModel>(
+        &mut self,
+        model: &RelayModel<'_, D>,
+        settings: &Settings,
+        which: Which,
+        t: f64,
+        mut y: Y,
+    ) {
+        self.modes = transition(model, settings, which, t, &mut y, self.modes, &mut self.rec);
+        if let Some(last) = self.pieces.last_mut() {
+            last.y1 = y;
+        }
+        self.t = t;
+        self.y = y;
+        if self.rec.contact.len() >= MAX_EVENTS {
+            self.ending = Some(Outcome::EventLimit);
+        }
+    }
+
+    /// Count one more step, failing past the limit.
+    pub(crate) fn count_step(
+        &mut self,
+        m: &Mechanics,
+        settings: &Settings,
+    ) -> Result<(), DriveError> {
+        self.steps += 1;
+        if self.steps > MAX_DRIVEN_STEPS {
+            return Err(DriveError::TooManySteps {
+                steps: MAX_DRIVEN_STEPS,
+                time: self.t,
+                t_end: settings.t_end,
+                mass: m.mass,
+                stiffness: m.stiffness,
+                period: 2.0 * std::f64::consts::PI * (m.mass / m.stiffness).sqrt(),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// The state at t = 0: on the rest stop when the drive does not lift it.
+pub(super) fn start<D: DriveModel>(model: &RelayModel<'_, D>, e0: f64) -> Propagation {
+    let m = model.m;
+    let g = m.gap;
+    let x0 = m.initial_position;
+    let mut y = Y::new(x0 - g, m.initial_velocity, x0 - g, m.initial_velocity, e0);
+    let mut modes = StopModes {
+        contact: StopMode::Open,
+        pole: StopMode::Open,
+        rest: StopMode::Open,
+    };
+    if model.rest
+        && x0 == 0.0
+        && m.initial_velocity <= 0.0
+        && model.armature_push(0.0, &y, modes) <= 0.0
+    {
+        modes.rest = StopMode::Pressed;
+        y[1] = 0.0;
+    }
+    let mut rec = Tally {
+        contact: Vec::new(),
+        intervals: vec![Interval {
+            state: ContactState::Open,
+            start: 0.0,
+            end: 0.0,
+        }],
+        pole: Vec::new(),
+        back: Vec::new(),
+        back_intervals: vec![Interval {
+            state: if modes.rest == StopMode::Pressed {
+                ContactState::Closed
+            } else {
+                ContactState::Open
+            },
+            start: 0.0,
+            end: 0.0,
+        }],
+        lift_offs: Vec::new(),
+        reach: x0,
+    };
+    if modes.rest == StopMode::Pressed {
+        rec.back.push(Impact::touch(0.0, 0.0));
+    } else if model.rest && x0 == 0.0 {
+        rec.lift_offs.push(0.0);
+    }
+    Propagation {
+        t: 0.0,
+        y,
+        modes,
+        rec,
+        pieces: Vec::new(),
+        steps: 0,
+        bound: EnergyBound::new(),
+        ending: None,
+    }
+}
+
+/// The run's records, with the motion held where it stopped to `t_end`.
+pub(super) fn finish<D: DriveModel>(
+    model: &RelayModel<'_, D>,
+    settings: &Settings,
+    horizon: Horizon,
+    mut p: Propagation,
+) -> TwoStageRun {
+    let t_end = settings.t_end;
+    if p.t < t_end {
+        p.pieces.push(Span::dense(
+            Dense::constant(p.t, t_end, p.y),
+            t_end,
+            p.y,
+            p.modes,
+        ));
+    }
+    let rec = &mut p.rec;
+    for list in [&mut rec.intervals, &mut rec.back_intervals] {
+        if let Some(last) = list.last_mut() {
+            last.end = t_end;
+        }
+    }
+    let back = Chatter {
+        outcome: Outcome::Stuck,
+        first_impact: rec.back.first().map(|i| i.impact_time),
+        settle_time: None,
+        bounce_count: 0,
+        impacts: std::mem::take(&mut rec.back),
+        intervals: std::mem::take(&mut rec.back_intervals),
+        shortfall: None,
+        accumulation_time: None,
+        t_end,
+    };
+    let strokes: Vec<Stroke> = strokes(&rec.lift_offs, &rec.contact, &back.impacts);
+    let shortfall = model.g() - rec.reach;
+    let contact = match horizon {
+        Horizon::Cycle => summary(
+            std::mem::take(&mut rec.intervals),
+            std::mem::take(&mut rec.contact),
+            strokes.first(),
+            shortfall,
+            t_end,
+        ),
+        Horizon::Closing => closing_summary(
+            model,
+            &mut p.bound,
+            rec,
+            p.ending,
+            (p.t, p.y, p.modes),
+            t_end,
+        ),
+    };
+    TwoStageRun {
+        contact,
+        pole_face: std::mem::take(&mut p.rec.pole),
+        back,
+        lift_off: p.rec.lift_offs.first().copied(),
+        strokes,
+        steps: p.steps,
+        pieces: p.pieces,
+    }
+}
+
+/// The closing's chatter: its ending decided by the energy bound, or read
+/// at the horizon.
+pub(crate) fn closing_summary<D: DriveModel>(
+    model: &RelayModel<'_, D>,
+    bound: &mut EnergyBound,
+    rec: &mut Tally,
+    ending: Option<Outcome>,
+    (t, y, modes): (f64, Y, StopModes),
+    t_end: f64,
+) -> Chatter {
+    let impacts = std::mem::take(&mut rec.contact);
+    let intervals = std::mem::take(&mut rec.intervals);
+    let closed = modes.contact != StopMode::Open;
+    let outcome = match ending {
+        Some(o) => o,
+        None if impacts.is_empty() => Outcome::NeverCloses,
+        None if closed => {
+            if modes.contact == StopMode::Pressed || bound.cannot_release(model, t, &y, modes) {
+                Outcome::Stuck
+            } else {
+                Outcome::EndOfTime
+            }
+        }
+        None => {
+            if bound.cannot_reach(model, t, &y, modes) {
+                Outcome::EndsOpen
+            } else {
+                Outcome::EndOfTime
+            }
+        }
+    };
+    let first_impact = impacts.first().map(|i| i.impact_time);
+    let settle_time = if outcome.is_closed() {
+        impacts.last().map(|i| i.impact_time)
+    } else {
+        None
+    };
+    let bounce_count = crate::chatter::bounces(&intervals);
+    Chatter {
+        outcome,
+        first_impact,
+        settle_time,
+        bounce_count,
+        impacts,
+        intervals,
+        shortfall: (outcome == Outcome::NeverCloses).then_some((model.g() - rec.reach).max(0.0)),
+        accumulation_time: None,
+        t_end,
+    }
+}
+
+/// Whether a closing's ending is decided at `t`: the contact closed and
+/// unable to release, or open after touching and unable to reach it again.
+pub(crate) fn decided<D: DriveModel>(
+    model: &RelayModel<'_, D>,
+    bound: &mut EnergyBound,
+    t: f64,
+    y: &Y,
+    modes: StopModes,
+    rec: &Tally,
+) -> Option<Outcome> {
+    if rec.contact.is_empty() || !bound.due() {
+        return None;
+    }
+    match modes.contact {
+        StopMode::Engaged if bound.cannot_release(model, t, y, modes) => Some(Outcome::Stuck),
+        StopMode::Open if bound.cannot_reach(model, t, y, modes) => Some(Outcome::EndsOpen),
+        _ => None,
+    }
+}
+
+/// Apply the event of `which` at `t` to the state and the records; the
+/// new modes.
+pub(crate) fn transition<D: DriveModel>(
+    model: &RelayModel<'_, D>,
+    settings: &Settings,
+    which: Which,
+    t: f64,
+    y: &mut Y,
+    mut modes: StopModes,
+    rec: &mut Tally,
+) -> StopModes {
+    let g = model.g();
+    let no_blade = model.build.blade.is_none();
+    match which {
+        Which::Contact => match modes.contact {
+            StopMode::Open => {
+                if y[2] <= 0.0 {
+                    y[2] = 0.0;
+                    if no_blade {
+                        y[0] = 0.0;
+                    }
+                }
+                let v = y[3];
+                rec.contact.push(Impact::touch(t, v));
+                Tally::switch(&mut rec.intervals, t, ContactState::Closed);
+                modes.contact = match model.contact {
+                    Surface::Rigid { restitution } => rigid(
+                        model,
+                        settings,
+                        Which::Contact,
+                        t,
+                        y,
+                        modes,
+                        restitution,
+                        rec,
+                    ),
+                    _ => StopMode::Engaged,
+                };
+            }
+            StopMode::Engaged | StopMode::Pressed => {
+                if modes.contact == StopMode::Engaged && y[2] <= 0.0 {
+                    y[2] = 0.0;
+                    if no_blade {
+                        y[0] = 0.0;
+                    }
+                }
+                if let Some(last) = rec.contact.last_mut() {
+                    release(last, t, y[3]);
+                }
+                Tally::switch(&mut rec.intervals, t, ContactState::Open);
+                modes.contact = StopMode::Open;
+            }
+        },
+        Which::Pole => {
+            let o = model.overtravel();
+            match modes.pole {
+                StopMode::Open => {
+                    if y[0] <= o {
+                        y[0] = o;
+                    }
+                    rec.pole.push(Impact::touch(t, y[1]));
+                    let surface = model.build.pole_face.map(|p| p.surface);
+                    modes.pole = match surface {
+                        Some(Surface::Rigid { restitution }) => {
+                            rigid(model, settings, Which::Pole, t, y, modes, restitution, rec)
+                        }
+                        _ => StopMode::Engaged,
+                    };
+                }
+                StopMode::Engaged | StopMode::Pressed => {
+                    if modes.pole == StopMode::Engaged && y[0] <= o {
+                        y[0] = o;
+                    }
+                    if let Some(last) = rec.pole.last_mut() {
+                        release(last, t, y[1]);
+                    }
+                    modes.pole = StopMode::Open;
+                }
+            }
+        }
+        Which::Rest => match modes.rest {
+            StopMode::Open => {
+                y[0] = -g;
+                if no_blade {
+                    y[2] = -g;
+                }
+                rec.back.push(Impact::touch(t, -y[1]));
+                Tally::switch(&mut rec.back_intervals, t, ContactState::Closed);
+                modes.rest = match model.back {
+                    None => {
+                        y[1] = 0.0;
+                        if no_blade {
+                            y[3] = 0.0;
+                        }
+                        StopMode::Pressed
+                    }
+                    Some(Surface::Rigid { restitution }) => {
+                        rigid(model, settings, Which::Rest, t, y, modes, restitution, rec)
+                    }
+                    Some(_) => StopMode::Engaged,
+                };
+            }
+            StopMode::Engaged | StopMode::Pressed => {
+                y[0] = -g;
+                if no_blade {
+                    y[2] = -g;
+                }
+                if let Some(last) = rec.back.last_mut() {
+                    release(last, t, -y[1]);
+                }
+                Tally::switch(&mut rec.back_intervals, t, ContactState::Open);
+                rec.lift_offs.push(t);
+                modes.rest = StopMode::Open;
+            }
+        },
+    }
+    modes
+}
+
+/// A rigid impact of `which` at `t` with restitution `e`: the velocity
+/// reversed, or the body pressed on the stop when the rebound would be
+/// below resolution (shorter than `min_open_time` or smaller than
+/// `min_gap`). Returns the stop's new mode; records the rebound.
+#[allow(clippy::too_many_arguments)]
+fn rigid<D: DriveModel>(
+    model: &RelayModel<'_, D>,
+    settings: &Settings,
+    which: Which,
+    t: f64,
+    y: &mut Y,
+    modes: StopModes,
+    e: f64,
+    rec: &mut Tally,
+) -> StopMode {
+    let no_blade = model.build.blade.is_none();
+    // The velocity components of the body that hits, and its sign toward
+    // the stop.
+    let (idx, sign) = match which {
+        Which::Contact => (if no_blade { 1 } else { 3 }, 1.0),
+        Which::Pole => (1, 1.0),
+        Which::Rest => (1, -1.0),
+    };
+    let v = y[idx];
+    let w = e * v.abs();
+    let mut open = modes;
+    match which {
+        Which::Contact => open.contact = StopMode::Open,
+        Which::Pole => open.pole = StopMode::Open,
+        Which::Rest => open.rest = StopMode::Open,
+    }
+    let set_v = |y: &mut Y, value: f64| {
+        y[idx] = value;
+        if no_blade && idx == 1 {
+            y[3] = value;
+        }
+        if no_blade && idx == 3 {
+            y[1] = value;
+        }
+    };
+    set_v(y, -sign * w);
+    let a = model.toward(which, t, y, open);
+    let resolved =
+        a > 0.0 && (2.0 * w / a < settings.min_open_time || w * w / (2.0 * a) < settings.min_gap);
+    let pressed = resolved || (w == 0.0 && a > 0.0);
+    let list = match which {
+        Which::Contact => &mut rec.contact,
+        Which::Pole => &mut rec.pole,
+        Which::Rest => &mut rec.back,
+    };
+    if pressed {
+        set_v(y, 0.0);
+        StopMode::Pressed
+    } else {
+        if let Some(last) = list.last_mut() {
+            release(last, t, -w);
+        }
+        let intervals = match which {
+            Which::Contact => Some(&mut rec.intervals),
+            Which::Rest => Some(&mut rec.back_intervals),
+            Which::Pole => None,
+        };
+        if let Some(iv) = intervals {
+            Tally::switch(iv, t, ContactState::Open);
+        }
+        if which == Which::Rest {
+            rec.lift_offs.push(t);
+        }
+        StopMode::Open
+    }
+}
