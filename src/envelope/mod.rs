@@ -13,8 +13,10 @@
 //! holds each limit against the worst kept relay.
 
 mod render;
+mod report;
 
 pub use render::{band_table, json_with_envelope};
+pub use report::{Band, EnvelopeReport, WorstRelay};
 
 use std::collections::BTreeMap;
 use std::num::NonZeroUsize;
@@ -23,7 +25,6 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::{Rng, SeedableRng};
-use serde::Serialize;
 use thiserror::Error;
 
 use crate::calibrate::fit::datasheet_figures;
@@ -95,74 +96,6 @@ pub enum EnvelopeError {
         /// Why they were rejected, as `figure: count` pairs.
         reasons: String,
     },
-}
-
-/// A quantity over the kept relays.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Band {
-    /// The smallest value.
-    pub min: f64,
-    /// The 50th percentile (nearest rank).
-    pub median: f64,
-    /// The 95th percentile (nearest rank).
-    pub p95: f64,
-    /// The largest value.
-    pub max: f64,
-}
-
-impl Band {
-    /// The band of `values` (non-finite values left out); `None` when
-    /// none is left.
-    pub fn of(values: impl IntoIterator<Item = f64>) -> Option<Band> {
-        let mut v: Vec<f64> = values.into_iter().filter(|x| x.is_finite()).collect();
-        if v.is_empty() {
-            return None;
-        }
-        v.sort_by(f64::total_cmp);
-        let rank = |p: f64| v[((p * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1];
-        Some(Band {
-            min: v[0],
-            median: rank(0.5),
-            p95: rank(0.95),
-            max: v[v.len() - 1],
-        })
-    }
-}
-
-/// The worst kept relay: the one with the least room left on a limit (or,
-/// without limits, the most bounces).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct WorstRelay {
-    /// Its index in the draw, from 0.
-    pub index: usize,
-    /// Its sampled values, by key.
-    pub values: BTreeMap<String, f64>,
-    /// The limit it is worst on, when there are limits.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub limit: Option<String>,
-}
-
-/// What an envelope gave.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct EnvelopeReport {
-    /// Relays drawn.
-    pub samples: usize,
-    /// Relays that met every printed figure and ran.
-    pub kept: usize,
-    /// Relays rejected, by the figure they missed (`operate_time`, …; a
-    /// relay that misses several counts under each), `invalid` for values
-    /// the model refuses and `failed` for a run that failed.
-    pub rejected: BTreeMap<String, usize>,
-    /// Where the ranges come from (`[envelope] source`).
-    pub source: Option<String>,
-    /// What was sampled: each key's range (a printed tolerance included).
-    pub ranges: BTreeMap<String, EnvelopeRange>,
-    /// Every quantity as a band over the kept relays: `bounce_count`,
-    /// `operate_time`, `bounce_time`, `settle_time`, and per probe
-    /// `<signal>.edges`, `.lockout`, `.stable_for`, `.peak`.
-    pub quantities: BTreeMap<String, Band>,
-    /// The worst kept relay.
-    pub worst: Option<WorstRelay>,
 }
 
 /// One kept relay's outcome.

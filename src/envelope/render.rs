@@ -3,7 +3,7 @@
 
 use std::fmt::Write;
 
-use super::EnvelopeReport;
+use super::report::EnvelopeReport;
 use crate::report::units::engineering;
 
 /// The unit of an envelope quantity, by its name.
