@@ -85,16 +85,13 @@ fn read_plot(file: &mut File, place: Located, buf: &mut Vec<u8>) -> io::Result<P
 }
 
 /// The points in `block` (`row` bytes each, 8 a value; the first is point
-/// `first`) into `columns`, vector by vector: each column is written in
-/// order while the block, a fraction of the cache, is read with a stride.
+/// `first`) into `columns`, point by point: the block is read in order,
+/// each value written to its column. (Column by column, reading the block
+/// with a stride, measured twice as slow.)
 fn transpose_real(block: &[u8], row: usize, first: usize, columns: &mut [Vec<f64>]) {
-    for (j, column) in columns.iter_mut().enumerate() {
-        let off = j * 8;
-        let Some(dst) = column.get_mut(first..) else {
-            continue;
-        };
-        for (d, point) in dst.iter_mut().zip(block.chunks_exact(row)) {
-            if let Some(cell) = point.get(off..).and_then(<[u8]>::first_chunk::<8>) {
+    for (i, point) in block.chunks_exact(row).enumerate() {
+        for (column, cell) in columns.iter_mut().zip(point.chunks_exact(8)) {
+            if let (Some(d), Some(cell)) = (column.get_mut(first + i), cell.first_chunk::<8>()) {
                 *d = f64::from_le_bytes(*cell);
             }
         }
@@ -104,30 +101,21 @@ fn transpose_real(block: &[u8], row: usize, first: usize, columns: &mut [Vec<f64
 /// As [`transpose_real`] for a complex plot: 16 bytes a value, `(re, im)`;
 /// a real column (the frequency scale) keeps the real part.
 fn transpose_complex(block: &[u8], row: usize, first: usize, columns: &mut [Column]) {
-    for (j, column) in columns.iter_mut().enumerate() {
-        let off = j * 16;
-        let cells = block
-            .chunks_exact(row)
-            .map(|point| point.get(off..).and_then(<[u8]>::first_chunk::<16>));
-        match column {
-            Column::Real(v) => {
-                let Some(dst) = v.get_mut(first..) else {
-                    continue;
-                };
-                for (d, cell) in dst.iter_mut().zip(cells) {
-                    if let Some(cell) = cell.and_then(|c| c.first_chunk::<8>()) {
-                        *d = f64::from_le_bytes(*cell);
+    for (i, point) in block.chunks_exact(row).enumerate() {
+        for (column, cell) in columns.iter_mut().zip(point.chunks_exact(16)) {
+            let Some((re, im)) = cell.split_first_chunk::<8>() else {
+                continue;
+            };
+            let re = f64::from_le_bytes(*re);
+            match column {
+                Column::Real(v) => {
+                    if let Some(d) = v.get_mut(first + i) {
+                        *d = re;
                     }
                 }
-            }
-            Column::Complex(v) => {
-                let Some(dst) = v.get_mut(first..) else {
-                    continue;
-                };
-                for (d, cell) in dst.iter_mut().zip(cells) {
-                    if let Some((re, im)) = cell.and_then(|c| c.split_first_chunk::<8>()) {
-                        let im = im.first_chunk::<8>().copied().unwrap_or_default();
-                        *d = Complex64::new(f64::from_le_bytes(*re), f64::from_le_bytes(im));
+                Column::Complex(v) => {
+                    if let (Some(d), Some(im)) = (v.get_mut(first + i), im.first_chunk::<8>()) {
+                        *d = Complex64::new(re, f64::from_le_bytes(*im));
                     }
                 }
             }

@@ -252,10 +252,12 @@ impl VectorStats {
 
 /// The least and greatest of `values` that are not `NaN`.
 fn range(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
-    values.filter(|x| !x.is_nan()).fold(None, |r, x| match r {
-        None => Some((x, x)),
-        Some((lo, hi)) => Some((lo.min(x), hi.max(x))),
-    })
+    // `f64::min` and `max` pass over a `NaN`; a range that stays inverted
+    // had no other value.
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+        (lo.min(x), hi.max(x))
+    });
+    (lo <= hi).then_some((lo, hi))
 }
 
 /// A table of every plot's vectors with their [`VectorStats`]: a line

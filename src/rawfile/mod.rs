@@ -634,7 +634,7 @@ impl RawFile {
     ///
     /// ngspice's binary files (whole, or cut short by a killed run) are
     /// read from the disk straight into the columns a block of points at a
-    /// time, so memory is the size of the values plus a 1 MiB buffer; any
+    /// time, so memory is the size of the values plus a 256 KiB buffer; any
     /// other file (ASCII, LTspice's, `.options interp`, unpadded) is read
     /// whole and parsed as [`RawFile::parse`] does. Both give the same
     /// plots and warnings.
