@@ -1,6 +1,7 @@
 //! `chatterspice raw FILE`: a raw file (ngspice's or LTspice's) as CSV
-//! (streamed for ngspice's binary files), a JSON summary of its plots, or,
-//! with `--signal`, the probe analysis of `run` on any raw file.
+//! (streamed for ngspice's binary files), a JSON summary of its plots,
+//! every vector's count and range, or, with `--signal`, the probe analysis
+//! of `run` on any raw file.
 
 use std::io::{self, Write};
 use std::path::PathBuf;
@@ -46,6 +47,9 @@ pub enum RawFormat {
     /// A summary of every plot (name, flags, variables, points) or, with
     /// --signal, the probe analyses.
     Json,
+    /// Every plot's vectors with their count, minimum and maximum (of the
+    /// magnitude, for complex values): reads every value.
+    Stats,
     /// With --signal: a table of the probe analyses, for people.
     Table,
 }
@@ -88,6 +92,9 @@ pub fn raw(args: &RawArgs) -> Result<()> {
     let written = match format {
         RawFormat::Json => out
             .write_all(export::summary_json(&raw).as_bytes())
+            .map_err(export::ExportError::Write),
+        RawFormat::Stats => out
+            .write_all(export::stats_table(&raw).as_bytes())
             .map_err(export::ExportError::Write),
         _ => export::plot_csv(selected, &mut out),
     }
@@ -163,8 +170,11 @@ fn probes(args: &RawArgs) -> Result<()> {
             text
         }
         RawFormat::Table => report::table::render_probes(&results),
-        RawFormat::Csv => {
-            bail!("--format csv writes the vectors themselves; with --signal choose table or json")
+        RawFormat::Csv | RawFormat::Stats => {
+            bail!(
+                "--format csv and stats describe the vectors themselves; with --signal choose \
+                 table or json"
+            )
         }
     };
     let mut out = io::stdout().lock();

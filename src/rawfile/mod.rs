@@ -66,8 +66,10 @@
 //! twice their size as `f64`).
 
 mod data;
+mod direct;
 pub mod export;
 mod header;
+mod locate;
 mod ltspice;
 mod stream;
 #[cfg(test)]
@@ -629,6 +631,13 @@ impl RawFile {
     /// Reads and parses a raw file; errors name the path. Only regular
     /// files of at most [`MAX_LOADED_BYTES`] are read (a device such as
     /// `/dev/zero` would never end).
+    ///
+    /// ngspice's binary files (whole, or cut short by a killed run) are
+    /// read from the disk straight into the columns a block of points at a
+    /// time, so memory is the size of the values plus a 256 KiB buffer; any
+    /// other file (ASCII, LTspice's, `.options interp`, unpadded) is read
+    /// whole and parsed as [`RawFile::parse`] does. Both give the same
+    /// plots and warnings.
     pub fn read(path: impl AsRef<Path>) -> Result<RawFile, RawError> {
         let path = path.as_ref();
         let io = |source| RawError::Io {
@@ -643,6 +652,12 @@ impl RawFile {
                 limit: MAX_LOADED_BYTES,
             });
         }
+        let mut file = crate::input::open_regular(path).map_err(io)?;
+        let len = file.metadata().map_err(io)?.len();
+        if let Some(raw) = direct::read(&mut file, len).map_err(io)? {
+            return Ok(raw);
+        }
+        drop(file);
         let bytes = crate::input::read_limited(path, MAX_LOADED_BYTES).map_err(io)?;
         RawFile::parse(&bytes).map_err(|error| RawError::InFile {
             path: path.to_path_buf(),

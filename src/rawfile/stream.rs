@@ -14,33 +14,12 @@
 //! the identical `f64` (`1.5`, `0.001`, `1e-7`, `3.3000000000000003`).
 
 use std::fs::File;
-use std::io::{BufReader, Read, Seek, SeekFrom, Write};
+use std::io::Write;
 use std::path::Path;
 
 use super::export::ExportError;
-use super::{
-    Cursor, DataKind, Dialect, Header, RawError, RawWarning, ltspice, next_is_header, parse_header,
-    real_in_complex_plot, regular_file,
-};
-
-/// A header and its `Binary:` line fit in this; a longer one is not
-/// something ngspice writes (and the in-memory reader will say what is
-/// wrong with it).
-const HEADER_LIMIT: usize = 1 << 20;
-
-/// Points converted per block.
-const BLOCK_BYTES: usize = 1 << 20;
-
-/// One plot's header and where its data are.
-struct Located {
-    header: Header,
-    /// Byte offset of the first point.
-    data: u64,
-    /// Whole points there.
-    points: u64,
-    /// The point count fell short of `No. Points:` (or it was 0).
-    truncated: bool,
-}
+use super::locate::{Located, locate};
+use super::{RawError, RawWarning, real_in_complex_plot, regular_file};
 
 /// Writes plot `index` (default: the last) of the raw file at `path` as
 /// CSV to `out`, streaming. `Ok(None)`: the file is not one this streams
@@ -51,26 +30,19 @@ pub fn stream_csv<W: Write>(
     index: Option<usize>,
     out: W,
 ) -> Result<Option<Vec<RawWarning>>, ExportError> {
-    let in_file = |error: RawError| RawError::InFile {
-        path: path.to_path_buf(),
-        error: Box::new(error),
-    };
     let io = |source: std::io::Error| RawError::Io {
         path: path.to_path_buf(),
         source,
     };
-    let len = regular_file(path)?.len();
-    let mut file =
-        BufReader::with_capacity(BLOCK_BYTES, crate::input::open_regular(path).map_err(io)?);
-    let Some(plots) = locate(&mut file, len).map_err(|e| match e {
-        Locate::Raw(e) => in_file(e),
-        Locate::Io(e) => io(e),
-    })?
-    else {
+    regular_file(path)?;
+    let mut file = crate::input::open_regular(path).map_err(io)?;
+    let len = file.metadata().map_err(io)?.len();
+    let Some(plots) = locate(&mut file, len).map_err(io)? else {
         return Ok(None);
     };
     if plots.is_empty() {
-        return Err(in_file(RawError::Empty).into());
+        // The in-memory reader says why.
+        return Ok(None);
     }
     let count = plots.len();
     let chosen = index.unwrap_or(count - 1);
@@ -83,124 +55,8 @@ pub fn stream_csv<W: Write>(
     write_plot(&mut file, plot, chosen, out, &io)
 }
 
-enum Locate {
-    Raw(RawError),
-    Io(std::io::Error),
-}
-
-impl From<std::io::Error> for Locate {
-    fn from(e: std::io::Error) -> Self {
-        Locate::Io(e)
-    }
-}
-
-/// Every plot's header and data, or `None` when the file is not one to
-/// stream.
-fn locate(file: &mut BufReader<File>, len: u64) -> Result<Option<Vec<Located>>, Locate> {
-    let mut plots = Vec::new();
-    let (mut title, mut date) = (String::new(), String::new());
-    let mut pos = 0u64;
-    let mut buf = Vec::new();
-    while pos < len {
-        file.seek(SeekFrom::Start(pos))?;
-        buf.clear();
-        file.by_ref()
-            .take(HEADER_LIMIT as u64)
-            .read_to_end(&mut buf)?;
-        let mut cur = Cursor {
-            bytes: &buf,
-            pos: 0,
-            line: Some(1),
-        };
-        cur.skip_blank_lines();
-        if cur.at_end() {
-            break;
-        }
-        if matches!(
-            ltspice::utf16_start(cur.rest(), cur.at()),
-            Ok(Some(_)) | Err(_)
-        ) {
-            // LTspice's UTF-16 text: the in-memory reader decodes it.
-            return Ok(None);
-        }
-        if !has_data_line(cur.rest()) {
-            // No `Binary:`/`Values:` within the limit: let the full reader
-            // report what is wrong.
-            return Ok(None);
-        }
-        let header = parse_header(&mut cur, &mut title, &mut date).map_err(Locate::Raw)?;
-        if !matches!(header.data, DataKind::Binary) || header.plot.dialect != Dialect::Ngspice {
-            return Ok(None);
-        }
-        let declared = header.plot.declared_points;
-        let uniform = header.plot.flags.padded || header.lengths.iter().all(|&l| l == declared);
-        if !uniform {
-            return Ok(None);
-        }
-        let width = if header.plot.flags.complex { 16 } else { 8 };
-        let row = (header.nvars * width) as u64;
-        let data = pos + cur.pos as u64;
-        let available = (len - data).checked_div(row).unwrap_or(0);
-        let claimed = declared as u64;
-        // Data the size the other kind of value would have: the full
-        // reader says the `Flags:` line is wrong.
-        let other = (header.nvars * if header.plot.flags.complex { 8 } else { 16 }) as u64;
-        if claimed > 0
-            && claimed.checked_mul(other) == Some(len - data)
-            && claimed.checked_mul(row) != Some(len - data)
-        {
-            return Ok(None);
-        }
-        if declared == 0 || claimed > available {
-            // A killed run: its data end the file.
-            plots.push(Located {
-                header,
-                data,
-                points: available,
-                truncated: true,
-            });
-            break;
-        }
-        let end = data + claimed * row;
-        // What follows must be the end or the next plot's header.
-        file.seek(SeekFrom::Start(end))?;
-        let mut next = [0u8; 64];
-        let got = read_up_to(file, &mut next)?;
-        let after = next[..got].trim_ascii_start();
-        if !after.is_empty() && !next_is_header(after) {
-            return Ok(None);
-        }
-        plots.push(Located {
-            header,
-            data,
-            points: claimed,
-            truncated: false,
-        });
-        pos = end;
-    }
-    Ok(Some(plots))
-}
-
-/// Whether `bytes` hold a `Binary:` or `Values:` line.
-fn has_data_line(bytes: &[u8]) -> bool {
-    bytes
-        .split(|&b| b == b'\n')
-        .any(|l| l.starts_with(b"Binary:") || l.starts_with(b"Values:"))
-}
-
-fn read_up_to(file: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
-    let mut got = 0;
-    while got < buf.len() {
-        match file.read(&mut buf[got..])? {
-            0 => break,
-            n => got += n,
-        }
-    }
-    Ok(got)
-}
-
 fn write_plot<W: Write>(
-    file: &mut BufReader<File>,
+    file: &mut File,
     located: &Located,
     index: usize,
     out: W,
@@ -231,33 +87,19 @@ fn write_plot<W: Write>(
         .map_err(|e| ExportError::Write(e.into_error()))?;
 
     let width = if complex { 16 } else { 8 };
-    let row = located.header.nvars * width;
+    let row = located.row();
     // Formatting, not reading, is the cost: about 15 ns a number with
     // zmij. (Splitting a block between two threads was measured slower on
     // the 2-core development machine.)
-    let rows_per_block = (BLOCK_BYTES / row.max(1)).max(1);
-    let mut block = vec![0u8; rows_per_block * row];
+    let mut buf = Vec::new();
     let mut text = Vec::new();
-    file.seek(SeekFrom::Start(located.data)).map_err(io)?;
-    let mut left = located.points;
-    while left > 0 {
-        let rows = (left as usize).min(rows_per_block);
-        file.read_exact(&mut block[..rows * row]).map_err(io)?;
-        format_rows(&block[..rows * row], row, width, &pairs, &mut text);
+    let mut blocks = located.blocks(file, &mut buf).map_err(io)?;
+    while let Some((data, _)) = blocks.next_block().map_err(io)? {
+        format_rows(data, row, width, &pairs, &mut text);
         out.write_all(&text)?;
-        left -= rows as u64;
     }
     out.flush()?;
-    let mut warnings = Vec::new();
-    if located.truncated {
-        warnings.push(RawWarning::Truncated {
-            plot: index,
-            declared: plot.declared_points,
-            read: located.points as usize,
-            offset: (located.data + located.points * row as u64) as usize,
-        });
-    }
-    Ok(Some(warnings))
+    Ok(Some(located.warning(index).into_iter().collect()))
 }
 
 /// Appends the CSV lines of the points in `data` (`row` bytes each) to

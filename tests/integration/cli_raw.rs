@@ -1,9 +1,9 @@
-//! `chatterspice raw`: CSV of one plot, JSON summary, exit codes.
+//! `chatterspice raw`: CSV of one plot, JSON summary, statistics, exit codes.
 
 use std::path::PathBuf;
 
 use assert_cmd::Command;
-use chatterspice::rawfile::RawFile;
+use chatterspice::rawfile::{RawFile, Vector};
 use predicates::prelude::*;
 
 fn data(name: &str) -> PathBuf {
@@ -82,8 +82,58 @@ fn json_summarises_every_plot() {
 }
 
 #[test]
+fn stats_give_every_vector_s_count_and_range_of_every_plot() {
+    for name in ["divider_op_tran.raw", "rc_ac.raw", "killed_binary.raw"] {
+        let path = data(name);
+        let out = stdout_of(&[path.to_str().unwrap(), "--format", "stats"]);
+        let raw = RawFile::read(&path).unwrap();
+        let mut lines = out.lines();
+        for (index, plot) in raw.plots.iter().enumerate() {
+            let head = lines.next().unwrap();
+            assert!(
+                head.starts_with(&format!("plot {index}: {}, ", plot.name)),
+                "{head}"
+            );
+            let s = if plot.points() == 1 { "" } else { "s" };
+            assert!(
+                head.ends_with(&format!(" {} point{s}", plot.points())),
+                "{head}"
+            );
+            assert_eq!(
+                lines.next().unwrap().split_whitespace().collect::<Vec<_>>(),
+                ["vector", "type", "points", "min", "max"]
+            );
+            for (i, var) in plot.variables.iter().enumerate() {
+                let values: Vec<f64> = match plot.vector(i).unwrap() {
+                    Vector::Real(v) => v.to_vec(),
+                    Vector::Complex(v) => v.iter().map(|c| c.norm()).collect(),
+                };
+                let min = values.iter().copied().fold(f64::INFINITY, f64::min);
+                let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                let cells: Vec<&str> = lines.next().unwrap().split_whitespace().collect();
+                assert_eq!(
+                    cells[..3],
+                    [&var.name, &var.kind, &values.len().to_string()]
+                );
+                assert_eq!(cells[3].parse::<f64>().unwrap(), min, "{name} {}", var.name);
+                assert_eq!(cells[4].parse::<f64>().unwrap(), max, "{name} {}", var.name);
+            }
+        }
+        assert_eq!(lines.next(), None);
+    }
+    raw_cmd()
+        .arg(data("rc_tran.raw"))
+        .args([
+            "--format", "stats", "--signal", "v(out)", "--low", "0.3", "--high", "0.6",
+        ])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("table or json"));
+}
+
+#[test]
 fn output_is_byte_identical_across_runs() {
-    for format in ["csv", "json"] {
+    for format in ["csv", "json", "stats"] {
         let args = [
             data("rc_ac.raw").to_str().unwrap().to_string(),
             "--format".into(),

@@ -1,4 +1,5 @@
-//! Helpers shared by the integration tests that need ngspice.
+//! Helpers shared by the integration tests: ngspice or a skip, scenarios
+//! and scripts in a test directory, and KiCad's S-expressions.
 
 use chatterspice::spice::Ngspice;
 
@@ -69,4 +70,93 @@ pub fn script(dir: &std::path::Path, name: &str, body: &str) -> std::path::PathB
     std::fs::write(&path, format!("#!/bin/sh\n{body}")).unwrap();
     std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).unwrap();
     path
+}
+
+/// An S-expression (KiCad's files): an atom or a list.
+#[derive(Debug)]
+pub enum Sexp {
+    Atom(String),
+    List(Vec<Sexp>),
+}
+
+pub fn parse_sexp(text: &str) -> Sexp {
+    fn list(chars: &mut std::iter::Peekable<std::str::Chars>) -> Vec<Sexp> {
+        let mut out = Vec::new();
+        while let Some(&c) = chars.peek() {
+            match c {
+                '(' => {
+                    chars.next();
+                    out.push(Sexp::List(list(chars)));
+                }
+                ')' => {
+                    chars.next();
+                    return out;
+                }
+                '"' => {
+                    chars.next();
+                    let mut s = String::new();
+                    while let Some(c) = chars.next() {
+                        match c {
+                            '\\' => s.extend(chars.next()),
+                            '"' => break,
+                            c => s.push(c),
+                        }
+                    }
+                    out.push(Sexp::Atom(s));
+                }
+                c if c.is_whitespace() => {
+                    chars.next();
+                }
+                _ => {
+                    let mut s = String::new();
+                    while let Some(&c) = chars.peek() {
+                        if c.is_whitespace() || c == '(' || c == ')' {
+                            break;
+                        }
+                        s.push(c);
+                        chars.next();
+                    }
+                    out.push(Sexp::Atom(s));
+                }
+            }
+        }
+        panic!("unbalanced S-expression");
+    }
+    let mut chars = text.trim().chars().peekable();
+    assert_eq!(chars.next(), Some('('));
+    let top = Sexp::List(list(&mut chars));
+    assert!(chars.next().is_none(), "text after the S-expression");
+    top
+}
+
+pub fn head(s: &Sexp) -> Option<&str> {
+    match s {
+        Sexp::List(items) => match items.first() {
+            Some(Sexp::Atom(a)) => Some(a),
+            _ => None,
+        },
+        Sexp::Atom(_) => None,
+    }
+}
+
+pub fn atom(s: &Sexp, k: usize) -> Option<&str> {
+    match s {
+        Sexp::List(items) => match items.get(k) {
+            Some(Sexp::Atom(a)) => Some(a),
+            _ => None,
+        },
+        Sexp::Atom(_) => None,
+    }
+}
+
+/// Every list under `s` whose head is `name`.
+pub fn all<'a>(s: &'a Sexp, name: &str, out: &mut Vec<&'a Sexp>) {
+    if let Sexp::List(items) = s {
+        if head(s) == Some(name) {
+            out.push(s);
+        }
+        for item in items {
+            all(item, name, out);
+        }
+    }
 }

@@ -11,6 +11,8 @@ use chatterspice::chatter::ContactState;
 use chatterspice::scenario::Scenario;
 use serde_json::Value;
 
+use crate::common::{Sexp, all, atom, head, parse_sexp};
+
 fn example(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("examples/kicad")
@@ -79,95 +81,6 @@ fn the_exported_netlist_runs_as_the_walkthrough_says() {
     assert_eq!(probe["edges"].as_u64().unwrap() as usize, 1 + 2 * long);
     // The exported file is never edited.
     assert_eq!(std::fs::read(&netlist).unwrap(), before);
-}
-
-/// An S-expression: an atom or a list.
-#[derive(Debug)]
-enum Sexp {
-    Atom(String),
-    List(Vec<Sexp>),
-}
-
-fn parse_sexp(text: &str) -> Sexp {
-    fn list(chars: &mut std::iter::Peekable<std::str::Chars>) -> Vec<Sexp> {
-        let mut out = Vec::new();
-        while let Some(&c) = chars.peek() {
-            match c {
-                '(' => {
-                    chars.next();
-                    out.push(Sexp::List(list(chars)));
-                }
-                ')' => {
-                    chars.next();
-                    return out;
-                }
-                '"' => {
-                    chars.next();
-                    let mut s = String::new();
-                    while let Some(c) = chars.next() {
-                        match c {
-                            '\\' => s.extend(chars.next()),
-                            '"' => break,
-                            c => s.push(c),
-                        }
-                    }
-                    out.push(Sexp::Atom(s));
-                }
-                c if c.is_whitespace() => {
-                    chars.next();
-                }
-                _ => {
-                    let mut s = String::new();
-                    while let Some(&c) = chars.peek() {
-                        if c.is_whitespace() || c == '(' || c == ')' {
-                            break;
-                        }
-                        s.push(c);
-                        chars.next();
-                    }
-                    out.push(Sexp::Atom(s));
-                }
-            }
-        }
-        panic!("unbalanced S-expression");
-    }
-    let mut chars = text.trim().chars().peekable();
-    assert_eq!(chars.next(), Some('('));
-    let top = Sexp::List(list(&mut chars));
-    assert!(chars.next().is_none(), "text after the library");
-    top
-}
-
-fn head(s: &Sexp) -> Option<&str> {
-    match s {
-        Sexp::List(items) => match items.first() {
-            Some(Sexp::Atom(a)) => Some(a),
-            _ => None,
-        },
-        Sexp::Atom(_) => None,
-    }
-}
-
-fn atom(s: &Sexp, k: usize) -> Option<&str> {
-    match s {
-        Sexp::List(items) => match items.get(k) {
-            Some(Sexp::Atom(a)) => Some(a),
-            _ => None,
-        },
-        Sexp::Atom(_) => None,
-    }
-}
-
-/// Every list under `s` whose head is `name`.
-fn all<'a>(s: &'a Sexp, name: &str, out: &mut Vec<&'a Sexp>) {
-    if let Sexp::List(items) = s {
-        if head(s) == Some(name) {
-            out.push(s);
-        }
-        for item in items {
-            all(item, name, out);
-        }
-    }
 }
 
 #[test]

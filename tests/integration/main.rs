@@ -27,6 +27,7 @@ mod extremes;
 mod fit;
 mod free_impact;
 mod kicad;
+mod kicad_project;
 mod ltspice;
 mod mechanics_closed_forms;
 mod mechanics_sweep;
