@@ -20,6 +20,7 @@ use std::fs::File;
 use std::io;
 use std::ops::Range;
 
+use super::data::{transpose_complex, transpose_real};
 use super::locate::{Located, POSITIONAL_READS, locate};
 use super::{Column, Complex64, Plot, RawFile, real_in_complex_plot};
 
@@ -161,80 +162,6 @@ fn read_real(
         result
     })?;
     Ok(columns.into_iter().map(Column::Real).collect())
-}
-
-/// Points at a time in [`transpose_real`]'s tiles.
-const TILE: usize = 4;
-
-/// The points in `block` (`row` bytes each, 8 a value; the first is point
-/// `first` of `columns`) into `columns`, a tile of [`TILE`] points at a
-/// time: each column gets its tile's values in one run, read from a few
-/// hundred bytes of the block. (Point by point, a value to each column in
-/// turn, measured 1.7× slower; column by column over the whole block, 3×.)
-fn transpose_real(block: &[u8], row: usize, first: usize, columns: &mut [&mut [f64]]) {
-    let whole = block.len() / (row * TILE) * (row * TILE);
-    let (tiles, rest) = block.split_at(whole);
-    for (t, tile) in tiles.chunks_exact(row * TILE).enumerate() {
-        let at = first + t * TILE;
-        for (j, column) in columns.iter_mut().enumerate() {
-            let Some(dst) = column
-                .get_mut(at..)
-                .and_then(|d| d.first_chunk_mut::<TILE>())
-            else {
-                // A vector shorter than the plot (`dims=`): one at a time.
-                for (i, point) in tile.chunks_exact(row).enumerate() {
-                    if let (Some(d), Some(cell)) = (column.get_mut(at + i), cell_at(point, j)) {
-                        *d = f64::from_le_bytes(*cell);
-                    }
-                }
-                continue;
-            };
-            for (i, d) in dst.iter_mut().enumerate() {
-                if let Some(cell) = tile.get(i * row..).and_then(|p| cell_at(p, j)) {
-                    *d = f64::from_le_bytes(*cell);
-                }
-            }
-        }
-    }
-    let at = first + tiles.len() / row;
-    for (i, point) in rest.chunks_exact(row).enumerate() {
-        for (j, column) in columns.iter_mut().enumerate() {
-            if let (Some(d), Some(cell)) = (column.get_mut(at + i), cell_at(point, j)) {
-                *d = f64::from_le_bytes(*cell);
-            }
-        }
-    }
-}
-
-/// The 8 bytes of value `j` of a point.
-#[inline]
-fn cell_at(point: &[u8], j: usize) -> Option<&[u8; 8]> {
-    point.get(j * 8..).and_then(<[u8]>::first_chunk::<8>)
-}
-
-/// As [`transpose_real`] for a complex plot: 16 bytes a value, `(re, im)`;
-/// a real column (the frequency scale) keeps the real part.
-fn transpose_complex(block: &[u8], row: usize, first: usize, columns: &mut [Column]) {
-    for (i, point) in block.chunks_exact(row).enumerate() {
-        for (column, cell) in columns.iter_mut().zip(point.chunks_exact(16)) {
-            let Some((re, im)) = cell.split_first_chunk::<8>() else {
-                continue;
-            };
-            let re = f64::from_le_bytes(*re);
-            match column {
-                Column::Real(v) => {
-                    if let Some(d) = v.get_mut(first + i) {
-                        *d = re;
-                    }
-                }
-                Column::Complex(v) => {
-                    if let (Some(d), Some(im)) = (v.get_mut(first + i), im.first_chunk::<8>()) {
-                        *d = Complex64::new(re, f64::from_le_bytes(*im));
-                    }
-                }
-            }
-        }
-    }
 }
 
 #[cfg(test)]
