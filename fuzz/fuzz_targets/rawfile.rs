@@ -16,5 +16,6 @@ fuzz_target!(|data: &[u8]| {
             export::plot_csv(plot, &mut sink).expect("CSV into memory");
         }
         let _ = export::summary_json(&raw);
+        let _ = export::stats_table(&raw);
     }
 });

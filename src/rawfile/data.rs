@@ -1,5 +1,7 @@
 //! The data of a raw file: binary (padded or not) and ASCII values into
-//! columns, with what a killed or restarted run leaves.
+//! columns, with what a killed or restarted run leaves; the transposition
+//! of binary points into columns, which the reader from disk
+//! ([`super::direct`]) shares.
 
 use super::*;
 
@@ -171,19 +173,10 @@ fn interpolated_sections(rest: &[u8], shape: &Shape, variables: &[Variable]) -> 
 /// The columns of whole points `data` (`shape.row` bytes each), `lens`
 /// values in each column.
 fn read_rows(data: &[u8], plot: &Plot, lens: &[usize], shape: &Shape) -> Vec<Column> {
-    let row = shape.row;
-    // One pass over the rows, each value written straight to its place
-    // in its column (sized up front, so no capacity checks): the input
-    // is read once, and the output pages are touched in order.
     if !shape.complex {
         let mut cols: Vec<Vec<f64>> = lens.iter().map(|&l| vec![0.0; l]).collect();
-        for (i, r) in data.chunks_exact(row).enumerate() {
-            for (col, cell) in cols.iter_mut().zip(r.chunks_exact(8)) {
-                if let Some(d) = col.get_mut(i) {
-                    *d = le_f64(cell, 0);
-                }
-            }
-        }
+        let mut slices: Vec<&mut [f64]> = cols.iter_mut().map(Vec::as_mut_slice).collect();
+        transpose_real(data, shape.row, 0, &mut slices);
         cols.into_iter().map(Column::Real).collect()
     } else {
         let mut cols: Vec<Column> = plot
@@ -198,23 +191,82 @@ fn read_rows(data: &[u8], plot: &Plot, lens: &[usize], shape: &Shape) -> Vec<Col
                 }
             })
             .collect();
-        for (i, r) in data.chunks_exact(row).enumerate() {
-            for (col, cell) in cols.iter_mut().zip(r.chunks_exact(16)) {
-                match col {
-                    Column::Real(v) => {
-                        if let Some(d) = v.get_mut(i) {
-                            *d = le_f64(cell, 0);
-                        }
+        transpose_complex(data, shape.row, 0, &mut cols);
+        cols
+    }
+}
+
+/// Points at a time in [`transpose_real`]'s tiles.
+const TILE: usize = 4;
+
+/// The points in `block` (`row` bytes each, 8 a value; the first is point
+/// `first` of `columns`) into `columns`, a tile of [`TILE`] points at a
+/// time: each column gets its tile's values in one run, read from a few
+/// hundred bytes of the block. (Point by point, a value to each column in
+/// turn, measured 1.7× slower; column by column over the whole block, 3×.)
+pub(super) fn transpose_real(block: &[u8], row: usize, first: usize, columns: &mut [&mut [f64]]) {
+    let whole = block.len() / (row * TILE) * (row * TILE);
+    let (tiles, rest) = block.split_at(whole);
+    for (t, tile) in tiles.chunks_exact(row * TILE).enumerate() {
+        let at = first + t * TILE;
+        for (j, column) in columns.iter_mut().enumerate() {
+            let Some(dst) = column
+                .get_mut(at..)
+                .and_then(|d| d.first_chunk_mut::<TILE>())
+            else {
+                // A vector shorter than the plot (`dims=`): one at a time.
+                for (i, point) in tile.chunks_exact(row).enumerate() {
+                    if let (Some(d), Some(cell)) = (column.get_mut(at + i), cell_at(point, j)) {
+                        *d = f64::from_le_bytes(*cell);
                     }
-                    Column::Complex(v) => {
-                        if let Some(d) = v.get_mut(i) {
-                            *d = Complex64::new(le_f64(cell, 0), le_f64(cell, 8));
-                        }
+                }
+                continue;
+            };
+            for (i, d) in dst.iter_mut().enumerate() {
+                if let Some(cell) = tile.get(i * row..).and_then(|p| cell_at(p, j)) {
+                    *d = f64::from_le_bytes(*cell);
+                }
+            }
+        }
+    }
+    let at = first + tiles.len() / row;
+    for (i, point) in rest.chunks_exact(row).enumerate() {
+        for (j, column) in columns.iter_mut().enumerate() {
+            if let (Some(d), Some(cell)) = (column.get_mut(at + i), cell_at(point, j)) {
+                *d = f64::from_le_bytes(*cell);
+            }
+        }
+    }
+}
+
+/// The 8 bytes of value `j` of a point.
+#[inline]
+fn cell_at(point: &[u8], j: usize) -> Option<&[u8; 8]> {
+    point.get(j * 8..).and_then(<[u8]>::first_chunk::<8>)
+}
+
+/// As [`transpose_real`] for a complex plot: 16 bytes a value, `(re, im)`;
+/// a real column (the frequency scale) keeps the real part.
+pub(super) fn transpose_complex(block: &[u8], row: usize, first: usize, columns: &mut [Column]) {
+    for (i, point) in block.chunks_exact(row).enumerate() {
+        for (column, cell) in columns.iter_mut().zip(point.chunks_exact(16)) {
+            let Some((re, im)) = cell.split_first_chunk::<8>() else {
+                continue;
+            };
+            let re = f64::from_le_bytes(*re);
+            match column {
+                Column::Real(v) => {
+                    if let Some(d) = v.get_mut(first + i) {
+                        *d = re;
+                    }
+                }
+                Column::Complex(v) => {
+                    if let (Some(d), Some(im)) = (v.get_mut(first + i), im.first_chunk::<8>()) {
+                        *d = Complex64::new(re, f64::from_le_bytes(*im));
                     }
                 }
             }
         }
-        cols
     }
 }
 

@@ -239,7 +239,7 @@ impl VectorStats {
     /// ```
     pub fn of(vector: Vector<'_>) -> VectorStats {
         let range = match vector {
-            Vector::Real(v) => range(v.iter().copied()),
+            Vector::Real(v) => range_of_slice(v),
             Vector::Complex(v) => range(v.iter().map(|c| c.norm())),
         };
         VectorStats {
@@ -257,6 +257,27 @@ fn range(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
     let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
         (lo.min(x), hi.max(x))
     });
+    (lo <= hi).then_some((lo, hi))
+}
+
+/// [`range`] of a slice, eight running ranges at a time (one chain of
+/// comparisons took 3× as long).
+fn range_of_slice(values: &[f64]) -> Option<(f64, f64)> {
+    let mut lo = [f64::INFINITY; 8];
+    let mut hi = [f64::NEG_INFINITY; 8];
+    let chunks = values.chunks_exact(8);
+    let rest = chunks.remainder();
+    for chunk in chunks {
+        for k in 0..8 {
+            lo[k] = lo[k].min(chunk[k]);
+            hi[k] = hi[k].max(chunk[k]);
+        }
+    }
+    let lo = lo.iter().chain(rest).fold(f64::INFINITY, |a, &b| a.min(b));
+    let hi = hi
+        .iter()
+        .chain(rest)
+        .fold(f64::NEG_INFINITY, |a, &b| a.max(b));
     (lo <= hi).then_some((lo, hi))
 }
 
@@ -382,6 +403,20 @@ mod tests {
         assert_eq!(lines[1].find("max").map(|i| i + 3), Some(lines[3].len()));
         let empty = VectorStats::of(Vector::Real(&[f64::NAN]));
         assert_eq!((empty.points, empty.min, empty.max), (1, None, None));
+        // Eight lanes and a remainder: the range wherever its ends are.
+        for len in [0usize, 1, 7, 8, 9, 17, 64] {
+            for at in 0..len {
+                let mut v: Vec<f64> = (0..len).map(|k| (k % 5) as f64).collect();
+                v[at] = -1.0;
+                v[len - 1 - at] = 9.0;
+                if len > 2 {
+                    v[(at + 1) % len] = f64::NAN;
+                }
+                let expected = range(v.iter().copied());
+                assert_eq!(range_of_slice(&v), expected, "{len} {at}");
+            }
+        }
+        assert_eq!(range_of_slice(&[]), None);
     }
 
     #[test]

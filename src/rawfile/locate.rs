@@ -17,6 +17,7 @@
 
 use std::fs::File;
 use std::io::{self, Read, Seek, SeekFrom};
+use std::ops::Range;
 
 use super::{Cursor, DataKind, Dialect, Header, RawWarning, ltspice, next_is_header, parse_header};
 
@@ -65,54 +66,78 @@ impl Located {
         })
     }
 
-    /// The plot's points a block at a time (whole points, at most
-    /// [`BLOCK_BYTES`] unless one point is larger), read into `buf`.
+    /// The plot's points `points` (all of them: `0..self.points`) a block
+    /// at a time (whole points, at most [`BLOCK_BYTES`] unless one point
+    /// is larger), read into `buf`.
     pub(super) fn blocks<'a>(
         &self,
-        file: &'a mut File,
+        file: &'a File,
         buf: &'a mut Vec<u8>,
-    ) -> io::Result<Blocks<'a>> {
+        points: Range<usize>,
+    ) -> Blocks<'a> {
         let row = self.row();
         let per_block = (BLOCK_BYTES / row).max(1);
         buf.resize(per_block * row, 0);
-        file.seek(SeekFrom::Start(self.data))?;
-        Ok(Blocks {
+        Blocks {
             file,
             buf,
             row,
+            offset: self.data + (points.start * row) as u64,
             first: 0,
-            left: self.points as usize,
-        })
+            left: points.len(),
+        }
     }
 }
 
-/// A plot's data read a block of points at a time into one buffer.
+/// A run of a plot's points read a block at a time into one buffer, each
+/// block from its own offset: several can read one file at once.
 pub(super) struct Blocks<'a> {
-    file: &'a mut File,
+    file: &'a File,
     buf: &'a mut Vec<u8>,
     /// Bytes a point.
     row: usize,
-    /// Index of the next block's first point.
+    /// Where the next block starts in the file.
+    offset: u64,
+    /// Index of the next block's first point, from the run's first.
     first: usize,
     /// Points not read yet.
     left: usize,
 }
 
 impl Blocks<'_> {
-    /// The next block and the index of its first point; `None` after the
-    /// last.
+    /// The next block and the index of its first point (from the run's
+    /// first); `None` after the last.
     pub(super) fn next_block(&mut self) -> io::Result<Option<(&[u8], usize)>> {
         if self.left == 0 {
             return Ok(None);
         }
         let rows = self.left.min(self.buf.len() / self.row);
         let block = &mut self.buf[..rows * self.row];
-        self.file.read_exact(block)?;
+        read_exact_at(self.file, block, self.offset)?;
         let first = self.first;
+        self.offset += (rows * self.row) as u64;
         self.first += rows;
         self.left -= rows;
         Ok(Some((block, first)))
     }
+}
+
+/// Whether [`read_exact_at`] leaves the file's position alone, so that
+/// several threads can read one file.
+pub(super) const POSITIONAL_READS: bool = cfg!(unix);
+
+/// Fills `buf` from `offset` in `file`.
+#[cfg(unix)]
+fn read_exact_at(file: &File, buf: &mut [u8], offset: u64) -> io::Result<()> {
+    std::os::unix::fs::FileExt::read_exact_at(file, buf, offset)
+}
+
+/// Fills `buf` from `offset` in `file` (moving its position: one reader at
+/// a time, see [`POSITIONAL_READS`]).
+#[cfg(not(unix))]
+fn read_exact_at(mut file: &File, buf: &mut [u8], offset: u64) -> io::Result<()> {
+    file.seek(SeekFrom::Start(offset))?;
+    file.read_exact(buf)
 }
 
 /// Every plot of the file (of `len` bytes) with its data, or `None` when

@@ -52,11 +52,11 @@ pub fn stream_csv<W: Write>(
             count,
         });
     };
-    write_plot(&mut file, plot, chosen, out, &io)
+    write_plot(&file, plot, chosen, out, &io)
 }
 
 fn write_plot<W: Write>(
-    file: &mut File,
+    file: &File,
     located: &Located,
     index: usize,
     out: W,
@@ -93,7 +93,7 @@ fn write_plot<W: Write>(
     // the 2-core development machine.)
     let mut buf = Vec::new();
     let mut text = Vec::new();
-    let mut blocks = located.blocks(file, &mut buf).map_err(io)?;
+    let mut blocks = located.blocks(file, &mut buf, 0..located.points as usize);
     while let Some((data, _)) = blocks.next_block().map_err(io)? {
         format_rows(data, row, width, &pairs, &mut text);
         out.write_all(&text)?;
