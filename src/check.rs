@@ -666,18 +666,12 @@ pub fn dc_step(
     scenario: &Scenario,
 ) -> Result<(Chatter, Option<crate::mechanics::two_stage::TwoStageRun>), CheckError> {
     let path = || scenario.origin.clone();
-    let Some(section) = &scenario.coil else {
-        return Err(CheckError::NoDriveVoltage { path: path() });
-    };
-    let voltage = scenario
-        .dc_step_voltage()
+    let (coil, source) = scenario
+        .dc_step()
         .ok_or_else(|| CheckError::NoDriveVoltage { path: path() })?;
     crate::coil::direct::direct_closing(
-        &crate::coil::Coil::from(section),
-        &crate::coil::Source {
-            voltage,
-            series_resistance: 0.0,
-        },
+        &coil,
+        &source,
         &scenario.armature(),
         &scenario.two_stage(),
         &scenario.surface(),

@@ -117,20 +117,10 @@ impl Failure {
             kind: Kind::Input,
             message,
             key: err.key().map(str::to_owned),
-            location: location(err).cloned(),
+            location: err.location().cloned(),
             io: io_kind(err),
         }
     }
-}
-
-/// The place a scenario error names, when it names one.
-pub fn location(err: &ScenarioError) -> Option<&Location> {
-    err.location()
-}
-
-/// [`location`], to move it.
-pub fn location_mut(err: &mut ScenarioError) -> Option<&mut Location> {
-    err.location_mut()
 }
 
 /// The error and each cause on lines of their own, as the command line

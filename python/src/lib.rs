@@ -25,7 +25,7 @@ use chatterspice::pipeline::{self, RunOptions};
 use chatterspice::report::{self, Format};
 use chatterspice::scenario::{DEFAULT_SCENARIO_TOML, Scenario};
 use chatterspice::spice::Ngspice;
-use chatterspice::sweep::{self, Mode, NoProgress, Sampler, SweepOptions};
+use chatterspice::sweep::{self, NoProgress, Sampler, SweepMode, SweepOptions};
 use chatterspice::waveform::read_state_csv;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -286,8 +286,8 @@ fn py_sweep(
         let sampler = Sampler::new(scenario, samples, seed)?;
         let ngspice = (!mechanics_only).then(|| ngspice(timeout)).transpose()?;
         let mut options = SweepOptions::new(match &ngspice {
-            Some(n) => Mode::Circuit(n),
-            None => Mode::Mechanics,
+            Some(n) => SweepMode::Circuit(n),
+            None => SweepMode::Mechanics,
         });
         if let Some(j) = jobs {
             options.jobs = j;

@@ -27,7 +27,7 @@ use chatterspice::scenario::{DEFAULT_NETLIST, DEFAULT_SCENARIO_TOML, Scenario, S
 use toml::de::{DeTable, DeValue};
 use toml::{Table, Value};
 
-use crate::error::{Failure, location_mut};
+use crate::error::Failure;
 
 /// The name errors give the text.
 pub const TEXT_ORIGIN: &str = "<toml_text>";
@@ -104,7 +104,7 @@ fn merge(mut base: Table, over: Table) -> Table {
 /// Point `err` at the line of the text (or of the default scenario) that
 /// set the key it is about, instead of the merged text's line.
 fn relocate(err: &mut ScenarioError, merged: &str, text: &str) {
-    let Some(at) = location_mut(err) else {
+    let Some(at) = err.location_mut() else {
         return;
     };
     let Some(line) = at.line else {

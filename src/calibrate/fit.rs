@@ -448,11 +448,6 @@ fn drop_pair(events: &[Event], j: usize) -> Vec<Event> {
         .collect()
 }
 
-/// The datasheet figures that were given, in a fixed order.
-fn figures(d: &DatasheetSection) -> Vec<(&'static str, PrintedFigure)> {
-    d.figures()
-}
-
 /// V, a pick-up or drop-out voltage `v` as the relay at the far end of
 /// its coil's printed resistance tolerance shows it, when the figure is a
 /// bound: the currents are the relay's, so the voltages scale with the
@@ -519,7 +514,7 @@ pub fn model_events(s: &Scenario, voltage: Option<f64>) -> Result<Vec<Event>, St
 /// show (it never closes, say).
 pub fn datasheet_figures(s: &Scenario, d: &DatasheetSection) -> Vec<(&'static str, Option<f64>)> {
     let Some(section) = &s.coil else {
-        return figures(d).into_iter().map(|(n, _)| (n, None)).collect();
+        return d.figures().into_iter().map(|(n, _)| (n, None)).collect();
     };
     let coil = Coil::from(section);
     let m = s.armature();
@@ -545,7 +540,7 @@ pub fn datasheet_figures(s: &Scenario, d: &DatasheetSection) -> Vec<(&'static st
     let operate = closing.as_ref().and_then(|c| c.first_impact);
     let settle = closing.as_ref().and_then(|c| c.settle_time);
     let mut out = Vec::new();
-    for (name, _) in figures(d) {
+    for (name, _) in d.figures() {
         let value = match name {
             "coil_resistance" => Some(coil.resistance),
             "pick_up_voltage" => Some(pick_up(&coil, &line).voltage),
@@ -632,7 +627,7 @@ impl Problem<'_> {
 
     fn data_len(&self) -> usize {
         self.measured.as_ref().map_or(0, |m| m.len() + 1)
-            + self.datasheet.as_ref().map_or(0, |d| figures(d).len())
+            + self.datasheet.as_ref().map_or(0, |d| d.figures().len())
     }
 
     /// The scaled data residuals (no prior rows); `None` when the
@@ -649,7 +644,7 @@ impl Problem<'_> {
             r.resize(self.measured.as_ref().map_or(0, |m| m.len() + 1), 0.0);
         }
         if let Some(d) = &self.datasheet {
-            for ((name, figure), (_, model)) in figures(d).iter().zip(&e.figures) {
+            for ((name, figure), (_, model)) in d.figures().iter().zip(&e.figures) {
                 r.push(match model {
                     Some(m) => {
                         figure.misfit(coil_tolerance_corner(d, name, figure, *m)) / RELATIVE_SCALE
@@ -979,11 +974,11 @@ fn evidence(scenario: &Scenario, request: &FitRequest, path: &str) -> Result<Evi
     let datasheet = scenario
         .datasheet
         .clone()
-        .filter(|d| !figures(d).is_empty());
+        .filter(|d| !d.figures().is_empty());
     if let Some(d) = &scenario.datasheet {
         let all = [("coil_voltage", d.coil_voltage)]
             .into_iter()
-            .chain(figures(d).into_iter().map(|(n, f)| (n, Some(f.nominal()))));
+            .chain(d.figures().into_iter().map(|(n, f)| (n, Some(f.nominal()))));
         for (figure, v) in all {
             if let Some(value) = v
                 && !(value > 0.0 && value.is_finite())
@@ -1000,7 +995,7 @@ fn evidence(scenario: &Scenario, request: &FitRequest, path: &str) -> Result<Evi
         if scenario.coil.is_none() {
             return Err(FitError::NeedsCoil {
                 path: path.to_owned(),
-                figure: figures(d)[0].0,
+                figure: d.figures()[0].0,
             });
         }
         let timed = d.operate_time.is_some() || d.bounce_time.is_some();

@@ -9,7 +9,7 @@ use nalgebra::DMatrix;
 use super::{
     BounceCount, Candidate, DatasheetSection, Determined, Evaluation, Event, EventKind, EventRow,
     FigureRow, FitReport, FitRequest, Held, ParameterRow, Problem, RELATIVE_SCALE, event_residuals,
-    figures, pick_up_of,
+    pick_up_of,
 };
 use crate::coil::Coil;
 use crate::scenario::Scenario;
@@ -289,7 +289,7 @@ fn datasheet_rows(
         return (datasheet_rows, pick_up_binds);
     };
     let pick = pick_up_of(fitted);
-    for ((figure, printed), (_, model)) in figures(d).into_iter().zip(&e.figures) {
+    for ((figure, printed), (_, model)) in d.figures().into_iter().zip(&e.figures) {
         let target = printed.nominal();
         datasheet_rows.push(FigureRow {
             figure,

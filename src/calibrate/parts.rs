@@ -21,7 +21,7 @@ use thiserror::Error;
 
 use super::fit::{datasheet_figures, pick_up_of};
 use crate::report::units::engineering;
-use crate::scenario::{PrintedFigure, Scenario, ScenarioError};
+use crate::scenario::{PrintedFigure, Scenario, ScenarioError, bundled_part_text};
 
 /// No bundled part of that name.
 #[derive(Debug, Error)]
@@ -67,7 +67,7 @@ const PARTS: &[Part] = &[
         source: "Omron G5LE-1 DC5; Omron datasheet \"G5LE PCB Power Relay: Cubic, Single-pole 10A Power Relay\" (coil ratings: 5 VDC, 79.4 mA, 63 Ω, must operate 75 % max., must release 10 % min.; operate time 10 ms max., release time 5 ms max.)",
         contact_rating: "single-pole 10 A power relay (SPDT)",
         remark: "times are maxima: the fitted relay is the slowest the datasheet allows",
-        scenario: include_str!("../../parts/omron-g5le-1-dc5.toml"),
+        scenario: bundled_part_text("omron-g5le-1-dc5"),
     },
     Part {
         name: "songle-srd-05vdc-sl-c",
@@ -75,7 +75,7 @@ const PARTS: &[Part] = &[
         source: "Songle SRD-05VDC-SL-C; Ningbo Songle Relay SRD datasheet, coil data chart (high sensitivity 0.36 W: 5 VDC, 71.4 mA, 70 Ω ±10 %, pull-in 75 % max., drop-out 10 % min.; operation time 10 ms max., release time 5 ms max.)",
         contact_rating: "10 A 125 VAC / 10 A 30 VDC resistive (form C)",
         remark: "times are maxima: the fitted relay is the slowest the datasheet allows",
-        scenario: include_str!("../../parts/songle-srd-05vdc-sl-c.toml"),
+        scenario: bundled_part_text("songle-srd-05vdc-sl-c"),
     },
     Part {
         name: "panasonic-tq4-5v",
@@ -83,7 +83,7 @@ const PARTS: &[Part] = &[
         source: "Panasonic TQ4-5V; Panasonic (NAIS) datasheet \"TQ-RELAYS: Low profile 2 Form C relay\", 4 Form C single side stable coil table (5 V DC, 56.2 mA, 89 Ω, pick-up 3.75 V max., drop-out 0.5 V min.; operate time max. 3 ms (approx. 2 ms), release time max. 3 ms (approx. 1 ms))",
         contact_rating: "1 A 30 V DC / 0.5 A 125 V AC resistive",
         remark: "fitted to the typical operate time (approx. 2 ms)",
-        scenario: include_str!("../../parts/panasonic-tq4-5v.toml"),
+        scenario: bundled_part_text("panasonic-tq4-5v"),
     },
     Part {
         name: "finder-40.52-12vdc",
@@ -91,7 +91,7 @@ const PARTS: &[Part] = &[
         source: "Finder 40.52.9.012.0000; Finder datasheet \"40 Series - Miniature PCB/Plug-in relays 8 - 10 - 12 - 16 A\" (DC coil 0.65 W, operating range 0.73…1.5 U_N, must drop-out 0.1 U_N, operate/release time 7/3 ms); coil resistance 220 Ω as listed for 40.52.9.012.0000",
         contact_rating: "2 CO 8 A 250 VAC",
         remark: "pick-up 8.76 V = 0.73 × 12 V (the lower end of the operating range)",
-        scenario: include_str!("../../parts/finder-40.52-12vdc.toml"),
+        scenario: bundled_part_text("finder-40.52-12vdc"),
     },
     Part {
         name: "coto-9104-05",
@@ -99,7 +99,7 @@ const PARTS: &[Part] = &[
         source: "Coto Technology 9104 (5 V); Coto 9100/9104 series reed relay datasheet, model 9104 4-pin SIP (5 VDC, coil 175 Ω ±10 %, must operate 3.75 V max., must release 0.5 V min.; operate time including bounce 0.75 ms typ., release time 0.5 ms typ.)",
         contact_rating: "10 W, 0.5 A switching, 1000 V max. (DC/peak AC, resistive)",
         remark: "the printed operate time includes bounce; it is fitted as the time to first make",
-        scenario: include_str!("../../parts/coto-9104-05.toml"),
+        scenario: bundled_part_text("coto-9104-05"),
     },
     Part {
         name: "te-v23145-12v",
@@ -107,7 +107,7 @@ const PARTS: &[Part] = &[
         source: "TE Connectivity Micro Relay Low Noise V23145 (coil code *01-402); TE datasheet \"Automotive Relays, Plug-in Micro ISO Relays, Micro Relay Low Noise\" (12 VDC, operate 7.2 V, release 1.4 V, 181 Ω ±10 %, 796 mW)",
         contact_rating: "20 A NO at 23 °C, 12 VDC",
         remark: "no operate, bounce or release time printed in the coil data: the mass is the prior's",
-        scenario: include_str!("../../parts/te-v23145-12v.toml"),
+        scenario: bundled_part_text("te-v23145-12v"),
     },
     Part {
         name: "te-axicom-im-5v",
@@ -115,7 +115,7 @@ const PARTS: &[Part] = &[
         source: "TE Connectivity AXICOM IM, standard 5 VDC 140 mW; TE datasheet \"AXICOM Signal Relays IM Relay\" Rev. 0917 (operate time typ. 1 ms, max. 3 ms; release time typ. 1 ms, max. 3 ms; bounce time typ. 1 ms, max. 5 ms) and catalog 1308242 (max. operate 3.5 V for 5 V)",
         contact_rating: "2 A, 60 W / 62.5 VA, 220 VDC / 250 VAC (PdRu, gold covered, twin contacts)",
         remark: "fitted to the typical operate and bounce times (1 ms each); the coil resistance is 5 V squared over 140 mW, not a printed figure",
-        scenario: include_str!("../../parts/te-axicom-im-5v.toml"),
+        scenario: bundled_part_text("te-axicom-im-5v"),
     },
     Part {
         name: "te-rt1-rt314012",
@@ -123,7 +123,7 @@ const PARTS: &[Part] = &[
         source: "TE Connectivity Schrack RT1 RT314012 (12 VDC); TE datasheet \"Power PCB Relay RT1\" F0144-C Rev. HK1 (operate/release time max. 8/6 ms, bounce time NO/NC max. 4/6 ms) and coil table F0144-B (12 V: pull-in 8.4 V, release 1.2 V, 360 Ω ±10 %)",
         contact_rating: "1 CO 12 A / 16 A, 250 VAC (AgNi 90/10)",
         remark: "every time is a maximum: the nominal relay is the prior inside them, with the spring moved up to the printed release voltage; the NO contact's bounce time is the one held",
-        scenario: include_str!("../../parts/te-rt1-rt314012.toml"),
+        scenario: bundled_part_text("te-rt1-rt314012"),
     },
     Part {
         name: "omron-g8h-1c4t-r-12v",
@@ -131,7 +131,7 @@ const PARTS: &[Part] = &[
         source: "Omron G8H-1C4T-R (12 VDC); Omron datasheet \"Micro ISO Automotive Relay G8H\" (coil 100 Ω ±10 %, 1440 mW, pull-in < 7.0 V, drop-out > 0.7 V; operate time 20 ms max., release time 10 ms max., bounce time at operate 5 ms max.)",
         contact_rating: "20 A (NO) / 10 A (NC) steady, 60 A inrush, 16 V max. (AgSnO2)",
         remark: "every figure is a bound and the prior meets them all, so the fit held every key: the nominal relay is an assumption inside the datasheet, and the envelope is the honest answer",
-        scenario: include_str!("../../parts/omron-g8h-1c4t-r-12v.toml"),
+        scenario: bundled_part_text("omron-g8h-1c4t-r-12v"),
     },
     Part {
         name: "te-card-e-v23057-12v",
@@ -139,7 +139,7 @@ const PARTS: &[Part] = &[
         source: "TE Connectivity Schrack Card E V23057, coil code 002 (12 VDC); TE datasheet \"Power PCB Relay Card E\" F0151-B Rev. 0411 (operate 8.0 V, release 1.2 V, 330 Ω ±10 %; operate/release time typ. 7/3 ms; bounce time typ. form A/form B 0.5/3 ms)",
         contact_rating: "1 CO 8 A, 250 VAC (AgCdO / AgNi20)",
         remark: "fitted to the typical operate time and the form A (closing) contact's typical bounce time",
-        scenario: include_str!("../../parts/te-card-e-v23057-12v.toml"),
+        scenario: bundled_part_text("te-card-e-v23057-12v"),
     },
     Part {
         name: "te-rel-5v",
@@ -147,7 +147,7 @@ const PARTS: &[Part] = &[
         source: "TE Connectivity Schrack REL, 5 VDC; TE datasheet \"Miniature PCB Relay REL\" Rev. 0511 (5 V: operate 3.75 V, release 0.5 V, 70 Ω ±10 %, 357 mW; operate/release time max. 10/5 ms; bounce time max. 4 ms)",
         contact_rating: "1 form A 5 A, 250 VAC (AgNi 90/10, AgCdO)",
         remark: "every time is a maximum: the nominal relay is the prior inside them, with the spring moved up to the printed release voltage",
-        scenario: include_str!("../../parts/te-rel-5v.toml"),
+        scenario: bundled_part_text("te-rel-5v"),
     },
 ];
 

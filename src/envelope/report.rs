@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use crate::scenario::EnvelopeRange;
+use crate::sweep::summary::Distribution;
 
 /// A quantity over the kept relays.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -24,17 +25,11 @@ impl Band {
     /// The band of `values` (non-finite values left out); `None` when
     /// none is left.
     pub fn of(values: impl IntoIterator<Item = f64>) -> Option<Band> {
-        let mut v: Vec<f64> = values.into_iter().filter(|x| x.is_finite()).collect();
-        if v.is_empty() {
-            return None;
-        }
-        v.sort_by(f64::total_cmp);
-        let rank = |p: f64| v[((p * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1];
-        Some(Band {
-            min: v[0],
-            median: rank(0.5),
-            p95: rank(0.95),
-            max: v[v.len() - 1],
+        Distribution::of(values.into_iter()).map(|d| Band {
+            min: d.min,
+            median: d.median,
+            p95: d.p95,
+            max: d.max,
         })
     }
 }

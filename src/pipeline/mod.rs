@@ -342,19 +342,12 @@ fn run_dc_step(
 ) -> Result<RunResult, RunError> {
     let scenario = plan.scenario();
     let path = || scenario.origin.clone();
-    let section = scenario
-        .coil
-        .as_ref()
-        .ok_or_else(|| RunError::NoDriveVoltage { path: path() })?;
-    let voltage = scenario
-        .dc_step_voltage()
+    let (coil, source) = scenario
+        .dc_step()
         .ok_or_else(|| RunError::NoDriveVoltage { path: path() })?;
     let (chatter, two_stage) = crate::coil::direct::direct_closing(
-        &crate::coil::Coil::from(section),
-        &crate::coil::Source {
-            voltage,
-            series_resistance: 0.0,
-        },
+        &coil,
+        &source,
         &scenario.armature(),
         &plan.two_stage(),
         &plan.surface(),

@@ -197,6 +197,34 @@ pub fn bundled_part(name: &str) -> Option<&'static str> {
         .map(|(_, text)| *text)
 }
 
+/// [`bundled_part`] at compile time, for the parts' own table: a name
+/// that is not bundled stops the build.
+pub const fn bundled_part_text(name: &str) -> &'static str {
+    let mut i = 0;
+    while i < BUNDLED_PARTS.len() {
+        if same(name.as_bytes(), BUNDLED_PARTS[i].0.as_bytes()) {
+            return BUNDLED_PARTS[i].1;
+        }
+        i += 1;
+    }
+    panic!("not a bundled part")
+}
+
+/// `a == b`, at compile time.
+const fn same(a: &[u8], b: &[u8]) -> bool {
+    if a.len() != b.len() {
+        return false;
+    }
+    let mut i = 0;
+    while i < a.len() {
+        if a[i] != b[i] {
+            return false;
+        }
+        i += 1;
+    }
+    true
+}
+
 /// `text` as a TOML table; a syntax error names `origin`.
 fn table_of(text: &str, origin: &Path) -> Result<toml::Table, ScenarioError> {
     toml::from_str::<toml::Table>(text).map_err(|source| {

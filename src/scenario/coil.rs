@@ -72,6 +72,20 @@ impl Check<'_> {
     }
 }
 
+impl super::Scenario {
+    /// The ideal DC step a coil-driven relay closes on without its driver
+    /// circuit: its magnet and the source of [`super::Scenario::dc_step_voltage`]
+    /// (no series resistance). `None` without a `[coil]` or a voltage.
+    pub fn dc_step(&self) -> Option<(crate::coil::Coil, crate::coil::Source)> {
+        let coil = crate::coil::Coil::from(self.coil.as_ref()?);
+        let source = crate::coil::Source {
+            voltage: self.dc_step_voltage()?,
+            series_resistance: 0.0,
+        };
+        Some((coil, source))
+    }
+}
+
 /// The magnet of the section.
 impl From<&CoilSection> for crate::coil::Coil {
     fn from(c: &CoilSection) -> Self {

@@ -214,43 +214,38 @@ pub enum ScenarioError {
     },
 }
 
+/// `Some(f(at))` for the variants that point at a place in the file, by
+/// reference or by mutable reference as `$error` is borrowed.
+macro_rules! located {
+    ($error:expr, $at:ident => $value:expr) => {
+        match $error {
+            ScenarioError::UnknownKey { $at, .. }
+            | ScenarioError::MissingKey { $at, .. }
+            | ScenarioError::BadValue { $at, .. }
+            | ScenarioError::Invalid { $at, .. }
+            | ScenarioError::Empty { $at, .. }
+            | ScenarioError::Conflict { $at, .. }
+            | ScenarioError::NotForLaw { $at, .. }
+            | ScenarioError::UnknownNumber { $at, .. }
+            | ScenarioError::Sweep { $at, .. }
+            | ScenarioError::Syntax { $at, .. }
+            | ScenarioError::Base { $at, .. } => Some($value),
+            _ => None,
+        }
+    };
+}
+
 impl ScenarioError {
     /// The place in a scenario file the error points at, when it points
     /// at one (its file and line).
     pub fn location(&self) -> Option<&Location> {
-        match self {
-            ScenarioError::UnknownKey { at, .. }
-            | ScenarioError::MissingKey { at, .. }
-            | ScenarioError::BadValue { at, .. }
-            | ScenarioError::Invalid { at, .. }
-            | ScenarioError::Empty { at, .. }
-            | ScenarioError::Conflict { at, .. }
-            | ScenarioError::NotForLaw { at, .. }
-            | ScenarioError::UnknownNumber { at, .. }
-            | ScenarioError::Sweep { at, .. }
-            | ScenarioError::Syntax { at, .. }
-            | ScenarioError::Base { at, .. } => Some(at),
-            _ => None,
-        }
+        located!(self, at => at)
     }
 
     /// [`ScenarioError::location`], to move it (an error found in merged
     /// or overlaid text, pointed back at the file its key came from).
     pub fn location_mut(&mut self) -> Option<&mut Location> {
-        match self {
-            ScenarioError::UnknownKey { at, .. }
-            | ScenarioError::MissingKey { at, .. }
-            | ScenarioError::BadValue { at, .. }
-            | ScenarioError::Invalid { at, .. }
-            | ScenarioError::Empty { at, .. }
-            | ScenarioError::Conflict { at, .. }
-            | ScenarioError::NotForLaw { at, .. }
-            | ScenarioError::UnknownNumber { at, .. }
-            | ScenarioError::Sweep { at, .. }
-            | ScenarioError::Syntax { at, .. }
-            | ScenarioError::Base { at, .. } => Some(at),
-            _ => None,
-        }
+        located!(self, at => at)
     }
 
     /// The dotted key the error is about, if it is about one.

@@ -38,7 +38,7 @@ mod sweep;
 mod tests;
 mod two_stage;
 
-pub use base::{BUNDLED_PARTS, bundled_part};
+pub use base::{BUNDLED_PARTS, bundled_part, bundled_part_text};
 pub use builder::ScenarioBuilder;
 pub use calibration::{
     DatasheetSection, Determined, FitSection, FittedParameter, ProvenanceSection,

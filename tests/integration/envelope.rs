@@ -94,33 +94,32 @@ fn the_draw_is_reproducible_and_the_seed_moves_it() {
     assert_ne!(a["envelope"]["quantities"], c["envelope"]["quantities"]);
 }
 
+/// The message of `check --envelope` on `part:te-rel-5v` with the
+/// envelope `range` (one TOML line), which must be refused with exit 2.
+fn refused(dir: &std::path::Path, range: &str) -> String {
+    let file = dir.join("point.toml");
+    std::fs::write(
+        &file,
+        format!("base = \"part:te-rel-5v\"\n[envelope]\n{range}\n"),
+    )
+    .unwrap();
+    let out = Command::cargo_bin("chatterspice")
+        .unwrap()
+        .args(["check", file.to_str().unwrap(), "--envelope"])
+        .assert()
+        .code(2);
+    String::from_utf8_lossy(&out.get_output().stderr).into_owned()
+}
+
 #[test]
 fn an_envelope_that_is_a_point_is_refused_before_anything_runs() {
     let dir = tempfile::tempdir().unwrap();
-    let file = dir.path().join("point.toml");
-    std::fs::write(
-        &file,
-        "base = \"part:te-rel-5v\"\n[envelope]\n\"surface.damping\" = { min = 20.0, max = 20.0 }\n",
-    )
-    .unwrap();
-    let out = Command::cargo_bin("chatterspice")
-        .unwrap()
-        .args(["check", file.to_str().unwrap(), "--envelope"])
-        .assert()
-        .code(2);
-    let err = String::from_utf8_lossy(&out.get_output().stderr).into_owned();
+    let err = refused(
+        dir.path(),
+        "\"surface.damping\" = { min = 20.0, max = 20.0 }",
+    );
     assert!(err.contains("point.toml") && err.contains("max"), "{err}");
     // An unknown key is named too.
-    std::fs::write(
-        &file,
-        "base = \"part:te-rel-5v\"\n[envelope]\n\"surface.dampnig\" = { min = 1.0, max = 2.0 }\n",
-    )
-    .unwrap();
-    let out = Command::cargo_bin("chatterspice")
-        .unwrap()
-        .args(["check", file.to_str().unwrap(), "--envelope"])
-        .assert()
-        .code(2);
-    let err = String::from_utf8_lossy(&out.get_output().stderr).into_owned();
+    let err = refused(dir.path(), "\"surface.dampnig\" = { min = 1.0, max = 2.0 }");
     assert!(err.contains("surface.dampnig"), "{err}");
 }
