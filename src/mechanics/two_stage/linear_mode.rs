@@ -1,8 +1,8 @@
 //! One linear mode of the two-stage relay and its exact solution: the
-//! mode's scaled matrix, equilibrium and step propagator
-//! ([`LinearMode`]), a step's motion as a Taylor series in τ
-//! ([`Taylor`]), and linear functions of the state ([`Form`]) as scalar
-//! polynomials ([`Poly`]) whose roots and extrema locate events.
+//! mode's scaled matrix, equilibrium, Taylor series and step propagator
+//! ([`LinearMode`]), and linear functions of the state along the motion
+//! ([`Series`]) as scalar polynomials in τ ([`Poly`]) whose roots and
+//! extrema locate events.
 
 use nalgebra::{Matrix4, Vector4};
 
@@ -17,114 +17,149 @@ pub(crate) struct LinearMode {
     pub(super) a: Matrix4<f64>,
     /// `(u_a, v_a, u_b, v_b)` at equilibrium.
     pub(super) eq: Vector4<f64>,
-    /// rad/s, the velocity scale.
-    pub(super) omega: f64,
+    /// The scales of `(u_a, v_a, u_b, v_b)`: `y − eq = D w`, `D = diag(d)`.
+    pub(super) d: [f64; 4],
     /// `exp(a h)`.
     pub(super) phi: Matrix4<f64>,
+    /// `a^k / k!`, the Taylor series' matrices.
+    pub(super) powers: Box<[Matrix4<f64>; TERMS]>,
     /// s
     pub(super) h: f64,
 }
 
 impl LinearMode {
-    /// `w(τ)` from `w0` (τ within a step), by the step's Taylor series.
+    /// The mode of scaled matrix `a`, equilibrium `eq`, scales `d` and
+    /// step `h` (`‖a h‖∞ ≤` [`STEP_NORM`]).
+    pub(super) fn new(a: Matrix4<f64>, eq: Vector4<f64>, d: [f64; 4], h: f64) -> LinearMode {
+        let mut powers = Box::new([Matrix4::identity(); TERMS]);
+        for k in 1..TERMS {
+            powers[k] = a * powers[k - 1] * RECIPROCALS[k];
+        }
+        let mut mode = LinearMode {
+            a,
+            eq,
+            d,
+            phi: Matrix4::identity(),
+            powers,
+            h,
+        };
+        mode.phi = mode.propagator(h);
+        mode
+    }
+
+    /// `exp(a τ)` for τ within a step, by Horner's rule on the series.
+    fn propagator(&self, tau: f64) -> Matrix4<f64> {
+        let mut m = self.powers[TERMS - 1];
+        for k in (0..TERMS - 1).rev() {
+            m = m * tau + self.powers[k];
+        }
+        m
+    }
+
+    /// `w(τ)` from `w0` (τ within a step), by the Taylor series.
     pub(crate) fn at(&self, w0: &W, tau: f64) -> W {
-        Taylor::new(self, w0).at(tau)
+        self.propagator(tau) * w0
     }
 
     /// The state of `w`.
     pub(crate) fn y_of(&self, w: &W) -> Y {
+        let d = &self.d;
         Y::new(
-            self.eq[0] + w[0],
-            self.eq[1] + self.omega * w[1],
-            self.eq[2] + w[2],
-            self.eq[3] + self.omega * w[3],
+            self.eq[0] + d[0] * w[0],
+            self.eq[1] + d[1] * w[1],
+            self.eq[2] + d[2] * w[2],
+            self.eq[3] + d[3] * w[3],
             0.0,
         )
     }
 
     /// The scaled deviation of state `y`.
     pub(crate) fn w_of(&self, y: &Y) -> W {
+        let d = &self.d;
         W::new(
-            y[0] - self.eq[0],
-            (y[1] - self.eq[1]) / self.omega,
-            y[2] - self.eq[2],
-            (y[3] - self.eq[3]) / self.omega,
+            (y[0] - self.eq[0]) / d[0],
+            (y[1] - self.eq[1]) / d[1],
+            (y[2] - self.eq[2]) / d[2],
+            (y[3] - self.eq[3]) / d[3],
         )
     }
-
-    /// The linear form `c·y + d` as `k + q·w`.
-    pub(super) fn form(&self, c: [f64; 4], d: f64) -> Form {
-        let scale = [1.0, self.omega, 1.0, self.omega];
-        Form {
-            k: c[0] * self.eq[0] + c[1] * self.eq[1] + c[2] * self.eq[2] + c[3] * self.eq[3] + d,
-            q: W::new(
-                c[0] * scale[0],
-                c[1] * scale[1],
-                c[2] * scale[2],
-                c[3] * scale[3],
-            ),
-        }
-    }
 }
 
-/// `k + q·w`: a linear function of the state.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Form {
-    pub(super) k: f64,
-    pub(super) q: W,
-}
+/// The step's size in the mode's own time: `‖a h‖∞`. Under π, so that a
+/// step is under half the fastest period (the spectral radius is at most
+/// the norm).
+pub(super) const STEP_NORM: f64 = 2.5;
 
-impl Form {
-    pub(super) fn value(&self, w: &W) -> f64 {
-        self.k + self.q.dot(w)
-    }
-
-    pub(super) fn negated(self) -> Form {
-        Form {
-            k: -self.k,
-            q: -self.q,
-        }
-    }
-}
-
-/// Terms of the Taylor series kept per step: with `‖a h‖ ≤ 2.5` the
-/// first one left out is below 5e-18 of the first.
+/// Terms of the Taylor series kept per step (a multiple of 4, for
+/// [`evaluate`]): with `‖a h‖ ≤ 3` the first one left out is below 1e-20
+/// of the first.
 pub(super) const TERMS: usize = 28;
 
-/// One step's motion as a power series in τ: `w(τ) = Σ c_k τ^k`,
-/// `c_k = a^k w0 / k!`. Built only for steps where something must be
-/// located; any linear form of it is then a scalar polynomial.
-pub(super) struct Taylor {
-    pub(super) c: [W; TERMS],
+/// A linear function of the state, `c·y + d`, along the motion of one
+/// mode: with `w = D⁻¹ (y − eq)` it is `k + q·w`, and from `w0` it is the
+/// polynomial `k + Σ (r_k·w0) τ^k` with `r_k = (aᵀ)^k q / k!`. Built once
+/// per form and mode, it gives a step's polynomial for 28 dot products,
+/// and the form's rate at any state as `r_1·w`.
+#[derive(Debug, Clone)]
+pub(super) struct Series {
+    c: [f64; 4],
+    d: f64,
+    k: f64,
+    r: [W; TERMS],
 }
 
-impl Taylor {
-    pub(super) fn new(mode: &LinearMode, w0: &W) -> Taylor {
-        let mut c = [W::zeros(); TERMS];
-        c[0] = *w0;
-        for k in 1..TERMS {
-            c[k] = mode.a * c[k - 1] / k as f64;
-        }
-        Taylor { c }
+impl Series {
+    pub(super) fn new(mode: &LinearMode, c: [f64; 4], d: f64) -> Series {
+        let eq = &mode.eq;
+        let k = c[0] * eq[0] + c[1] * eq[1] + c[2] * eq[2] + c[3] * eq[3] + d;
+        let q = W::from_fn(|i, _| c[i] * mode.d[i]);
+        let r = std::array::from_fn(|k| mode.powers[k].tr_mul(&q));
+        Series { c, d, k, r }
     }
 
-    pub(super) fn at(&self, tau: f64) -> W {
-        let mut w = self.c[TERMS - 1];
-        for k in (0..TERMS - 1).rev() {
-            w = w * tau + self.c[k];
-        }
-        w
+    /// The form's value at `w`.
+    pub(super) fn value(&self, w: &W) -> f64 {
+        self.k + self.r[0].dot(w)
     }
 
-    pub(super) fn poly(&self, form: &Form) -> Poly {
+    /// The form's rate (per unit τ) at `w`.
+    pub(super) fn rate(&self, w: &W) -> f64 {
+        self.r[1].dot(w)
+    }
+
+    /// The form along the motion from `w0` (the state `y0`), as a
+    /// polynomial in τ. Its value at τ = 0 is taken from `y0` itself, so
+    /// that a state set exactly on a surface starts exactly on its zero,
+    /// whatever the rounding of the scaled deviation.
+    pub(super) fn poly(&self, w0: &W, y0: &Y) -> Poly {
         let mut p = [0.0; TERMS];
-        for (k, c) in self.c.iter().enumerate() {
-            p[k] = form.q.dot(c);
+        for (p, r) in p.iter_mut().zip(&self.r) {
+            *p = r.dot(w0);
         }
-        p[0] += form.k;
+        let c = &self.c;
+        p[0] = c[0] * y0[0] + c[1] * y0[1] + c[2] * y0[2] + c[3] * y0[3] + self.d;
         Poly { p }
     }
 }
+
+/// `1/k` for the series' terms.
+const RECIPROCALS: [f64; TERMS] = {
+    let mut r = [0.0; TERMS];
+    let mut k = 1;
+    while k < TERMS {
+        r[k] = 1.0 / k as f64;
+        k += 1;
+    }
+    r
+};
+
+/// The last Newton step of a root, relative to the bracket's end: the
+/// error left after it is of the order of its square (to rounding).
+const ROOT_TOLERANCE: f64 = 1e-9;
+
+/// The last Newton step of an extremum, relative to the step: the error
+/// left is of the order of 1e-12 of the step.
+const EXTREMUM_TOLERANCE: f64 = 1e-6;
 
 /// A scalar polynomial in τ.
 #[derive(Clone, Copy)]
@@ -132,19 +167,59 @@ pub(super) struct Poly {
     pub(super) p: [f64; TERMS],
 }
 
+/// `Σ p_k τ^k` by Horner's rule in τ⁴ on the four residues of `k` mod 4,
+/// four chains at once (their latency, not their arithmetic, bounds it).
+fn evaluate(p: &[f64; TERMS], tau: f64) -> f64 {
+    if tau == 0.0 {
+        return p[0];
+    }
+    let t2 = tau * tau;
+    let t4 = t2 * t2;
+    let mut c = [p[TERMS - 4], p[TERMS - 3], p[TERMS - 2], p[TERMS - 1]];
+    for k in (0..TERMS / 4 - 1).rev() {
+        for (j, c) in c.iter_mut().enumerate() {
+            *c = *c * t4 + p[4 * k + j];
+        }
+    }
+    (c[0] + tau * c[1]) + t2 * (c[2] + tau * c[3])
+}
+
+/// `p` at `s` and `q` at `t`, as [`evaluate`] does each, in one pass of
+/// eight chains.
+fn evaluate_pair(p: &[f64; TERMS], s: f64, q: &[f64; TERMS], t: f64) -> (f64, f64) {
+    let (s2, t2) = (s * s, t * t);
+    let (s4, t4) = (s2 * s2, t2 * t2);
+    let top = TERMS - 4;
+    let mut a = [p[top], p[top + 1], p[top + 2], p[top + 3]];
+    let mut b = [q[top], q[top + 1], q[top + 2], q[top + 3]];
+    for k in (0..TERMS / 4 - 1).rev() {
+        for j in 0..4 {
+            a[j] = a[j] * s4 + p[4 * k + j];
+            b[j] = b[j] * t4 + q[4 * k + j];
+        }
+    }
+    (
+        (a[0] + s * a[1]) + s2 * (a[2] + s * a[3]),
+        (b[0] + t * b[1]) + t2 * (b[2] + t * b[3]),
+    )
+}
+
 impl Poly {
-    pub(super) fn value(&self, tau: f64) -> f64 {
-        self.p.iter().rev().fold(0.0, |acc, &c| acc * tau + c)
+    pub(super) fn negated(&self) -> Poly {
+        Poly {
+            p: self.p.map(|c| -c),
+        }
     }
 
-    /// (value, rate) at τ.
-    pub(super) fn jet(&self, tau: f64) -> (f64, f64) {
-        let (mut v, mut d) = (self.p[TERMS - 1], 0.0);
-        for k in (0..TERMS - 1).rev() {
-            d = d * tau + v;
-            v = v * tau + self.p[k];
-        }
-        (v, d)
+    pub(super) fn value(&self, tau: f64) -> f64 {
+        evaluate(&self.p, tau)
+    }
+
+    /// A bound on the rounding of [`Poly::value`] over `|τ| ≤ t`: a few
+    /// units in the last place of the sum of the terms' magnitudes. Below
+    /// it a value is zero as far as the arithmetic can tell.
+    fn noise(&self, t: f64) -> f64 {
+        8.0 * f64::EPSILON * evaluate(&self.p.map(f64::abs), t)
     }
 
     pub(super) fn derivative(&self) -> Poly {
@@ -156,14 +231,36 @@ impl Poly {
     }
 
     /// τ in `[lo, hi]` where the polynomial is zero, given a sign change
-    /// between the ends: Newton's method kept inside the bracket,
-    /// bisection where it would leave it.
-    pub(super) fn root(&self, mut lo: f64, mut hi: f64) -> f64 {
-        let positive_lo = self.value(lo) > 0.0;
-        let mut tau = 0.5 * (lo + hi);
+    /// between the ends: Newton's method from the secant's zero, kept
+    /// inside the bracket, bisection where it would leave it, to where
+    /// the value is lost in its rounding or the bracket is two floats wide.
+    pub(super) fn root(&self, lo: f64, hi: f64) -> f64 {
+        let (v_lo, v_hi) = evaluate_pair(&self.p, lo, &self.p, hi);
+        let floor = self.noise(lo.abs().max(hi.abs()));
+        self.root_between((lo, hi), (v_lo, v_hi), floor, ROOT_TOLERANCE)
+    }
+
+    /// [`Poly::root`] with the values at the ends known, to where the
+    /// value is below `floor` or the step or the bracket below `rel` of
+    /// the bracket's end.
+    fn root_between(
+        &self,
+        (mut lo, mut hi): (f64, f64),
+        (v_lo, v_hi): (f64, f64),
+        floor: f64,
+        rel: f64,
+    ) -> f64 {
+        let rate = self.derivative();
+        let positive_lo = v_lo > 0.0;
+        let secant = lo + (hi - lo) * v_lo / (v_lo - v_hi);
+        let mut tau = if secant > lo && secant < hi {
+            secant
+        } else {
+            0.5 * (lo + hi)
+        };
         for _ in 0..200 {
-            let (v, slope) = self.jet(tau);
-            if v == 0.0 {
+            let (v, slope) = evaluate_pair(&self.p, tau, &rate.p, tau);
+            if v.abs() <= floor {
                 return tau;
             }
             if (v > 0.0) == positive_lo {
@@ -177,7 +274,7 @@ impl Poly {
             } else {
                 0.5 * (lo + hi)
             };
-            if (next - tau).abs() <= 2.0 * f64::EPSILON * hi || hi - lo <= 2.0 * f64::EPSILON * hi {
+            if (next - tau).abs() <= rel * hi || hi - lo <= rel * hi {
                 return next;
             }
             tau = next;
@@ -185,13 +282,16 @@ impl Poly {
         tau
     }
 
-    /// The extremum inside `(0, h)`, where the rate changes sign.
+    /// The extremum inside `(0, h)`, where the rate changes sign, to
+    /// [`EXTREMUM_TOLERANCE`]: a value there is off by a part in 1e24 of
+    /// the step's swing (the rate is zero there), and its sign, the one
+    /// other use, holds.
     pub(super) fn extremum(&self, h: f64) -> Option<f64> {
         let rate = self.derivative();
-        let (r0, r1) = (rate.value(0.0), rate.value(h));
+        let (r0, r1) = (rate.p[0], rate.value(h));
         if r0 == 0.0 || r1 == 0.0 || (r0 > 0.0) == (r1 > 0.0) {
             return None;
         }
-        Some(rate.root(0.0, h))
+        Some(rate.root_between((0.0, h), (r0, r1), rate.noise(h), EXTREMUM_TOLERANCE))
     }
 }

@@ -40,21 +40,29 @@ impl Tally {
     /// first touch.
     pub(crate) fn observe(&mut self, gap: f64, modes: StopModes, y: &Y, force: impl Fn(&Y) -> f64) {
         match modes.contact {
-            StopMode::Engaged | StopMode::Pressed => {
-                let f = force(y);
-                if let Some(last) = self.contact.last_mut() {
-                    last.peak_force = Some(last.peak_force.map_or(f, |p: f64| p.max(f)));
-                    last.min_force = Some(last.min_force.map_or(f, |p: f64| p.min(f)));
-                }
+            StopMode::Engaged | StopMode::Pressed => self.observe_force(force(y)),
+            StopMode::Open => self.observe_blade(gap, y[2]),
+        }
+    }
+
+    /// Take in the engaged contact's force `f` (N).
+    pub(crate) fn observe_force(&mut self, f: f64) {
+        if let Some(last) = self.contact.last_mut() {
+            last.peak_force = Some(last.peak_force.map_or(f, |p: f64| p.max(f)));
+            last.min_force = Some(last.min_force.map_or(f, |p: f64| p.min(f)));
+        }
+    }
+
+    /// Take in the open contact's blade at `u_b` (m, from the gap): the
+    /// opening after a release, or the reach before the first touch.
+    pub(crate) fn observe_blade(&mut self, gap: f64, u_b: f64) {
+        match self.contact.last_mut() {
+            Some(last) => {
+                let opening = (-u_b).max(0.0);
+                last.max_gap_after =
+                    Some(last.max_gap_after.map_or(opening, |p: f64| p.max(opening)));
             }
-            StopMode::Open => match self.contact.last_mut() {
-                Some(last) => {
-                    let opening = (-y[2]).max(0.0);
-                    last.max_gap_after =
-                        Some(last.max_gap_after.map_or(opening, |p: f64| p.max(opening)));
-                }
-                None => self.reach = self.reach.max(gap + y[2]),
-            },
+            None => self.reach = self.reach.max(gap + u_b),
         }
     }
 

@@ -14,7 +14,8 @@ pub(crate) enum Interpolant {
     /// DOP853's dense output of the step.
     Dense(Box<Dense<5>>),
     /// The exact solution of a linear mode from `w0` (scaled deviation
-    /// from the mode's equilibrium) at `t0`.
+    /// from the mode's equilibrium) at `t0`, over steps of the mode's `h`
+    /// from `t0` (the last one shorter).
     Linear { w0: W, mode: Arc<LinearMode> },
 }
 
@@ -47,7 +48,15 @@ impl Span {
         let t = t.max(self.t0);
         match &self.motion {
             Interpolant::Dense(dense) => dense.at(t),
-            Interpolant::Linear { w0, mode } => mode.y_of(&mode.at(w0, t - self.t0)),
+            Interpolant::Linear { w0, mode } => {
+                // Step by step as the propagation went, then within the step.
+                let (mut w, mut t0) = (*w0, self.t0);
+                while t - t0 > mode.h {
+                    w = mode.phi * w;
+                    t0 += mode.h;
+                }
+                mode.y_of(&mode.at(&w, t - t0))
+            }
         }
     }
 
