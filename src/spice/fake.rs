@@ -10,7 +10,9 @@ use std::path::PathBuf;
 use std::sync::Mutex;
 use std::time::Duration;
 
-use super::{Failure, RunContext, RunOutput, RunRequest, Runner, SpiceError};
+use super::classify::Failure;
+use super::error::{RunContext, SpiceError};
+use super::run::{RunOutput, RunRequest, Runner};
 use crate::rawfile::RawFile;
 
 #[derive(Debug, Clone)]

@@ -23,7 +23,8 @@ use std::thread;
 use std::time::{Duration, Instant};
 
 use super::classify::{self, Exit};
-use super::{RunContext, RunOutput, RunRequest, Runner, SpiceError, log_tail};
+use super::error::{RunContext, SpiceError, log_tail};
+use super::run::{RunOutput, RunRequest, Runner};
 use crate::rawfile::{RawFile, RawWarning};
 
 /// The environment variable naming the ngspice binary.
