@@ -12,6 +12,7 @@
 //! once), and every quantity becomes a band over the kept relays. A check
 //! holds each limit against the worst kept relay.
 
+mod gather;
 mod render;
 mod report;
 
@@ -35,6 +36,7 @@ use crate::pipeline::{self, RunOptions, RunResult};
 use crate::plan::Plan;
 use crate::scenario::{EnvelopeRange, Scenario, ScenarioError};
 use crate::spice::Runner;
+use gather::Gather;
 
 /// How to sample an envelope.
 #[derive(Debug, Clone)]
@@ -248,8 +250,17 @@ pub fn run(
     };
     let outcomes: Mutex<Vec<Outcome>> = Mutex::new(Vec::new());
     let next = AtomicUsize::new(0);
+    // With a circuit, the relays run on threads of their own whose circuit
+    // passes are gathered into rounds, one ngspice process per job and
+    // round; without, the relays alone on one thread per job.
+    let threads = match circuit {
+        Some(_) => (options.jobs.get() * RELAYS_PER_PROCESS).min(draw.relays.len()),
+        None => options.jobs.get().min(draw.relays.len()),
+    };
+    let gather = circuit.map(|runner| Gather::new(runner, options.jobs.get(), threads));
+    let runner: Option<&dyn Runner> = gather.as_ref().map(|g| g as &dyn Runner);
     std::thread::scope(|scope| {
-        for _ in 0..options.jobs.get().min(draw.relays.len()) {
+        for _ in 0..threads {
             scope.spawn(|| {
                 let mut plan = base.clone();
                 loop {
@@ -257,11 +268,14 @@ pub fn run(
                     let Some(values) = draw.relays.get(i) else {
                         break;
                     };
-                    let outcome = relay(&mut plan, &draw.keys, values, i, circuit, &run_options);
+                    let outcome = relay(&mut plan, &draw.keys, values, i, runner, &run_options);
                     outcomes
                         .lock()
                         .unwrap_or_else(|e| e.into_inner())
                         .push((i, outcome));
+                }
+                if let Some(gather) = &gather {
+                    gather.leave();
                 }
             });
         }
@@ -327,6 +341,10 @@ pub fn run(
         verdict,
     })
 }
+
+/// Relays whose circuit runs one ngspice process takes in turn (per job):
+/// its start-up is paid once for them.
+const RELAYS_PER_PROCESS: usize = 16;
 
 /// A relay's place in the draw, and what became of it: kept, or the
 /// reasons it was not.

@@ -3,7 +3,8 @@
 //!
 //! Everything above this module talks to a [`Runner`]:
 //! - [`Ngspice`] runs the real program in batch mode
-//!   (`ngspice -b -r out.raw deck.cir`, no shell) in a fresh work directory
+//!   (`ngspice -b -r out.raw -D norefvalue deck.cir`, no shell; many decks in one
+//!   process when asked for many at once) in a fresh work directory
 //!   per run, reads stdout and stderr on their own threads (a full pipe
 //!   would stall the child), and kills and reaps it at a wall-clock timeout
 //!   — nothing in ngspice times out by itself;

@@ -8,10 +8,22 @@
 //!
 //! A run writes `deck.cir` and the includes into a fresh temporary
 //! directory (under the system temp dir unless told otherwise — never the
-//! user's directories), runs `ngspice -b -r out.raw deck.cir` there
+//! user's directories), runs `ngspice -b -r out.raw -D norefvalue deck.cir` there
 //! without a shell, and collects stdout and stderr line by line on two
 //! threads into one log, in arrival order. The main thread waits for the
 //! child with a deadline; at the deadline it kills (SIGKILL) and reaps it.
+//!
+//! Many decks at once ([`Runner::run_many`]) share one process: each deck
+//! and its includes go into a directory of their own, and a control script
+//! sources them in turn (`cd`, `source`, `run`, `write`, `destroy`,
+//! `remcirc`), which saves ngspice's start-up on every deck but the first.
+//! A deck's result is taken from the batch only when it is certain: the
+//! batch's log shows no failure, the deck got to its end marker, and its
+//! raw file reads whole with a transient plot that reaches the deck's
+//! `.tran` stop time. Any other deck (a failure, a deck with its own
+//! `.control` block or with analyses besides one `.tran`, a kept work
+//! directory) runs on its own, so its result and any error are exactly
+//! those of [`Runner::run`].
 
 use std::collections::VecDeque;
 use std::ffi::OsStr;
@@ -198,7 +210,9 @@ impl Runner for Ngspice {
         if self.skip_user_init {
             cmd.arg("-n");
         }
-        cmd.args(["-b", "-r", RAW_NAME, DECK_NAME])
+        // `norefvalue`: no progress line, and no clock read at every time
+        // point to decide when to print one (a fifth of a short run's time).
+        cmd.args(["-b", "-r", RAW_NAME, "-D", "norefvalue", DECK_NAME])
             .current_dir(dir.path());
         // ngspice 39 crashes (SIGSEGV) looking for `~/.spiceinit` when HOME
         // is unset; the work directory is a home with no start-up file.
@@ -297,6 +311,208 @@ impl Runner for Ngspice {
             warnings,
         })
     }
+
+    fn run_many(&self, reqs: &[RunRequest]) -> Vec<Result<RunOutput, SpiceError>> {
+        let batched: Vec<usize> = (0..reqs.len())
+            .filter(|&i| batchable(&reqs[i]).is_some())
+            .collect();
+        let mut out: Vec<Option<Result<RunOutput, SpiceError>>> =
+            reqs.iter().map(|_| None).collect();
+        if batched.len() > 1
+            && let Ok(done) = self.batch(reqs, &batched)
+        {
+            for (i, output) in done {
+                out[i] = Some(Ok(output));
+            }
+        }
+        out.into_iter()
+            .zip(reqs)
+            .map(|(done, req)| done.unwrap_or_else(|| self.run(req)))
+            .collect()
+    }
+}
+
+/// The first line of a batch's log for each deck, then its number.
+const DECK_MARK: &str = "@@chatterspice-deck";
+/// The line after a deck's raw file is written, then its number.
+const DONE_MARK: &str = "@@chatterspice-done";
+
+/// The `.tran` stop time of a deck a batch can run: no `.control` block,
+/// one `.tran` with a plain stop time and no other analysis, includes by
+/// plain name, and no kept work directory.
+fn batchable(req: &RunRequest) -> Option<f64> {
+    if req.keep_workdir || !req.includes.iter().all(|(name, _)| is_plain_name(name)) {
+        return None;
+    }
+    const OTHERS: [&str; 11] = [
+        ".control", ".op", ".ac", ".dc", ".noise", ".tf", ".sens", ".disto", ".pz", ".pss", ".sp",
+    ];
+    let mut stop = None;
+    for line in req.deck.lines().skip(1) {
+        let card = line.trim_start().to_ascii_lowercase();
+        let word = card.split_whitespace().next().unwrap_or_default();
+        if OTHERS.contains(&word) {
+            return None;
+        }
+        if word == ".tran" {
+            if stop.is_some() {
+                return None;
+            }
+            let value = card.split_whitespace().nth(2)?;
+            stop = Some(crate::netlist::number::parse_number(value)?);
+        }
+    }
+    stop.filter(|t| *t > 0.0)
+}
+
+impl Ngspice {
+    /// Runs the decks `which` of `reqs` in one ngspice process: the outputs
+    /// of those whose results are certain (see the module's docs). `Err`
+    /// when the batch could not even be set up or started.
+    fn batch(
+        &self,
+        reqs: &[RunRequest],
+        which: &[usize],
+    ) -> Result<Vec<(usize, RunOutput)>, SpiceError> {
+        let parent = self
+            .workdir_parent
+            .clone()
+            .unwrap_or_else(std::env::temp_dir);
+        let dir = tempfile::Builder::new()
+            .prefix("chatterspice-batch-")
+            .tempdir_in(&parent)
+            .map_err(|source| SpiceError::WorkDir {
+                parent: parent.clone(),
+                source,
+            })?;
+        let _remove_at_stop = crate::interrupt::remove_at_stop(dir.path());
+        let write = |path: PathBuf, text: &str| {
+            std::fs::write(&path, text).map_err(|source| SpiceError::Write { path, source })
+        };
+        // `norefvalue`: no progress line, and no clock read at every time
+        // point to decide when to print one (a quarter of the run's time).
+        let mut script = format!(
+            "* chatterspice: {} decks in turn\n.control\nset norefvalue\n",
+            which.len()
+        );
+        for (k, &i) in which.iter().enumerate() {
+            let sub = dir.path().join(k.to_string());
+            std::fs::create_dir(&sub).map_err(|source| SpiceError::WorkDir {
+                parent: dir.path().to_path_buf(),
+                source,
+            })?;
+            write(sub.join(DECK_NAME), &reqs[i].deck)?;
+            for (name, text) in &reqs[i].includes {
+                write(sub.join(name), text)?;
+            }
+            script.push_str(&format!(
+                "echo {DECK_MARK} {k}\ncd {k}\nsource {DECK_NAME}\nrun\nwrite {RAW_NAME}\n\
+                 destroy all\nremcirc\ncd ..\necho {DONE_MARK} {k}\n"
+            ));
+        }
+        script.push_str("quit 0\n.endc\n.end\n");
+        write(dir.path().join("batch.cir"), &script)?;
+
+        let mut cmd = Command::new(&self.program);
+        if self.skip_user_init {
+            cmd.arg("-n");
+        }
+        cmd.args(["-b", "batch.cir"]).current_dir(dir.path());
+        if std::env::var_os("HOME").is_none_or(|h| h.is_empty()) {
+            cmd.env("HOME", dir.path());
+        }
+        let timeout = which.iter().map(|&i| reqs[i].timeout).sum();
+        let started = Instant::now();
+        let finished = run_child(cmd, timeout).map_err(|source| SpiceError::Process {
+            program: self.program.clone(),
+            source,
+            context: Box::new(RunContext {
+                workdir: dir.path().to_path_buf(),
+                kept: false,
+                log_tail: String::new(),
+            }),
+        })?;
+        let share = started.elapsed() / which.len() as u32;
+        // A failure anywhere, or a batch that did not end by itself, makes
+        // every deck run again on its own: a log's lines cannot be told
+        // apart by deck with certainty (stdout and stderr are two pipes).
+        let clean = finished.status.is_some_and(|s| s.success())
+            && classify::classify(Exit::Code(0), &finished.log).is_none();
+        if !clean {
+            return Ok(Vec::new());
+        }
+        let segments = split_log(&finished.log);
+        let mut done = Vec::new();
+        for (k, &i) in which.iter().enumerate() {
+            let Some(segment) = segments.get(&k).filter(|s| s.finished) else {
+                continue;
+            };
+            let Some(stop) = batchable(&reqs[i]) else {
+                continue;
+            };
+            let path = dir.path().join(k.to_string()).join(RAW_NAME);
+            let Ok(bytes) = std::fs::read(&path) else {
+                continue;
+            };
+            let Ok(raw) = RawFile::parse(&bytes) else {
+                continue;
+            };
+            let reached = raw
+                .last_transient()
+                .and_then(|plot| plot.real("time"))
+                .and_then(|t| t.last().copied());
+            if !raw.warnings.is_empty() || reached.is_none_or(|t| t < stop * (1.0 - 1e-9)) {
+                continue;
+            }
+            let mut warnings = classify::warnings(&segment.log);
+            warnings.extend(raw.warnings.iter().map(ToString::to_string));
+            done.push((
+                i,
+                RunOutput {
+                    raw,
+                    log: segment.log.clone(),
+                    version: self.version.clone(),
+                    elapsed: share,
+                    workdir: None,
+                    warnings,
+                },
+            ));
+        }
+        Ok(done)
+    }
+}
+
+/// One deck's part of a batch's log.
+#[derive(Debug, Default)]
+struct Segment {
+    log: String,
+    /// Its end marker was seen.
+    finished: bool,
+}
+
+/// A batch's log cut at its deck markers, by deck.
+fn split_log(log: &str) -> std::collections::BTreeMap<usize, Segment> {
+    let mut segments = std::collections::BTreeMap::<usize, Segment>::new();
+    let mut current: Option<usize> = None;
+    let number = |rest: &str| rest.trim().parse::<usize>().ok();
+    for line in log.lines() {
+        let trimmed = line.trim();
+        if let Some(k) = trimmed.strip_prefix(DECK_MARK).and_then(number) {
+            current = Some(k);
+            segments.entry(k).or_default();
+            continue;
+        }
+        if let Some(k) = trimmed.strip_prefix(DONE_MARK).and_then(number) {
+            segments.entry(k).or_default().finished = true;
+            current = None;
+            continue;
+        }
+        if let Some(segment) = current.and_then(|k| segments.get_mut(&k)) {
+            segment.log.push_str(line);
+            segment.log.push('\n');
+        }
+    }
+    segments
 }
 
 fn is_plain_name(name: &str) -> bool {

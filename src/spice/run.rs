@@ -8,11 +8,19 @@ use std::time::Duration;
 use super::error::SpiceError;
 use crate::rawfile::RawFile;
 
-/// Runs one deck.
+/// Runs decks.
 pub trait Runner: Send + Sync {
     /// Runs `req` to completion: its raw file and log, or why there is
     /// no usable result.
     fn run(&self, req: &RunRequest) -> Result<RunOutput, SpiceError>;
+
+    /// Runs every request of `reqs`, giving for each what [`Runner::run`]
+    /// would give, in order. A runner may share work between them (one
+    /// simulator process for many decks); this default runs them one by
+    /// one.
+    fn run_many(&self, reqs: &[RunRequest]) -> Vec<Result<RunOutput, SpiceError>> {
+        reqs.iter().map(|req| self.run(req)).collect()
+    }
 }
 
 /// One simulation to run.

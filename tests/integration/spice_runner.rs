@@ -303,3 +303,96 @@ fn truncated_or_garbage_raw_files_are_errors() {
     assert!(matches!(err, SpiceError::BadRaw { .. }), "{err}");
     assert!(err.to_string().contains("line 1"), "{err}");
 }
+
+/// An RC stage of `r` ohms whose capacitor is in an include named
+/// `parts.inc` (the same name in every deck, a different text).
+#[cfg(unix)]
+fn rc_with_include(r: u32) -> RunRequest {
+    let mut req = RunRequest::new(format!(
+        "RC {r}\nV1 in 0 PWL(0 0 1n 1)\nR1 in out {r}\n.include parts.inc\n.tran 50u 5m 0 50u\n.end\n"
+    ));
+    req.includes
+        .push(("parts.inc".into(), format!("C1 out 0 {}n\n", r / 2)));
+    req
+}
+
+/// ngspice behind a script that counts its runs (the version probe aside).
+#[cfg(unix)]
+fn counted_ngspice(dir: &Path) -> (Ngspice, PathBuf) {
+    let count = dir.join("runs");
+    let body = format!(
+        "[ \"$1\" = -v ] && exec ngspice -v\necho run >> '{}'\nexec ngspice \"$@\"",
+        count.display()
+    );
+    (fake_ngspice(dir, &body), count)
+}
+
+#[cfg(unix)]
+fn runs(count: &Path) -> usize {
+    std::fs::read_to_string(count).map_or(0, |s| s.lines().count())
+}
+
+#[cfg(unix)]
+#[test]
+fn many_decks_share_one_process_and_give_what_single_runs_give() {
+    if ngspice_or_skip!().version().is_none() {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let (ng, count) = counted_ngspice(tmp.path());
+    let reqs: Vec<RunRequest> = [1000, 2000, 3000, 4000].map(rc_with_include).to_vec();
+    let many = ng.run_many(&reqs);
+    assert_eq!(runs(&count), 1, "four decks, one ngspice process");
+    for (req, out) in reqs.iter().zip(many) {
+        let out = out.unwrap();
+        let alone = ng.run(req).unwrap();
+        let (a, b) = (
+            out.raw.last_transient().unwrap(),
+            alone.raw.last_transient().unwrap(),
+        );
+        // Each deck read its own include: the same values, point for point.
+        for name in ["time", "v(out)", "v(in)"] {
+            assert_eq!(a.real(name), b.real(name), "{name} of {}", req.deck);
+        }
+        assert!(
+            out.log.contains(&req.deck[..7].to_lowercase()),
+            "{}",
+            out.log
+        );
+    }
+    assert_eq!(runs(&count), 5);
+}
+
+#[cfg(unix)]
+#[test]
+fn a_failing_deck_among_many_fails_as_it_would_alone_and_the_others_run() {
+    if ngspice_or_skip!().version().is_none() {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let (ng, count) = counted_ngspice(tmp.path());
+    let broken = RunRequest::new("broken\nR1 in 0 1k\nQ1 a b\n.tran 1u 1m\n.end\n");
+    // A deck with its own control block is never batched.
+    let controlled = RunRequest::new(
+        "controlled\nV1 in 0 DC 2\nR1 in 0 1k\n.tran 1u 1m\n.control\nrun\n.endc\n.end\n",
+    );
+    let reqs = vec![
+        rc_with_include(1000),
+        broken.clone(),
+        rc_with_include(2000),
+        controlled.clone(),
+    ];
+    let [first, second, third, fourth] = <[_; 4]>::try_from(ng.run_many(&reqs)).ok().unwrap();
+    let (failure, _) = failure_of(second);
+    let (alone, _) = failure_of(ng.run(&broken));
+    assert_eq!(failure, alone);
+    for good in [first, third] {
+        let out = good.unwrap();
+        let v = out.raw.last_transient().unwrap().real("v(out)").unwrap();
+        assert!(*v.last().unwrap() > 0.9);
+    }
+    assert!(fourth.is_ok(), "{:?}", fourth.err().map(|e| e.to_string()));
+    // The batch of three (its failure seen), then each again on its own,
+    // the control deck alone, and the lone run of the broken deck.
+    assert_eq!(runs(&count), 1 + 3 + 1 + 1);
+}
