@@ -9,7 +9,7 @@
 //! | `netlist.cir` | the deck that was run: the user's netlist plus the `.include` |
 //! | `contact.inc` | the contact subcircuit (and any data files it reads) |
 //! | `plot.svg` | the contact and the probes over the chatter |
-//! | `plot.png` | the same plot as a picture ([`png`]) |
+//! | `plot.png` | the same plot as a picture (the `png` feature) |
 //!
 //! `cd DIR && ngspice netlist.cir` runs the same simulation again.
 

@@ -1,4 +1,4 @@
-//! Running ngspice: the netlist goes in, a [`RawFile`] (or a typed failure)
+//! Running ngspice: the netlist goes in, a [`RawFile`](crate::rawfile::RawFile) (or a typed failure)
 //! comes out.
 //!
 //! Everything above this module talks to a [`Runner`]:
