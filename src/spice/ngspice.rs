@@ -185,17 +185,7 @@ impl Runner for Ngspice {
                 return Err(SpiceError::IncludeName { name: name.clone() });
             }
         }
-        let parent = self
-            .workdir_parent
-            .clone()
-            .unwrap_or_else(std::env::temp_dir);
-        let dir = tempfile::Builder::new()
-            .prefix("chatterspice-")
-            .tempdir_in(&parent)
-            .map_err(|source| SpiceError::WorkDir {
-                parent: parent.clone(),
-                source,
-            })?;
+        let dir = self.workdir("chatterspice-")?;
         let _remove_at_stop = crate::interrupt::remove_at_stop(dir.path());
         let write = |name: &str, text: &str| {
             let path = dir.path().join(name);
@@ -206,19 +196,12 @@ impl Runner for Ngspice {
             write(name, text)?;
         }
 
-        let mut cmd = Command::new(&self.program);
-        if self.skip_user_init {
-            cmd.arg("-n");
-        }
         // `norefvalue`: no progress line, and no clock read at every time
         // point to decide when to print one (a fifth of a short run's time).
-        cmd.args(["-b", "-r", RAW_NAME, "-D", "norefvalue", DECK_NAME])
-            .current_dir(dir.path());
-        // ngspice 39 crashes (SIGSEGV) looking for `~/.spiceinit` when HOME
-        // is unset; the work directory is a home with no start-up file.
-        if std::env::var_os("HOME").is_none_or(|h| h.is_empty()) {
-            cmd.env("HOME", dir.path());
-        }
+        let cmd = self.command(
+            dir.path(),
+            &["-b", "-r", RAW_NAME, "-D", "norefvalue", DECK_NAME],
+        );
         let started = Instant::now();
         let result = run_child(cmd, req.timeout);
         let elapsed = started.elapsed();
@@ -366,6 +349,35 @@ fn batchable(req: &RunRequest) -> Option<f64> {
 }
 
 impl Ngspice {
+    /// A fresh work directory whose name starts with `prefix`, under the
+    /// configured parent or the system's temporary directory.
+    fn workdir(&self, prefix: &str) -> Result<tempfile::TempDir, SpiceError> {
+        let parent = self
+            .workdir_parent
+            .clone()
+            .unwrap_or_else(std::env::temp_dir);
+        tempfile::Builder::new()
+            .prefix(prefix)
+            .tempdir_in(&parent)
+            .map_err(|source| SpiceError::WorkDir { parent, source })
+    }
+
+    /// ngspice with `args` in `dir` (after `-n` when the user's start-up
+    /// file is skipped).
+    fn command(&self, dir: &Path, args: &[&str]) -> Command {
+        let mut cmd = Command::new(&self.program);
+        if self.skip_user_init {
+            cmd.arg("-n");
+        }
+        cmd.args(args).current_dir(dir);
+        // ngspice 39 crashes (SIGSEGV) looking for `~/.spiceinit` when HOME
+        // is unset; the work directory is a home with no start-up file.
+        if std::env::var_os("HOME").is_none_or(|h| h.is_empty()) {
+            cmd.env("HOME", dir);
+        }
+        cmd
+    }
+
     /// Runs the decks `which` of `reqs` in one ngspice process: the outputs
     /// of those whose results are certain (see the module's docs). `Err`
     /// when the batch could not even be set up or started.
@@ -374,17 +386,7 @@ impl Ngspice {
         reqs: &[RunRequest],
         which: &[usize],
     ) -> Result<Vec<(usize, RunOutput)>, SpiceError> {
-        let parent = self
-            .workdir_parent
-            .clone()
-            .unwrap_or_else(std::env::temp_dir);
-        let dir = tempfile::Builder::new()
-            .prefix("chatterspice-batch-")
-            .tempdir_in(&parent)
-            .map_err(|source| SpiceError::WorkDir {
-                parent: parent.clone(),
-                source,
-            })?;
+        let dir = self.workdir("chatterspice-batch-")?;
         let _remove_at_stop = crate::interrupt::remove_at_stop(dir.path());
         let write = |path: PathBuf, text: &str| {
             std::fs::write(&path, text).map_err(|source| SpiceError::Write { path, source })
@@ -413,14 +415,7 @@ impl Ngspice {
         script.push_str("quit 0\n.endc\n.end\n");
         write(dir.path().join("batch.cir"), &script)?;
 
-        let mut cmd = Command::new(&self.program);
-        if self.skip_user_init {
-            cmd.arg("-n");
-        }
-        cmd.args(["-b", "batch.cir"]).current_dir(dir.path());
-        if std::env::var_os("HOME").is_none_or(|h| h.is_empty()) {
-            cmd.env("HOME", dir.path());
-        }
+        let cmd = self.command(dir.path(), &["-b", "batch.cir"]);
         let timeout = which.iter().map(|&i| reqs[i].timeout).sum();
         let started = Instant::now();
         let finished = run_child(cmd, timeout).map_err(|source| SpiceError::Process {
