@@ -1,9 +1,13 @@
 //! The data of a raw file: binary (padded or not) and ASCII values into
 //! columns, with what a killed or restarted run leaves; the transposition
-//! of binary points into columns, which the reader from disk
-//! ([`super::direct`]) shares.
+//! of binary points into columns, which the reader from disk (the
+//! `direct` module) shares.
 
-use super::*;
+use super::error::RawError;
+use super::header::{
+    Cursor, Header, Sections, next_is_header, real_in_complex_plot, scale_increases, sections, text,
+};
+use super::types::{Column, Complex64, Plot, RawWarning, Variable};
 
 pub(super) fn read_binary(
     cur: &mut Cursor<'_>,
@@ -348,16 +352,6 @@ pub(super) fn read_binary_unpadded(
         read += 1;
     }
     (columns, read, pos)
-}
-
-/// The f64 at `off` in a cell of at least `off + 8` bytes.
-#[inline]
-pub(super) fn le_f64(cell: &[u8], off: usize) -> f64 {
-    let mut b = [0u8; 8];
-    if let Some(src) = cell.get(off..off + 8) {
-        b.copy_from_slice(src);
-    }
-    f64::from_le_bytes(b)
 }
 
 #[inline]

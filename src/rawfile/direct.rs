@@ -1,5 +1,5 @@
 //! Reading a raw file from disk straight into its columns: what
-//! [`super::RawFile::read`] does first.
+//! [`super::types::RawFile::read`] does first.
 //!
 //! For the files [`super::locate`] finds its way in (ngspice's binary
 //! plots, whole or cut short by a killed run), every vector's `Vec` is
@@ -21,8 +21,9 @@ use std::io;
 use std::ops::Range;
 
 use super::data::{transpose_complex, transpose_real};
+use super::header::real_in_complex_plot;
 use super::locate::{Located, POSITIONAL_READS, locate};
-use super::{Column, Complex64, Plot, RawFile, real_in_complex_plot};
+use super::types::{Column, Complex64, Plot, RawFile};
 
 /// At most this many threads read one plot (measured on 2 cores: 2
 /// threads take 0.58 of the time of one, 4 threads 0.54).

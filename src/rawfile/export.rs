@@ -12,48 +12,9 @@
 use std::io::Write;
 
 use serde::Serialize;
-use thiserror::Error;
 
-use super::{Plot, RawFile, Vector};
-
-/// Why a plot could not be rendered.
-#[derive(Debug, Error)]
-#[non_exhaustive]
-pub enum ExportError {
-    /// The plot asked for is not in the file.
-    #[error("there is no plot {index}: the file has {count} plot(s), numbered 0 to {last}", last = .count.saturating_sub(1))]
-    NoSuchPlot {
-        /// The 0-based plot index asked for.
-        index: usize,
-        /// The number of plots in the file.
-        count: usize,
-    },
-    /// Writing the output failed.
-    #[error("cannot write the output: {0}")]
-    Write(#[from] std::io::Error),
-    /// The CSV writer failed (usually writing the output).
-    #[error("cannot write the CSV output: {0}")]
-    Csv(#[from] csv::Error),
-    /// The raw file cannot be read.
-    #[error(transparent)]
-    Raw(#[from] super::RawError),
-}
-
-impl ExportError {
-    /// The reader of the output went away (`chatterspice raw f | head`):
-    /// not an error worth reporting.
-    pub fn is_broken_pipe(&self) -> bool {
-        let io = match self {
-            ExportError::Write(e) => Some(e),
-            ExportError::Csv(e) => match e.kind() {
-                csv::ErrorKind::Io(e) => Some(e),
-                _ => None,
-            },
-            ExportError::NoSuchPlot { .. } | ExportError::Raw(_) => None,
-        };
-        io.is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe)
-    }
-}
+pub use super::error::ExportError;
+use super::types::{Plot, RawFile, Vector};
 
 /// Plot `index`, or the last plot (the main analysis after an `.op`).
 pub fn select_plot(raw: &RawFile, index: Option<usize>) -> Result<&Plot, ExportError> {

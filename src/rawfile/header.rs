@@ -1,7 +1,8 @@
 //! The header of a raw file: its plots, their variables and flags, and
 //! where each plot's data begins and ends.
 
-use super::*;
+use super::error::{Position, RawError};
+use super::types::{Dialect, Encoding, Flags, Plot, Variable};
 
 pub(super) struct Cursor<'a> {
     pub(super) bytes: &'a [u8],
@@ -433,4 +434,14 @@ pub(super) fn redeclaration(bytes: &[u8], vars: &[Variable]) -> Option<usize> {
         .get(pos..)?
         .starts_with(b"Binary:\n")
         .then_some(pos + b"Binary:\n".len())
+}
+
+/// The f64 at `off` in a cell of at least `off + 8` bytes.
+#[inline]
+pub(super) fn le_f64(cell: &[u8], off: usize) -> f64 {
+    let mut b = [0u8; 8];
+    if let Some(src) = cell.get(off..off + 8) {
+        b.copy_from_slice(src);
+    }
+    f64::from_le_bytes(b)
 }

@@ -1,11 +1,12 @@
 //! Finding the plots of a raw file on disk without loading it: each
 //! plot's header is read and parsed on its own, and where its binary data
 //! start and end follows from the header's counts and the file's size.
-//! [`super::direct`] reads the data found here straight into columns and
-//! [`super::stream`] turns them into CSV, both a block of points at a time.
+//! The reader from disk (the `direct` module) reads the data found here
+//! straight into columns and the streaming CSV writer (the `stream`
+//! module) turns them into CSV, both a block of points at a time.
 //!
 //! Only files whose every plot the in-memory parser
-//! ([`super::RawFile::parse`]) would read as declared are located: ngspice's
+//! ([`super::types::RawFile::parse`]) would read as declared are located: ngspice's
 //! binary plots, padded (or with every vector full length), each ending
 //! where its `No. Points:` says, at the end of the file or exactly at the
 //! next plot's header; or cut short (a killed run, the last plot). For any
@@ -19,7 +20,9 @@ use std::fs::File;
 use std::io::{self, Read, Seek, SeekFrom};
 use std::ops::Range;
 
-use super::{Cursor, DataKind, Dialect, Header, RawWarning, ltspice, next_is_header, parse_header};
+use super::header::{Cursor, DataKind, Header, next_is_header, parse_header};
+use super::ltspice;
+use super::types::{Dialect, RawWarning};
 
 /// A first read of a plot's header; a longer one is read again whole up
 /// to [`HEADER_LIMIT`].

@@ -2,7 +2,12 @@
 //! the sign LTspice leaves on some time stamps, and `.step` runs written
 //! as one plot.
 
-use super::*;
+use super::data::read_ascii;
+use super::error::{Position, RawError};
+use super::header::{
+    Cursor, DataKind, Header, field, le_f64, next_is_header, parse_header, real_in_complex_plot,
+};
+use super::types::{Column, Complex64, Dialect, Encoding, Plot, RawWarning, Step};
 
 // ---------------------------------------------------------------------------
 // UTF-16 text

@@ -7,7 +7,7 @@
 //! file or at the next plot's header), or a killed run's last plot cut
 //! anywhere. Anything else (ASCII, unpadded vectors, the irregular data of
 //! `.options interp`, LTspice's files) returns `None`, and the caller
-//! reads the file whole with [`super::RawFile::read`], which copes with
+//! reads the file whole with [`super::types::RawFile::read`], which copes with
 //! all of them.
 //!
 //! Numbers are written by [`zmij`]: the shortest digits that read back to
@@ -17,9 +17,11 @@ use std::fs::File;
 use std::io::Write;
 use std::path::Path;
 
-use super::export::ExportError;
+use super::error::{ExportError, RawError};
+use super::header::real_in_complex_plot;
 use super::locate::{Located, locate};
-use super::{RawError, RawWarning, real_in_complex_plot, regular_file};
+use super::read::regular_file;
+use super::types::RawWarning;
 
 /// Writes plot `index` (default: the last) of the raw file at `path` as
 /// CSV to `out`, streaming. `Ok(None)`: the file is not one this streams

@@ -1,7 +1,9 @@
 //! `[arc]`: the contact arcs on power loads (the section's struct and its
 //! materials are in [`crate::arc`]; this file checks its numbers).
 
-use super::*;
+use super::check::Check;
+use super::error::ScenarioError;
+use crate::arc::ArcSection;
 
 impl Check<'_> {
     /// `[arc]`: every number positive and within the envelope.

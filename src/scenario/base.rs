@@ -10,8 +10,13 @@
 //! what they meant in the file that wrote them. An error about a key
 //! names the file and line the key came from.
 
-use super::keys::KeyIndex;
-use super::*;
+use std::path::{Path, PathBuf};
+
+use toml::de::DeTable;
+
+use super::builtin::{DEFAULT_SCENARIO_ORIGIN, DEFAULT_SCENARIO_TOML};
+use super::error::{Location, ScenarioError};
+use super::keys::{KeyIndex, line_column};
 
 /// How deep a chain of bases may go before it is taken for a loop.
 const MAX_DEPTH: usize = 16;
@@ -332,4 +337,26 @@ impl Expanded {
         }
         error
     }
+}
+
+/// `path` with `.` dropped and `dir/..` folded, without touching the file
+/// system: `scenarios/../netlists/a.cir` → `netlists/a.cir`, which reads
+/// better in messages. A `..` with nothing to fold stays.
+pub(super) fn lexically_normal(path: &Path) -> PathBuf {
+    use std::path::Component;
+    let mut out = PathBuf::new();
+    for part in path.components() {
+        match part {
+            Component::CurDir => {}
+            Component::ParentDir => match out.components().next_back() {
+                Some(Component::Normal(_)) => {
+                    out.pop();
+                }
+                Some(Component::RootDir | Component::Prefix(_)) => {}
+                _ => out.push(".."),
+            },
+            other => out.push(other),
+        }
+    }
+    out
 }

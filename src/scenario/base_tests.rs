@@ -1,5 +1,7 @@
 //! `base =`: merging, paths, and errors that name the file a key came from.
 
+use std::path::{Path, PathBuf};
+
 use super::*;
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {

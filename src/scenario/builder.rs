@@ -22,7 +22,11 @@
 
 use std::path::Path;
 
-use super::{Probe, Scenario, ScenarioError, SurfaceLaw, SurfaceSection};
+use super::error::ScenarioError;
+use super::law::SurfaceLaw;
+use super::model::Scenario;
+use super::probes::Probe;
+use super::surface::SurfaceSection;
 use crate::mechanics::Surface;
 
 /// Builds a [`Scenario`] from the built-in relay (`scenarios/default.toml`:

@@ -176,7 +176,10 @@ impl<'de> Deserialize<'de> for Determined {
 impl super::check::Check<'_> {
     /// Every figure of `[datasheet]` says something and does not
     /// contradict itself; the coil voltage is positive.
-    pub(super) fn datasheet(&self, d: &DatasheetSection) -> Result<(), super::ScenarioError> {
+    pub(super) fn datasheet(
+        &self,
+        d: &DatasheetSection,
+    ) -> Result<(), super::error::ScenarioError> {
         if let Some(v) = d.coil_voltage {
             self.number(
                 "datasheet.coil_voltage",

@@ -1,7 +1,12 @@
-//! Validation of a deserialized document: the shared rules, and the
-//! order in which every section is checked.
+//! Validation of a deserialized document: [`Check`] and the rules every
+//! section shares. Each section's own rules are an `impl Check` in the
+//! section's file; the order in which they run is in `document.rs`.
 
-use super::*;
+use std::path::Path;
+
+use super::error::{Location, ScenarioError};
+use super::keys::KeyIndex;
+use super::numbers::ENVELOPE;
 
 /// Validation of a deserialized document, in file order.
 pub(super) struct Check<'a> {
@@ -92,69 +97,5 @@ impl Check<'_> {
             });
         }
         Ok(())
-    }
-
-    /// Everything; returns the resolved surface laws of the contact and
-    /// of the back stop.
-    pub(super) fn all(&self, d: &Document) -> Result<(Surface, Option<Surface>), ScenarioError> {
-        self.mechanics(&d.mechanics)?;
-        self.drive(&d.mechanics, d.coil.as_ref())?;
-        let surface = self.surface("surface", &d.surface)?;
-        let back_stop = self.back_stop(d.back_stop.as_ref(), d.coil.is_some())?;
-        self.two_stage(
-            d.blade.as_ref(),
-            d.pole_face.as_ref(),
-            &d.surface,
-            d.mechanics.gap,
-        )?;
-        self.contact(&d.contact)?;
-        self.simulation(&d.simulation)?;
-        if let Some(circuit) = &d.circuit {
-            self.circuit(circuit)?;
-            if circuit.nc_subckt.is_some() && d.coil.is_none() {
-                return Err(ScenarioError::Conflict {
-                    at: self.at("circuit.nc_subckt"),
-                    key: "circuit.nc_subckt".to_owned(),
-                    other: "mechanics.force".to_owned(),
-                    advice: "the normally-closed contact follows the armature back to its \
-                             rest stop on release, which needs a [coil]; give one or remove \
-                             the key",
-                });
-            }
-        }
-        for (i, probe) in d.probe.iter().enumerate() {
-            self.probe(i, probe)?;
-        }
-        if let Some(limits) = &d.limits {
-            self.limits(limits)?;
-            self.release_limits(limits, d.coil.is_some())?;
-        }
-        if let Some(arc) = &d.arc {
-            self.arc(arc)?;
-        }
-        if let Some(datasheet) = &d.datasheet {
-            self.datasheet(datasheet)?;
-        }
-        if let Some(envelope) = &d.envelope {
-            self.envelope_ranges(envelope)?;
-        }
-        if let Some(limits) = d.limits.as_ref().filter(|_| d.arc.is_none()) {
-            let given = [
-                ("limits.max_arc_energy", limits.max_arc_energy.is_some()),
-                ("limits.max_arc_count", limits.max_arc_count.is_some()),
-            ];
-            if let Some((key, _)) = given.iter().find(|(_, set)| *set) {
-                return Err(ScenarioError::MissingKey {
-                    at: self.at(key),
-                    key: "arc".to_owned(),
-                    help: format!(
-                        "`{key}` holds the arcs that [arc] models: add an [arc] section \
-                         (e.g. material = \"Ag\") or remove the limit"
-                    ),
-                    source: None,
-                });
-            }
-        }
-        Ok((surface, back_stop))
     }
 }

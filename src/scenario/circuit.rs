@@ -1,6 +1,13 @@
 //! `[circuit]` and `[circuit.params]`: the netlist the contact switches.
 
-use super::*;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use serde::Deserialize;
+
+use super::check::Check;
+use super::error::ScenarioError;
+use super::numbers::{PARAMS_PREFIX, valid_param_name};
 
 /// `[circuit]`: the netlist the contact is placed into.
 #[derive(Debug, Clone, PartialEq, Deserialize)]

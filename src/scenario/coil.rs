@@ -1,7 +1,10 @@
 //! `[coil]`: the magnetic drive of a coil-driven relay, instead of a step
 //! force.
 
-use super::*;
+use serde::Deserialize;
+
+use super::check::Check;
+use super::error::ScenarioError;
 
 /// `[coil]`: the magnetic drive of docs/model.md §7, instead of a step force.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -69,20 +72,6 @@ impl Check<'_> {
             )?;
         }
         Ok(())
-    }
-}
-
-impl super::Scenario {
-    /// The ideal DC step a coil-driven relay closes on without its driver
-    /// circuit: its magnet and the source of [`super::Scenario::dc_step_voltage`]
-    /// (no series resistance). `None` without a `[coil]` or a voltage.
-    pub fn dc_step(&self) -> Option<(crate::coil::Coil, crate::coil::Source)> {
-        let coil = crate::coil::Coil::from(self.coil.as_ref()?);
-        let source = crate::coil::Source {
-            voltage: self.dc_step_voltage()?,
-            series_resistance: 0.0,
-        };
-        Some((coil, source))
     }
 }
 

@@ -2,7 +2,10 @@
 //! itself ([`Holm`], [`ContactModel`]) lives in the waveform stage; this
 //! file reads and checks its numbers.
 
-use super::*;
+use serde::Deserialize;
+
+use super::check::Check;
+use super::error::ScenarioError;
 use crate::waveform::{ContactModel, Holm};
 
 /// `[contact]`: the contact as a resistor (docs/model.md §5).

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 use super::check::Check;
-use super::{Scenario, ScenarioError};
+use super::error::ScenarioError;
 
 /// `[envelope]`: for each number key the datasheet does not fix, the range
 /// real relays of the class take, and where those ranges come from.
@@ -88,40 +88,6 @@ impl Check<'_> {
                     .to_owned(),
                 source: None,
             });
-        }
-        Ok(())
-    }
-}
-
-impl Scenario {
-    /// The envelope's keys are numbers this scenario has, and both ends of
-    /// each range are values the key may take.
-    pub(super) fn check_envelope(&self, check: &Check<'_>) -> Result<(), ScenarioError> {
-        let Some(e) = &self.envelope else {
-            return Ok(());
-        };
-        for (key, r) in &e.ranges {
-            let at = format!("envelope.\"{key}\"");
-            if let Err(err) = self.number(key) {
-                return Err(ScenarioError::Sweep {
-                    at: check.at(&at),
-                    key: at,
-                    problem: format!(
-                        "not a number of this scenario; an envelope ranges over number keys \
-                         such as \"surface.damping\" ({err})"
-                    ),
-                });
-            }
-            for (end, v) in [("min", r.min), ("max", r.max)] {
-                let mut probe = self.clone();
-                if let Err(err) = probe.set_numbers(&[(key.as_str(), v)]) {
-                    return Err(ScenarioError::Sweep {
-                        at: check.at(&format!("{at}.{end}")),
-                        key: format!("{at}.{end}"),
-                        problem: format!("{v} is not a value `{key}` may take ({err})"),
-                    });
-                }
-            }
         }
         Ok(())
     }

@@ -1,6 +1,11 @@
 //! Where a scenario is wrong, and what to change.
 
-use super::*;
+use std::fmt;
+use std::path::PathBuf;
+
+use thiserror::Error;
+
+use super::law::SurfaceLaw;
 
 /// A place in a scenario file: the file and, when known, the 1-based line.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -154,7 +159,7 @@ pub enum ScenarioError {
         path: PathBuf,
     },
     /// A key given as one of the scenario's numbers (in `[sweep]`, or to
-    /// [`Scenario::number`] or [`Scenario::set_number`]) that is not one.
+    /// `Scenario::number` or `Scenario::set_number`) that is not one.
     #[error("{at}: `{key}` is not a number of the scenario{within}; use one of: {known}")]
     UnknownNumber {
         /// Where the key was named; no line for a library call.

@@ -1,7 +1,12 @@
 //! Where each key of a scenario file is: lines for messages, and the
 //! plain-words translation of the TOML parser's errors.
 
-use super::*;
+use std::ops::Range;
+use std::path::Path;
+
+use toml::de::{DeTable, DeValue};
+
+use super::error::{Location, ScenarioError};
 
 pub(super) fn line_column(text: &str, at: usize) -> (usize, usize) {
     let at = at.min(text.len());

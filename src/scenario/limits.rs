@@ -1,6 +1,9 @@
 //! `[limits]`: what `check` holds the relay to.
 
-use super::*;
+use serde::Deserialize;
+
+use super::check::Check;
+use super::error::ScenarioError;
 
 /// `[limits]`: what `check` holds the relay to. SI units; all optional.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]

@@ -1,7 +1,11 @@
 //! `[mechanics]`: the moving contact, and its drive (a step force, or
 //! the `[coil]` of `coil.rs`).
 
-use super::*;
+use serde::Deserialize;
+
+use super::check::Check;
+use super::coil::CoilSection;
+use super::error::ScenarioError;
 
 /// `[mechanics]`: the moving contact (docs/model.md §1). SI units.
 #[derive(Debug, Clone, PartialEq, Deserialize)]

@@ -1,6 +1,9 @@
 //! `[[probe]]`: the signals to measure, and their limits.
 
-use super::*;
+use serde::Deserialize;
+
+use super::check::Check;
+use super::error::ScenarioError;
 
 /// `[[probe]]`: a measured signal, its Schmitt thresholds, and the limits
 /// `check` holds it to (all optional).

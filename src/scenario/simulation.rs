@@ -1,6 +1,10 @@
 //! `[simulation]`: when to stop, and what is too small to resolve.
 
-use super::*;
+use serde::Deserialize;
+
+use super::check::Check;
+use super::error::ScenarioError;
+use crate::mechanics::Settings;
 
 /// `[simulation]`: the engine's [`Settings`].
 #[derive(Debug, Clone, PartialEq, Deserialize)]

@@ -1,71 +1,17 @@
 //! `[surface]` and `[back_stop]`: the surface laws of the fixed contact
 //! and of the rest stop.
 
-use super::*;
+use serde::Deserialize;
+
+use super::check::Check;
+use super::error::ScenarioError;
+use super::law::{ReleaseRule, SurfaceLaw};
+use crate::mechanics::Surface;
 use crate::mechanics::surface::hunt_crossley_chi;
-
-/// `surface.law`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum SurfaceLaw {
-    /// `"rigid"`: an impact of no duration that reverses the speed and
-    /// scales it by `restitution` (docs/model.md §2a).
-    Rigid,
-    /// `"kelvin-voigt"`: a linear spring `stiffness` and damper `damping`
-    /// while in contact (docs/model.md §2b).
-    KelvinVoigt,
-    /// `"hunt-crossley"`: the force k δⁿ (1 + χ δ̇), never negative; χ given
-    /// as `chi` or as `restitution` at `reference_velocity`
-    /// (docs/model.md §2c).
-    HuntCrossley,
-}
-
-impl SurfaceLaw {
-    /// The name used in the scenario file.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            SurfaceLaw::Rigid => "rigid",
-            SurfaceLaw::KelvinVoigt => "kelvin-voigt",
-            SurfaceLaw::HuntCrossley => "hunt-crossley",
-        }
-    }
-
-    /// The `[surface]` keys (besides `law`) this law reads.
-    fn keys(self) -> &'static [&'static str] {
-        match self {
-            SurfaceLaw::Rigid => &["restitution"],
-            SurfaceLaw::KelvinVoigt => &["stiffness", "damping"],
-            SurfaceLaw::HuntCrossley => &[
-                "stiffness",
-                "exponent",
-                "chi",
-                "restitution",
-                "reference_velocity",
-            ],
-        }
-    }
-
-    /// The same keys, as a reader should see them in an error.
-    pub(super) fn keys_described(self) -> &'static str {
-        match self {
-            SurfaceLaw::Rigid => "`restitution`",
-            SurfaceLaw::KelvinVoigt => "`stiffness` and `damping`",
-            SurfaceLaw::HuntCrossley => {
-                "`stiffness`, `exponent` and `chi` (or `restitution` with `reference_velocity`)"
-            }
-        }
-    }
-}
-
-impl fmt::Display for SurfaceLaw {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.as_str())
-    }
-}
 
 /// `[surface]` as written: one law and the keys it needs (docs/model.md §2).
 /// The keys are all optional here because which ones are required depends
-/// on `law`; validation checks them and [`Scenario::surface`] gives the
+/// on `law`; validation checks them and `Scenario::surface` gives the
 /// resolved law.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]

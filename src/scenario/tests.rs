@@ -1,7 +1,11 @@
 //! Unit tests of the scenario file.
 
+use std::path::Path;
+
+use super::base::lexically_normal;
 use super::*;
 use crate::mechanics::surface::hunt_crossley_chi;
+use crate::mechanics::{Settings, Surface};
 
 const ORIGIN: &str = "relays/test.toml";
 

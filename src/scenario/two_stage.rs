@@ -1,29 +1,14 @@
 //! `[blade]`, `[pole_face]` and `surface.release`: the relay as it is
-//! built (docs/model.md, "The two-stage relay").
+//! built (docs/model.md, "The two-stage relay"). The release rule itself
+//! ([`ReleaseRule`]) is in `law.rs`, beside the surface laws.
 
-use super::*;
-use crate::mechanics::two_stage::{Blade, PoleFace, Release, TwoStage};
+use serde::Deserialize;
 
-/// `surface.release` (and `pole_face.release`): how a deformable surface
-/// lets go.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum ReleaseRule {
-    /// `"position"`: the paper's rule, back at the surface moving out.
-    #[default]
-    Position,
-    /// `"force"`: when the contact force falls to 0.
-    Force,
-}
-
-impl From<ReleaseRule> for Release {
-    fn from(r: ReleaseRule) -> Release {
-        match r {
-            ReleaseRule::Position => Release::Position,
-            ReleaseRule::Force => Release::Force,
-        }
-    }
-}
+use super::check::Check;
+use super::error::ScenarioError;
+use super::law::{ReleaseRule, SurfaceLaw};
+use super::surface::SurfaceSection;
+use crate::mechanics::two_stage::{Blade, PoleFace, TwoStage};
 
 /// `[blade]`: the moving contact on its leaf spring. SI units.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
