@@ -35,7 +35,7 @@
 
 use std::sync::Arc;
 
-use nalgebra::{Matrix4, Vector4};
+use nalgebra::{Matrix4, SMatrix, SVector, Vector4};
 
 use super::linear_mode::{LinearMode, Poly, STEP_NORM, Series, W};
 use super::model::{RelayModel, StopMode, StopModes, Which, Y};
@@ -123,17 +123,37 @@ struct ModeKit {
     mode: Arc<LinearMode>,
     forms: Vec<Series>,
     guards: Vec<(Which, Guard)>,
+    /// The forms' values (rows 0–3) and rates (rows 4–7) as one affine map
+    /// of `w`, rows of absent forms zero: a step reads them in one product.
+    readout: SMatrix<f64, 8, 4>,
+    offset: SVector<f64, 8>,
 }
 
 impl ModeKit {
+    fn new(mode: Arc<LinearMode>, forms: Vec<Series>, guards: Vec<(Which, Guard)>) -> ModeKit {
+        let mut readout = SMatrix::<f64, 8, 4>::zeros();
+        let mut offset = SVector::<f64, 8>::zeros();
+        for (i, form) in forms.iter().enumerate() {
+            readout.set_row(i, &form.r[0].transpose());
+            readout.set_row(4 + i, &form.r[1].transpose());
+            offset[i] = form.k;
+        }
+        ModeKit {
+            mode,
+            forms,
+            guards,
+            readout,
+            offset,
+        }
+    }
+
     /// The forms' values and rates at `w`.
     fn read(&self, w: &W) -> Reading {
-        let mut at = Reading::default();
-        for (i, form) in self.forms.iter().enumerate() {
-            at.value[i] = form.value(w);
-            at.rate[i] = form.rate(w);
+        let v = self.readout * w + self.offset;
+        Reading {
+            value: [v[0], v[1], v[2], v[3]],
+            rate: [v[4], v[5], v[6], v[7]],
         }
-        at
     }
 }
 
@@ -313,11 +333,7 @@ impl LinearSystem {
                 },
             ));
         }
-        ModeKit {
-            mode: Arc::new(mode),
-            forms,
-            guards,
-        }
+        ModeKit::new(Arc::new(mode), forms, guards)
     }
 
     /// J, the energy of state `y` with the force frozen.

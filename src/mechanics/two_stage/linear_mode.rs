@@ -99,13 +99,13 @@ pub(super) const TERMS: usize = 28;
 /// mode: with `w = D⁻¹ (y − eq)` it is `k + q·w`, and from `w0` it is the
 /// polynomial `k + Σ (r_k·w0) τ^k` with `r_k = (aᵀ)^k q / k!`. Built once
 /// per form and mode, it gives a step's polynomial for 28 dot products,
-/// and the form's rate at any state as `r_1·w`.
+/// and the form's value and rate at any state as `k + r_0·w` and `r_1·w`.
 #[derive(Debug, Clone)]
 pub(super) struct Series {
     c: [f64; 4],
     d: f64,
-    k: f64,
-    r: [W; TERMS],
+    pub(super) k: f64,
+    pub(super) r: [W; TERMS],
 }
 
 impl Series {
@@ -115,16 +115,6 @@ impl Series {
         let q = W::from_fn(|i, _| c[i] * mode.d[i]);
         let r = std::array::from_fn(|k| mode.powers[k].tr_mul(&q));
         Series { c, d, k, r }
-    }
-
-    /// The form's value at `w`.
-    pub(super) fn value(&self, w: &W) -> f64 {
-        self.k + self.r[0].dot(w)
-    }
-
-    /// The form's rate (per unit τ) at `w`.
-    pub(super) fn rate(&self, w: &W) -> f64 {
-        self.r[1].dot(w)
     }
 
     /// The form along the motion from `w0` (the state `y0`), as a
