@@ -44,7 +44,8 @@ struct State {
 
 impl<'a> Gather<'a> {
     /// A gatherer for `active` relay threads, each of which calls
-    /// [`Gather::leave`] when it has no more requests.
+    /// [`Gather::leave`] (or drops its [`Gather::member`]) when it has no
+    /// more requests.
     pub(crate) fn new(inner: &'a dyn Runner, jobs: usize, active: usize) -> Gather<'a> {
         Gather {
             inner,
@@ -65,6 +66,12 @@ impl<'a> Gather<'a> {
     pub(crate) fn leave(&self) {
         self.lock().active -= 1;
         self.wake.notify_all();
+    }
+
+    /// A relay thread's membership: it leaves when the value is dropped,
+    /// however the thread ends.
+    pub(crate) fn member(&self) -> Member<'_, 'a> {
+        Member(self)
     }
 
     /// Runs one round: `round` split into up to `jobs` shares of
@@ -101,6 +108,15 @@ impl<'a> Gather<'a> {
                 })
                 .collect()
         })
+    }
+}
+
+/// A relay thread's membership of a [`Gather`]: dropping it leaves.
+pub(crate) struct Member<'g, 'a>(&'g Gather<'a>);
+
+impl Drop for Member<'_, '_> {
+    fn drop(&mut self) {
+        self.0.leave();
     }
 }
 
@@ -205,5 +221,35 @@ mod tests {
         // (11, in two shares), the second the 6 second ones.
         assert!(inner.largest.load(Ordering::SeqCst) >= 5);
         assert!(inner.calls.load(Ordering::SeqCst) <= 6);
+    }
+
+    #[test]
+    fn a_thread_that_panics_leaves_and_no_round_waits_for_it() {
+        let inner = Counting::default();
+        let gather = Gather::new(&inner, 2, 3);
+        let answered = AtomicUsize::new(0);
+        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            std::thread::scope(|scope| {
+                for t in 0..3 {
+                    let (gather, answered) = (&gather, &answered);
+                    scope.spawn(move || {
+                        let _member = gather.member();
+                        if t == 0 {
+                            panic!("a relay's analysis failed");
+                        }
+                        let deck = format!("deck {t}");
+                        let out = gather.run(&RunRequest::new(deck.clone()));
+                        assert_eq!(out.map(|o| o.log).ok(), Some(deck));
+                        answered.fetch_add(1, Ordering::SeqCst);
+                    });
+                }
+            });
+        }));
+        assert!(outcome.is_err(), "the panic reaches the scope");
+        assert_eq!(
+            answered.load(Ordering::SeqCst),
+            2,
+            "the others were answered"
+        );
     }
 }

@@ -262,6 +262,9 @@ pub fn run(
     std::thread::scope(|scope| {
         for _ in 0..threads {
             scope.spawn(|| {
+                // Leaves the gatherer however the thread ends (a panic
+                // too), so that no round waits for it.
+                let _leave = gather.as_ref().map(Gather::member);
                 let mut plan = base.clone();
                 loop {
                     let i = next.fetch_add(1, Ordering::Relaxed);
@@ -273,9 +276,6 @@ pub fn run(
                         .lock()
                         .unwrap_or_else(|e| e.into_inner())
                         .push((i, outcome));
-                }
-                if let Some(gather) = &gather {
-                    gather.leave();
                 }
             });
         }
