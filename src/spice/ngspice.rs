@@ -196,12 +196,7 @@ impl Runner for Ngspice {
             write(name, text)?;
         }
 
-        // `norefvalue`: no progress line, and no clock read at every time
-        // point to decide when to print one (a fifth of a short run's time).
-        let cmd = self.command(
-            dir.path(),
-            &["-b", "-r", RAW_NAME, "-D", "norefvalue", DECK_NAME],
-        );
+        let cmd = self.command(dir.path(), &["-b", "-r", RAW_NAME], DECK_NAME);
         let started = Instant::now();
         let result = run_child(cmd, req.timeout);
         let elapsed = started.elapsed();
@@ -296,8 +291,8 @@ impl Runner for Ngspice {
     }
 
     fn run_many(&self, reqs: &[RunRequest]) -> Vec<Result<RunOutput, SpiceError>> {
-        let batched: Vec<usize> = (0..reqs.len())
-            .filter(|&i| batchable(&reqs[i]).is_some())
+        let batched: Vec<(usize, f64)> = (0..reqs.len())
+            .filter_map(|i| batchable(&reqs[i]).map(|stop| (i, stop)))
             .collect();
         let mut out: Vec<Option<Result<RunOutput, SpiceError>>> =
             reqs.iter().map(|_| None).collect();
@@ -362,14 +357,18 @@ impl Ngspice {
             .map_err(|source| SpiceError::WorkDir { parent, source })
     }
 
-    /// ngspice with `args` in `dir` (after `-n` when the user's start-up
-    /// file is skipped).
-    fn command(&self, dir: &Path, args: &[&str]) -> Command {
+    /// ngspice on `file` with `args` in `dir` (after `-n` when the user's
+    /// start-up file is skipped). Every run sets `norefvalue`: no progress
+    /// line, and no clock read at every time point to decide when to print
+    /// one (a fifth of a short run's time).
+    fn command(&self, dir: &Path, args: &[&str], file: &str) -> Command {
         let mut cmd = Command::new(&self.program);
         if self.skip_user_init {
             cmd.arg("-n");
         }
-        cmd.args(args).current_dir(dir);
+        cmd.args(args)
+            .args(["-D", "norefvalue", file])
+            .current_dir(dir);
         // ngspice 39 crashes (SIGSEGV) looking for `~/.spiceinit` when HOME
         // is unset; the work directory is a home with no start-up file.
         if std::env::var_os("HOME").is_none_or(|h| h.is_empty()) {
@@ -378,26 +377,22 @@ impl Ngspice {
         cmd
     }
 
-    /// Runs the decks `which` of `reqs` in one ngspice process: the outputs
-    /// of those whose results are certain (see the module's docs). `Err`
-    /// when the batch could not even be set up or started.
+    /// Runs the decks `which` of `reqs` (each with its `.tran` stop time)
+    /// in one ngspice process: the outputs of those whose results are
+    /// certain (see the module's docs). `Err` when the batch could not even
+    /// be set up or started.
     fn batch(
         &self,
         reqs: &[RunRequest],
-        which: &[usize],
+        which: &[(usize, f64)],
     ) -> Result<Vec<(usize, RunOutput)>, SpiceError> {
         let dir = self.workdir("chatterspice-batch-")?;
         let _remove_at_stop = crate::interrupt::remove_at_stop(dir.path());
         let write = |path: PathBuf, text: &str| {
             std::fs::write(&path, text).map_err(|source| SpiceError::Write { path, source })
         };
-        // `norefvalue`: no progress line, and no clock read at every time
-        // point to decide when to print one (a quarter of the run's time).
-        let mut script = format!(
-            "* chatterspice: {} decks in turn\n.control\nset norefvalue\n",
-            which.len()
-        );
-        for (k, &i) in which.iter().enumerate() {
+        let mut script = format!("* chatterspice: {} decks in turn\n.control\n", which.len());
+        for (k, &(i, _)) in which.iter().enumerate() {
             let sub = dir.path().join(k.to_string());
             std::fs::create_dir(&sub).map_err(|source| SpiceError::WorkDir {
                 parent: dir.path().to_path_buf(),
@@ -415,8 +410,8 @@ impl Ngspice {
         script.push_str("quit 0\n.endc\n.end\n");
         write(dir.path().join("batch.cir"), &script)?;
 
-        let cmd = self.command(dir.path(), &["-b", "batch.cir"]);
-        let timeout = which.iter().map(|&i| reqs[i].timeout).sum();
+        let cmd = self.command(dir.path(), &["-b"], "batch.cir");
+        let timeout = which.iter().map(|&(i, _)| reqs[i].timeout).sum();
         let started = Instant::now();
         let finished = run_child(cmd, timeout).map_err(|source| SpiceError::Process {
             program: self.program.clone(),
@@ -438,11 +433,8 @@ impl Ngspice {
         }
         let segments = split_log(&finished.log);
         let mut done = Vec::new();
-        for (k, &i) in which.iter().enumerate() {
+        for (k, &(i, stop)) in which.iter().enumerate() {
             let Some(segment) = segments.get(&k).filter(|s| s.finished) else {
-                continue;
-            };
-            let Some(stop) = batchable(&reqs[i]) else {
                 continue;
             };
             let path = dir.path().join(k.to_string()).join(RAW_NAME);

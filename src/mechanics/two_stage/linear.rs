@@ -158,7 +158,7 @@ impl ModeKit {
 }
 
 /// The values and rates of a mode's forms at one state.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy)]
 struct Reading {
     value: [f64; 4],
     rate: [f64; 4],
