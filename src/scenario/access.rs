@@ -4,6 +4,7 @@
 //! the loader's rules.
 
 use super::check::Check;
+use super::document::Physics;
 use super::error::{Location, ScenarioError};
 use super::keys::KeyIndex;
 use super::model::Scenario;
@@ -260,18 +261,16 @@ impl Scenario {
             origin: &self.origin,
             index: &index,
         };
-        check.mechanics(&self.mechanics)?;
-        check.drive(&self.mechanics, self.coil.as_ref())?;
-        let surface = check.surface("surface", &self.surface)?;
-        let back_stop = check.back_stop(self.back_stop.as_ref(), self.coil.is_some())?;
-        check.two_stage(
-            self.blade.as_ref(),
-            self.pole_face.as_ref(),
-            &self.surface,
-            self.mechanics.gap,
-        )?;
-        check.contact(&self.contact)?;
-        check.simulation(&self.simulation)?;
+        let (surface, back_stop) = check.physics(Physics {
+            mechanics: &self.mechanics,
+            coil: self.coil.as_ref(),
+            surface: &self.surface,
+            back_stop: self.back_stop.as_ref(),
+            blade: self.blade.as_ref(),
+            pole_face: self.pole_face.as_ref(),
+            contact: &self.contact,
+            simulation: &self.simulation,
+        })?;
         if let Some(arc) = &self.arc {
             check.arc(arc)?;
         }

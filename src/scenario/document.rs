@@ -47,22 +47,51 @@ pub(super) struct Document {
     pub(super) envelope: Option<EnvelopeSection>,
 }
 
+/// The sections the physics rules read, borrowed from a file being loaded
+/// or from a scenario whose numbers a sweep or a fit has changed.
+pub(super) struct Physics<'a> {
+    pub(super) mechanics: &'a MechanicsSection,
+    pub(super) coil: Option<&'a CoilSection>,
+    pub(super) surface: &'a SurfaceSection,
+    pub(super) back_stop: Option<&'a SurfaceSection>,
+    pub(super) blade: Option<&'a BladeSection>,
+    pub(super) pole_face: Option<&'a PoleFaceSection>,
+    pub(super) contact: &'a ContactSection,
+    pub(super) simulation: &'a SimulationSection,
+}
+
 impl Check<'_> {
+    /// The physics rules, in the order the loader applies them: the
+    /// mechanics and its drive, the surfaces, the blade and the pole face,
+    /// the contact, the simulation. Returns the resolved surface laws of
+    /// the contact and of the back stop.
+    pub(super) fn physics(
+        &self,
+        p: Physics<'_>,
+    ) -> Result<(Surface, Option<Surface>), ScenarioError> {
+        self.mechanics(p.mechanics)?;
+        self.drive(p.mechanics, p.coil)?;
+        let surface = self.surface("surface", p.surface)?;
+        let back_stop = self.back_stop(p.back_stop, p.coil.is_some())?;
+        self.two_stage(p.blade, p.pole_face, p.surface, p.mechanics.gap)?;
+        self.contact(p.contact)?;
+        self.simulation(p.simulation)?;
+        Ok((surface, back_stop))
+    }
+
     /// Everything; returns the resolved surface laws of the contact and
     /// of the back stop.
     pub(super) fn all(&self, d: &Document) -> Result<(Surface, Option<Surface>), ScenarioError> {
-        self.mechanics(&d.mechanics)?;
-        self.drive(&d.mechanics, d.coil.as_ref())?;
-        let surface = self.surface("surface", &d.surface)?;
-        let back_stop = self.back_stop(d.back_stop.as_ref(), d.coil.is_some())?;
-        self.two_stage(
-            d.blade.as_ref(),
-            d.pole_face.as_ref(),
-            &d.surface,
-            d.mechanics.gap,
-        )?;
-        self.contact(&d.contact)?;
-        self.simulation(&d.simulation)?;
+        let (surface, back_stop) = self.physics(Physics {
+            mechanics: &d.mechanics,
+            coil: d.coil.as_ref(),
+            surface: &d.surface,
+            back_stop: d.back_stop.as_ref(),
+            blade: d.blade.as_ref(),
+            pole_face: d.pole_face.as_ref(),
+            contact: &d.contact,
+            simulation: &d.simulation,
+        })?;
         if let Some(circuit) = &d.circuit {
             self.circuit(circuit)?;
             if circuit.nc_subckt.is_some() && d.coil.is_none() {
