@@ -253,6 +253,38 @@ impl<const N: usize> Dense<N> {
     }
 }
 
+impl<const N: usize> Dense<N> {
+    /// The interpolant as a polynomial in `θ = (t − t0)/(t1 − t0)`: its
+    /// coefficients of `θ⁰ … θ⁷`, expanded from the nested form.
+    pub(crate) fn monomial(&self) -> [SVector<f64, N>; 8] {
+        let zero = SVector::<f64, N>::zeros();
+        // p·θ and p·(1 − θ) on coefficient arrays.
+        let times_theta = |p: &[SVector<f64, N>; 8]| {
+            let mut q = [zero; 8];
+            q[1..].copy_from_slice(&p[..7]);
+            q
+        };
+        let times_one_minus = |p: &[SVector<f64, N>; 8]| {
+            let shifted = times_theta(p);
+            std::array::from_fn(|k| p[k] - shifted[k])
+        };
+        let plus = |c: &SVector<f64, N>, mut p: [SVector<f64, N>; 8]| {
+            p[0] += c;
+            p
+        };
+        let [c0, c1, c2, c3, c4, c5, c6, c7] = &self.c;
+        let mut u = [zero; 8];
+        u[0] = *c6;
+        u[1] = *c7;
+        let u = plus(c5, times_one_minus(&u));
+        let t = plus(c4, times_theta(&u));
+        let t = plus(c3, times_one_minus(&t));
+        let p = plus(c2, times_theta(&t));
+        let p = plus(c1, times_one_minus(&p));
+        plus(c0, times_theta(&p))
+    }
+}
+
 /// DOP853 stepper for `ẏ = f(t, y)`.
 ///
 /// The error of the first `M` components (all, by default) sets the step

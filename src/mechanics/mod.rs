@@ -53,6 +53,7 @@ pub mod forced;
 pub mod hunt_crossley;
 pub mod integrate;
 pub mod linear;
+pub(crate) mod locate;
 mod parameters;
 pub mod root;
 pub(crate) mod segment;

@@ -11,7 +11,7 @@ use std::fmt::Write;
 use super::units::engineering;
 use crate::analysis::ProbeAnalysis;
 use crate::arc::ArcReport;
-use crate::chatter::{Chatter, Impact, Outcome};
+use crate::chatter::{Chatter, ContactState, Impact, Outcome};
 use crate::check::{Bound, Verdict, quantity};
 use crate::coil::{Closing, Operation};
 use crate::pipeline::{ProbeResult, RunResult};
@@ -26,7 +26,7 @@ pub fn render(chatter: &Chatter) -> String {
     let mut summary = vec![
         (
             "outcome",
-            format!("{} ({})", chatter.outcome, explain(chatter.outcome)),
+            format!("{} ({})", chatter.outcome, explain(chatter)),
         ),
         ("first impact", ms(chatter.first_impact)),
         ("settle time", ms(chatter.settle_time)),
@@ -184,18 +184,13 @@ fn relay_line(run: &RunResult) -> String {
             c.bounce_count,
             if c.bounce_count == 1 { "" } else { "s" },
             c.outcome,
-            explain(c.outcome),
+            explain(c),
             ms(Some(operate)),
             ms(Some(settle - operate)),
             ms(Some(settle)),
             from_coil_on(&closing),
         ),
-        _ => format!(
-            "{} ({}), {} bounces",
-            c.outcome,
-            explain(c.outcome),
-            c.bounce_count
-        ),
+        _ => format!("{} ({}), {} bounces", c.outcome, explain(c), c.bounce_count),
     }
 }
 
@@ -506,14 +501,25 @@ fn probe_row(label: &str, a: &ProbeAnalysis) -> [String; 10] {
     ]
 }
 
-fn explain(outcome: Outcome) -> &'static str {
-    match outcome {
-        Outcome::Stuck => "closed for good",
-        Outcome::Resolved => "closed for good; later bounces are below resolution",
-        Outcome::NeverCloses => "the contacts never touch",
-        Outcome::EndsOpen => "touched, but the contact ends open",
-        Outcome::EndOfTime => "still bouncing at the end of the simulation",
-        Outcome::EventLimit => "still bouncing after 100 000 impacts: the model has no losses",
+/// What the ending means, in words; at the end of time, what is true
+/// there: closed since when, or still bouncing.
+fn explain(chatter: &Chatter) -> String {
+    match chatter.outcome {
+        Outcome::Stuck => "closed for good".to_owned(),
+        Outcome::Resolved => "closed for good; later bounces are below resolution".to_owned(),
+        Outcome::NeverCloses => "the contacts never touch".to_owned(),
+        Outcome::EndsOpen => "touched, but the contact ends open".to_owned(),
+        Outcome::EndOfTime => match chatter.intervals.last() {
+            Some(last) if last.state == ContactState::Closed => format!(
+                "closed since {}, not yet proven to stay closed at {}",
+                ms(Some(last.start)),
+                ms(Some(chatter.t_end))
+            ),
+            _ => "still bouncing at the end of the simulation".to_owned(),
+        },
+        Outcome::EventLimit => {
+            "still bouncing after 100 000 impacts: the model has no losses".to_owned()
+        }
     }
 }
 

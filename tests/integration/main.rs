@@ -22,6 +22,7 @@ mod coil_coupled;
 mod coil_netlist;
 mod coil_release;
 mod coupling_accelerated;
+mod differential;
 mod envelope;
 mod extremes;
 mod fit;

@@ -22,10 +22,12 @@ use super::relay::{Release, TwoStage, validate_all};
 pub use super::run::Horizon;
 use super::run::TwoStageRun;
 use super::span::Span;
+use crate::chatter::Outcome;
 use crate::mechanics::dop853::{Dense, Dop853};
 use crate::mechanics::driven::{DriveModel, first_true};
 use crate::mechanics::error::{DriveError, MechanicsError};
 use crate::mechanics::forced::Forced;
+use crate::mechanics::locate::{self, StepForm};
 use crate::mechanics::parameters::{Mechanics, Settings, Stops};
 use crate::mechanics::step_control::StepTolerance;
 use crate::mechanics::surface::Surface;
@@ -33,15 +35,74 @@ use crate::mechanics::trajectory::{self, Trajectory, simulate_drive};
 
 /// Relative tolerance of the integration: impact and release times of a
 /// whole sequence agree with the exact one-mass engine to about 1e-9.
-pub(crate) const RTOL: f64 = 1e-11;
+pub(crate) const RTOL: f64 = 1e-12;
 
 /// Sample points per step at which the event functions are checked.
 const SAMPLES: usize = 4;
 
 impl<D: DriveModel> RelayModel<'_, D> {
-    /// The first event in `(t0, t1]` on `dense`: (time, which).
-    fn first_event(&self, dense: &Dense<5>, t1: f64, modes: StopModes) -> Option<(f64, Which)> {
+    /// The first event in `(t0, t1]` on `dense`: (time, which). Each stop
+    /// whose event function is linear in the state (every one but a body
+    /// pressed on a rigid stop by the drive) is searched by the one event
+    /// locator on the dense output's polynomial, so no zero of it is
+    /// stepped over; the others are sampled at [`SAMPLES`] points. The
+    /// bracket found is bisected on the interpolant to adjacent floats.
+    fn first_event(
+        &self,
+        dense: &Dense<5>,
+        t1: f64,
+        modes: StopModes,
+        resolution: f64,
+    ) -> Option<(f64, Which)> {
         const ALL: [Which; 3] = [Which::Contact, Which::Pole, Which::Rest];
+        let t0 = dense.t0;
+        let h = t1 - t0;
+        let mut mono: Option<[Y; 8]> = None;
+        let mut best: Option<(f64, Which)> = None;
+        for which in ALL {
+            let bracket = match self.linear_guard(which, modes) {
+                Some(None) => None,
+                Some(Some(guard)) => {
+                    let mono = mono.get_or_insert_with(|| dense.monomial());
+                    let forms: Vec<StepForm> = guard.forms[..guard.count]
+                        .iter()
+                        .map(|f| {
+                            let a: [f64; 8] = std::array::from_fn(|k| {
+                                let c = &mono[k];
+                                let v: f64 = (0..5).map(|i| f.c[i] * c[i]).sum();
+                                if k == 0 { v + f.d } else { v }
+                            });
+                            StepForm::new(&a)
+                        })
+                        .collect();
+                    locate::first_zero(&forms, guard.combine, resolution / h)
+                        .map(|(lo, hi)| (t0 + lo * h, t0 + hi * h))
+                }
+                None => self.sampled(which, dense, t1, modes),
+            };
+            let Some((lo, hi)) = bracket else { continue };
+            let negative = |t: f64| self.event(which, t, &dense.at(t), modes) < 0.0;
+            let t = if negative(hi) && !negative(lo) {
+                first_true(negative, lo, hi)
+            } else {
+                hi
+            };
+            if best.is_none_or(|(tb, _)| t < tb) {
+                best = Some((t, which));
+            }
+        }
+        best
+    }
+
+    /// The first of [`SAMPLES`] points of the step at which `which`'s
+    /// event function is negative, bracketed by the point before it.
+    fn sampled(
+        &self,
+        which: Which,
+        dense: &Dense<5>,
+        t1: f64,
+        modes: StopModes,
+    ) -> Option<(f64, f64)> {
         let t0 = dense.t0;
         let mut lo = t0;
         for k in 1..=SAMPLES {
@@ -50,18 +111,8 @@ impl<D: DriveModel> RelayModel<'_, D> {
             } else {
                 t0 + (t1 - t0) * k as f64 / SAMPLES as f64
             };
-            let y = dense.at(hi);
-            let mut best: Option<(f64, Which)> = None;
-            for which in ALL {
-                if self.event(which, hi, &y, modes) < 0.0 {
-                    let t = first_true(|t| self.event(which, t, &dense.at(t), modes) < 0.0, lo, hi);
-                    if best.is_none_or(|(tb, _)| t < tb) {
-                        best = Some((t, which));
-                    }
-                }
-            }
-            if best.is_some() {
-                return best;
+            if self.event(which, hi, &dense.at(hi), modes) < 0.0 {
+                return Some((lo, hi));
             }
             lo = hi;
         }
@@ -78,11 +129,61 @@ pub(crate) fn run_relay<D: DriveModel>(
     horizon: Horizon,
 ) -> Result<TwoStageRun, DriveError> {
     let mut progress = start(model, e0);
-    match LinearSystem::of(model) {
-        Some(system) => propagate(&system, model, settings, horizon, &mut progress)?,
-        None => integrate(model, settings, horizon, &mut progress)?,
+    advance(model, settings, horizon, &mut progress)?;
+    if horizon == Horizon::Closing {
+        prove_ending(model, settings, &mut progress);
     }
     Ok(finish(model, settings, horizon, progress))
+}
+
+/// Propagate `p` to the horizon: exactly when every mode is linear, else
+/// by DOP853.
+fn advance<D: DriveModel>(
+    model: &RelayModel<'_, D>,
+    settings: &Settings,
+    horizon: Horizon,
+    p: &mut Propagation,
+) -> Result<(), DriveError> {
+    match LinearSystem::of(model) {
+        Some(system) => propagate(&system, model, settings, horizon, p),
+        None => integrate(model, settings, horizon, p),
+    }
+}
+
+/// How far past `t_end` a closing that is closed there, but not yet
+/// proven to stay closed, is followed: to this many times `t_end`.
+pub const PROOF_SPAN: f64 = 10.0;
+
+/// A closing that ends closed at `t_end` without its ending decided is
+/// followed on, with the drive as it is, until the energy bound proves it
+/// stuck or the contact opens, up to [`PROOF_SPAN`]` × t_end`: stuck (with
+/// its settle time, the last impact before `t_end`) only when proven
+/// before any further event. What happens after `t_end` is not recorded.
+fn prove_ending<D: DriveModel>(
+    model: &RelayModel<'_, D>,
+    settings: &Settings,
+    p: &mut Propagation,
+) {
+    if p.ending.is_some()
+        || p.modes.contact == StopMode::Open
+        || p.rec.contact_is_empty()
+        || p.t < settings.t_end
+    {
+        return;
+    }
+    let mut later = p.fork();
+    let contacts = later.rec.contact_count();
+    let span = Settings {
+        t_end: settings.t_end * PROOF_SPAN,
+        ..*settings
+    };
+    let followed = advance(model, &span, Horizon::Closing, &mut later);
+    if followed.is_ok()
+        && later.ending == Some(Outcome::Stuck)
+        && later.rec.contact_count() == contacts
+    {
+        p.ending = Some(Outcome::Stuck);
+    }
 }
 
 /// DOP853 from event to event, to the horizon.
@@ -113,7 +214,7 @@ fn integrate<D: DriveModel>(
             if let Some(error) = pole_limit(model, &step.y1, step.t1) {
                 return Err(error);
             }
-            match model.first_event(&dense, step.t1, modes) {
+            match model.first_event(&dense, step.t1, modes, settings.min_open_time) {
                 None => {
                     sample(model, &dense, step.t1, modes, &mut p.rec);
                     p.pieces.push(Span::dense(dense, step.t1, step.y1, modes));

@@ -46,6 +46,7 @@ use super::span::{Interpolant, Span};
 use crate::chatter::Outcome;
 use crate::mechanics::driven::DriveModel;
 use crate::mechanics::error::DriveError;
+use crate::mechanics::locate::{self, Combine, StepForm};
 use crate::mechanics::parameters::Settings;
 use crate::mechanics::surface::Surface;
 
@@ -99,14 +100,6 @@ enum Guard {
 }
 
 impl Guard {
-    fn value(&self, at: &Reading) -> f64 {
-        match self {
-            Guard::One(f) => f.value(at),
-            Guard::Max(a, b) => a.value(at).max(b.value(at)),
-            Guard::Min(a, b) => a.value(at).min(b.value(at)),
-        }
-    }
-
     fn terms(&self) -> impl Iterator<Item = Term> {
         let (a, b) = match *self {
             Guard::One(f) => (f, None),
@@ -414,73 +407,74 @@ fn balance(a: &Matrix4<f64>, omega: f64) -> [f64; 4] {
     std::array::from_fn(|i| d0[i] * v[i].max(floor))
 }
 
-/// Whether `term` has a minimum inside the step from `at0` to `at1`: its
-/// rate turns from falling to rising.
-fn dips(term: Term, at0: &Reading, at1: &Reading) -> bool {
-    term.rate(at0) < 0.0 && term.rate(at1) > 0.0
-}
-
 /// Whether `term`'s rate changes sign inside the step from `at0` to `at1`.
 fn turns(term: Term, at0: &Reading, at1: &Reading) -> bool {
     let (r0, r1) = (term.rate(at0), term.rate(at1));
     r0 != 0.0 && r1 != 0.0 && (r0 > 0.0) != (r1 > 0.0)
 }
 
-/// The first event over `(0, h]` of a step read as `at0` at its start and
-/// `at1` at its end: (τ, which).
+/// Whether `term` stays positive over a step from `w0` (read as `at0`),
+/// as its series' spread alone shows: far from its zero, no polynomial is
+/// needed.
+fn stays_positive(kit: &ModeKit, term: Term, w0: &W, at0: &Reading) -> bool {
+    let series = &kit.forms[term.form];
+    term.value(at0) > series.spread * w0.amax() * (1.0 + 1e-12) + 1e-300
+}
+
+/// The first event over `(0, h]` of a step from `w0` (read as `at0`):
+/// (τ, which). Every guard is searched by the one event locator
+/// ([`crate::mechanics::locate`]), which cannot step over a zero of the
+/// exact polynomial, and the zero it brackets is polished on it.
 fn first_event(
     polys: &mut StepPolys<'_>,
-    (at0, at1): (&Reading, &Reading),
+    at0: &Reading,
     h: f64,
+    resolution: f64,
 ) -> Option<(f64, Which)> {
     let mut best: Option<(f64, Which)> = None;
     for &(which, guard) in &polys.kit.guards {
-        let needs = guard.value(at1) < 0.0 || guard.terms().any(|t| dips(t, at0, at1));
-        if !needs {
+        let (combine, quick) = match guard {
+            Guard::One(t) => (Combine::One, stays_positive(polys.kit, t, polys.w0, at0)),
+            Guard::Max(a, b) => (
+                Combine::Max,
+                stays_positive(polys.kit, a, polys.w0, at0)
+                    || stays_positive(polys.kit, b, polys.w0, at0),
+            ),
+            Guard::Min(a, b) => (
+                Combine::Min,
+                stays_positive(polys.kit, a, polys.w0, at0)
+                    && stays_positive(polys.kit, b, polys.w0, at0),
+            ),
+        };
+        if quick {
             continue;
         }
-        let mut terms = guard.terms();
-        let first = polys.of(terms.next().expect("a guard has a term"));
-        let second = terms.next().map(|t| polys.of(t));
-        let both = [Some(first), second];
-        let forms = both.iter().flatten();
-        let value = |tau: f64| match (guard, &second) {
-            (Guard::Max(..), Some(b)) => first.value(tau).max(b.value(tau)),
-            (Guard::Min(..), Some(b)) => first.value(tau).min(b.value(tau)),
-            _ => first.value(tau),
+        let terms: Vec<Term> = guard.terms().collect();
+        let step_polys: Vec<Poly> = terms.iter().map(|&t| polys.of(t)).collect();
+        let forms: Vec<StepForm> = step_polys
+            .iter()
+            .map(|p| StepForm::scaled(&p.p, h))
+            .collect();
+        let Some((lo, hi)) = locate::first_zero(&forms, combine, resolution / h) else {
+            continue;
         };
-        // Where the guard turns negative: at the step's end, or at an
-        // interior minimum of one of its forms.
-        let mut end = (value(h) < 0.0).then_some(h);
-        if end.is_none() {
-            for poly in forms.clone() {
-                if let Some(tm) = poly.extremum(h)
-                    && value(tm) < 0.0
-                {
-                    end = Some(end.map_or(tm, |e: f64| e.min(tm)));
-                }
-            }
-        }
-        let Some(hi) = end else { continue };
-        // The first zero in (0, hi] of the guard: of its forms, those that
-        // cross zero downward before `hi`; for a max the last of them, for
-        // a min the first.
-        let crossing = |poly: &Poly| {
-            if poly.value(hi) > 0.0 {
+        let (lo, hi) = (lo * h, hi * h);
+        // Polish on the exact polynomial: the zero of each form that
+        // crosses in the bracket; for a max the last, else the first.
+        let crossings = step_polys.iter().filter_map(|poly| {
+            let (v_lo, v_hi) = (poly.value(lo), poly.value(hi));
+            if v_hi >= 0.0 || v_lo < 0.0 {
                 return None;
             }
-            if poly.value(0.0) > 0.0 {
-                return Some(poly.root(0.0, hi));
+            // A form on its zero at the step's start is past that zero.
+            if lo == 0.0 && v_lo.abs() <= poly.noise(hi) {
+                return Some(hi);
             }
-            // Starting on its zero (the event that began this mode, set
-            // exactly): the crossing is after the form's maximum.
-            let top = poly.extremum(hi)?;
-            (poly.value(top) > 0.0).then(|| poly.root(top, hi))
-        };
-        let found = forms.filter_map(crossing);
-        let tau = match guard {
-            Guard::Max(..) => found.reduce(f64::max),
-            _ => found.reduce(f64::min),
+            Some(poly.root(lo, hi))
+        });
+        let tau = match combine {
+            Combine::Max => crossings.reduce(f64::max),
+            _ => crossings.reduce(f64::min),
         }
         .unwrap_or(hi);
         if best.is_none_or(|(tb, _)| tau < tb) {
@@ -537,7 +531,7 @@ pub(crate) fn propagate<D: DriveModel>(
                 y0: &y0,
                 polys: [None; 4],
             };
-            let event = first_event(&mut polys, (&at0, &at1), h);
+            let event = first_event(&mut polys, &at0, h, settings.min_open_time);
             let (tau, w_end, at_end) = match event {
                 Some((tau, _)) => {
                     let w_end = mode.at(&w, tau);

@@ -106,6 +106,9 @@ pub(super) struct Series {
     d: f64,
     pub(super) k: f64,
     pub(super) r: [W; TERMS],
+    /// `Σ_{k≥1} ‖r_k‖₁ h^k` over the mode's step: the form moves less
+    /// than this times `‖w0‖∞` within a step from `w0`.
+    pub(super) spread: f64,
 }
 
 impl Series {
@@ -113,8 +116,14 @@ impl Series {
         let eq = &mode.eq;
         let k = c[0] * eq[0] + c[1] * eq[1] + c[2] * eq[2] + c[3] * eq[3] + d;
         let q = W::from_fn(|i, _| c[i] * mode.d[i]);
-        let r = std::array::from_fn(|k| mode.powers[k].tr_mul(&q));
-        Series { c, d, k, r }
+        let r: [W; TERMS] = std::array::from_fn(|k| mode.powers[k].tr_mul(&q));
+        let mut hk = 1.0;
+        let mut spread = 0.0;
+        for rk in &r[1..] {
+            hk *= mode.h;
+            spread += rk.abs().sum() * hk;
+        }
+        Series { c, d, k, r, spread }
     }
 
     /// The form along the motion from `w0` (the state `y0`), as a
@@ -208,7 +217,7 @@ impl Poly {
     /// A bound on the rounding of [`Poly::value`] over `|τ| ≤ t`: a few
     /// units in the last place of the sum of the terms' magnitudes. Below
     /// it a value is zero as far as the arithmetic can tell.
-    fn noise(&self, t: f64) -> f64 {
+    pub(super) fn noise(&self, t: f64) -> f64 {
         8.0 * f64::EPSILON * evaluate(&self.p.map(f64::abs), t)
     }
 

@@ -7,6 +7,7 @@ use nalgebra::SVector;
 
 use super::relay::{Release, TwoStage};
 use crate::mechanics::driven::DriveModel;
+use crate::mechanics::locate::Combine;
 use crate::mechanics::parameters::Mechanics;
 use crate::mechanics::surface::Surface;
 
@@ -66,6 +67,74 @@ pub(super) fn law(surface: &Surface, delta: f64, rate: f64) -> f64 {
         Surface::HuntCrossley { .. } => surface.force(delta.max(0.0), rate),
         Surface::Rigid { .. } => 0.0,
     }
+}
+
+/// A linear form of the state, `c·y + d`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LinearForm {
+    pub c: [f64; 5],
+    pub d: f64,
+}
+
+impl LinearForm {
+    fn of(c: [f64; 5], d: f64) -> LinearForm {
+        LinearForm { c, d }
+    }
+
+    fn negated(self) -> LinearForm {
+        LinearForm {
+            c: self.c.map(|x| -x),
+            d: -self.d,
+        }
+    }
+}
+
+/// An event function as linear forms with the same signs: one, or the
+/// larger or smaller of two.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LinearGuard {
+    pub combine: Combine,
+    pub forms: [LinearForm; 2],
+    pub count: usize,
+}
+
+impl LinearGuard {
+    fn one(f: LinearForm) -> LinearGuard {
+        LinearGuard {
+            combine: Combine::One,
+            forms: [f, f],
+            count: 1,
+        }
+    }
+
+    fn two(combine: Combine, a: LinearForm, b: LinearForm) -> LinearGuard {
+        LinearGuard {
+            combine,
+            forms: [a, b],
+            count: 2,
+        }
+    }
+}
+
+/// The linear form with the sign of [`push`] on the penetration form
+/// `delta` (with its rate in component `rate`).
+fn push_form(surface: &Surface, delta: LinearForm, rate: usize) -> LinearForm {
+    let mut f = LinearForm::of([0.0; 5], 0.0);
+    match *surface {
+        Surface::KelvinVoigt { stiffness, damping } => {
+            for i in 0..5 {
+                f.c[i] = stiffness * delta.c[i];
+            }
+            f.d = stiffness * delta.d;
+            f.c[rate] += damping;
+        }
+        Surface::HuntCrossley { chi, .. } => {
+            f.d = 1.0;
+            f.c[rate] = chi;
+        }
+        Surface::Rigid { .. } => f = delta,
+    }
+    f
 }
 
 impl<D: DriveModel> RelayModel<'_, D> {
@@ -193,6 +262,76 @@ impl<D: DriveModel> RelayModel<'_, D> {
                     StopMode::Open => x,
                     StopMode::Engaged => -x,
                     StopMode::Pressed => -self.armature_push(t, y, modes),
+                }
+            }
+        }
+    }
+
+    /// The event function of `which` in `modes` as linear forms of the
+    /// state with its sign: `Some(None)` when the stop has no event,
+    /// `None` when the function depends on the drive (a body pressed on
+    /// a rigid stop, held there by the drive's force).
+    pub(super) fn linear_guard(
+        &self,
+        which: Which,
+        modes: StopModes,
+    ) -> Option<Option<LinearGuard>> {
+        let force_rule = |release: Release, s: &Surface| {
+            release == Release::Force && !matches!(s, Surface::Rigid { .. })
+        };
+        let guard = |mode: StopMode, surface: &Surface, by_force: bool, delta: LinearForm, rate| {
+            let push = push_form(surface, delta, rate);
+            Some(Some(match mode {
+                StopMode::Open if by_force => {
+                    LinearGuard::two(Combine::Max, delta.negated(), push.negated())
+                }
+                StopMode::Open => LinearGuard::one(delta.negated()),
+                StopMode::Engaged if by_force => LinearGuard::two(Combine::Min, delta, push),
+                StopMode::Engaged => LinearGuard::one(delta),
+                StopMode::Pressed => return None,
+            }))
+        };
+        match which {
+            Which::Contact => {
+                let s = &self.contact;
+                if modes.contact == StopMode::Pressed {
+                    let b = self.build.blade?;
+                    return Some(Some(LinearGuard::one(LinearForm::of(
+                        [b.stiffness, b.damping, -b.stiffness, -b.damping, 0.0],
+                        0.0,
+                    ))));
+                }
+                let delta = LinearForm::of([0.0, 0.0, 1.0, 0.0, 0.0], 0.0);
+                guard(
+                    modes.contact,
+                    s,
+                    force_rule(self.build.release, s),
+                    delta,
+                    3,
+                )
+            }
+            Which::Pole => {
+                let Some(p) = &self.build.pole_face else {
+                    return Some(None);
+                };
+                let delta = LinearForm::of([1.0, 0.0, 0.0, 0.0, 0.0], -p.overtravel);
+                guard(
+                    modes.pole,
+                    &p.surface,
+                    force_rule(p.release, &p.surface),
+                    delta,
+                    1,
+                )
+            }
+            Which::Rest => {
+                if !self.rest {
+                    return Some(None);
+                }
+                let x = LinearForm::of([1.0, 0.0, 0.0, 0.0, 0.0], self.g());
+                match modes.rest {
+                    StopMode::Open => Some(Some(LinearGuard::one(x))),
+                    StopMode::Engaged => Some(Some(LinearGuard::one(x.negated()))),
+                    StopMode::Pressed => None,
                 }
             }
         }

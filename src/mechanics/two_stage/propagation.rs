@@ -18,6 +18,7 @@ use crate::mechanics::parameters::{Mechanics, Settings};
 use crate::mechanics::surface::Surface;
 
 /// The records a run builds.
+#[derive(Clone)]
 pub(crate) struct Tally {
     contact: Vec<Impact>,
     intervals: Vec<Interval>,
@@ -33,6 +34,11 @@ impl Tally {
     /// Whether the contact has been touched.
     pub(crate) fn contact_is_empty(&self) -> bool {
         self.contact.is_empty()
+    }
+
+    /// Impacts on the contact so far.
+    pub(crate) fn contact_count(&self) -> usize {
+        self.contact.len()
     }
 
     /// Take in the state `y` in `modes`: the engaged contact's force
@@ -102,6 +108,20 @@ pub(crate) struct Propagation {
 }
 
 impl Propagation {
+    /// A copy to follow on from here, without the motion so far.
+    pub(crate) fn fork(&self) -> Propagation {
+        Propagation {
+            t: self.t,
+            y: self.y,
+            modes: self.modes,
+            rec: self.rec.clone(),
+            pieces: Vec::new(),
+            steps: 0,
+            bound: EnergyBound::new(),
+            ending: None,
+        }
+    }
+
     /// Apply the event of `which` at `t` (state `y` there, before it).
     pub(crate) fn event<D: DriveModel>(
         &mut self,

@@ -1,0 +1,486 @@
+//! The one event locator: the first time in a step at which an event
+//! function turns negative, with a guarantee that nothing was stepped
+//! over.
+//!
+//! Every event of every engine (an impact, a release, a pole-face touch
+//! or release, a landing on the rest stop) is the first zero of a guard:
+//! one linear form of the state, or the larger or smaller of two (a
+//! surface released by its force). Over one step the state is a
+//! polynomial in the step's own time `s ∈ [0, 1]`: the exact linear modes'
+//! Taylor series (28 terms, truncated below 1e-20 of the state's
+//! swing), or DOP853's dense output (degree 7). So each form is a
+//! polynomial `f(s) = Σ a_k s^k`.
+//!
+//! # The guarantee
+//!
+//! The locator never asks whether `f` looks positive at a few points; it
+//! asks whether `f` can be shown positive on an interval, by the Bernstein
+//! form of `f` there: `f` is a convex combination of its Bernstein
+//! coefficients, so when every coefficient is positive (beyond a bound on
+//! their rounding) so is `f`, everywhere on the interval. The step is
+//! searched from its start: an interval shown positive is skipped, any
+//! other is halved (de Casteljau) and searched left half first, down to a
+//! leaf no wider than a quarter of the resolution (`simulation.min_open_time`
+//! of the model's endings), where the guard is evaluated at the leaf's
+//! end and middle. Hence:
+//!
+//! - every interval skipped is one where the guard is provably positive:
+//!   no sign change is stepped over there, however many roots the step
+//!   holds (two roots a hair apart, a re-closure shorter than a step, a
+//!   function that starts on its zero and comes back);
+//! - an excursion below zero that lasts at least half the resolution
+//!   contains a whole leaf, whose end is then seen negative: it is found;
+//! - the interval returned is the first leaf where the guard was seen
+//!   negative, with every point before it shown positive or inside an
+//!   excursion shorter than half the resolution, which the model's
+//!   endings would merge anyway.
+//!
+//! A form that starts on its own zero (the event that began the mode set
+//! the state exactly on the surface) is divided by `s` first: for `s > 0`
+//! it has the sign of `(f(s) − f(0))/s`, whose first zero is the form's
+//! return to the surface; so a mode that begins on its zero cannot end on
+//! the same zero, and a return within the step is still found.
+//!
+//! The cost is a Bernstein conversion per form and step (a few hundred
+//! multiplications for the 28-term series), skipped when the coefficients
+//! alone bound the form away from zero, and halvings only near a zero.
+
+/// Most coefficients a form may have.
+pub(crate) const MAX_COEFFS: usize = 32;
+
+/// Deepest halving of a step: a leaf is never narrower than 2⁻⁴⁰ of the
+/// step, so a search costs at most 40 halvings per root.
+const MAX_DEPTH: u32 = 40;
+
+/// A form over one step: `f(s) = Σ a_k s^k`, `s ∈ [0, 1]`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct StepForm {
+    a: [f64; MAX_COEFFS],
+    n: usize,
+}
+
+impl StepForm {
+    /// The form of coefficients `a` (in the step's own time `s`).
+    pub(crate) fn new(a: &[f64]) -> StepForm {
+        assert!(a.len() <= MAX_COEFFS && !a.is_empty());
+        let mut c = [0.0; MAX_COEFFS];
+        c[..a.len()].copy_from_slice(a);
+        StepForm { a: c, n: a.len() }
+    }
+
+    /// The form of the polynomial `Σ p_k τ^k` over `τ ∈ [0, h]`.
+    pub(crate) fn scaled(p: &[f64], h: f64) -> StepForm {
+        assert!(p.len() <= MAX_COEFFS && !p.is_empty());
+        let mut c = [0.0; MAX_COEFFS];
+        let mut hk = 1.0;
+        for (c, p) in c.iter_mut().zip(p) {
+            *c = p * hk;
+            hk *= h;
+        }
+        StepForm { a: c, n: p.len() }
+    }
+
+    /// `f(s)`, by Horner's rule.
+    #[cfg(test)]
+    fn value(&self, s: f64) -> f64 {
+        self.a[..self.n]
+            .iter()
+            .rev()
+            .fold(0.0, |acc, &c| acc * s + c)
+    }
+
+    fn magnitude(&self) -> f64 {
+        self.a[..self.n].iter().map(|c| c.abs()).sum()
+    }
+
+    /// A bound on the rounding of a value or Bernstein coefficient of the
+    /// form: a few units in the last place of its terms' magnitudes, for
+    /// each of the conversions' roughly `n` operations.
+    fn noise(&self) -> f64 {
+        (4.0 * self.n as f64 + 16.0) * f64::EPSILON * self.magnitude()
+    }
+
+    /// Whether the form starts on its zero: `|f(0)|` within its rounding.
+    fn starts_on_zero(&self) -> bool {
+        self.a[0].abs() <= self.noise()
+    }
+
+    /// `(f(s) − f(0))/s`: the sign of `f` for `s > 0` when `f(0) = 0`.
+    fn deflated(&self) -> StepForm {
+        let mut c = [0.0; MAX_COEFFS];
+        let n = (self.n - 1).max(1);
+        c[..self.n - 1].copy_from_slice(&self.a[1..self.n]);
+        StepForm { a: c, n }
+    }
+}
+
+/// How a guard combines its forms: the one form, or the larger or the
+/// smaller of two.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Combine {
+    One,
+    Max,
+    Min,
+}
+
+/// The sign of a form (or a guard) over an interval, as far as its
+/// Bernstein coefficients can show it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Sign {
+    Positive,
+    Negative,
+    Unknown,
+}
+
+impl Combine {
+    fn sign(self, signs: &[Sign]) -> Sign {
+        let all = |s: Sign| signs.iter().all(|&x| x == s);
+        let any = |s: Sign| signs.contains(&s);
+        match self {
+            Combine::One => signs[0],
+            Combine::Max if any(Sign::Positive) => Sign::Positive,
+            Combine::Max if all(Sign::Negative) => Sign::Negative,
+            Combine::Min if all(Sign::Positive) => Sign::Positive,
+            Combine::Min if any(Sign::Negative) => Sign::Negative,
+            _ => Sign::Unknown,
+        }
+    }
+
+    fn value(self, values: &[f64]) -> f64 {
+        match self {
+            Combine::One => values[0],
+            Combine::Max => values.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            Combine::Min => values.iter().copied().fold(f64::INFINITY, f64::min),
+        }
+    }
+}
+
+/// A form in Bernstein form on one interval of the step.
+#[derive(Clone, Copy)]
+struct Bernstein {
+    b: [f64; MAX_COEFFS],
+    n: usize,
+    noise: f64,
+}
+
+impl Bernstein {
+    /// The Bernstein form of `f` on `[0, 1]`:
+    /// `b_j = Σ_{k ≤ j} C(j, k)/C(d, k) a_k`, `d = n − 1`.
+    fn of(f: &StepForm) -> Bernstein {
+        let n = f.n;
+        let d = n - 1;
+        let mut b = [0.0; MAX_COEFFS];
+        // ratio(j, k) = C(j, k)/C(d, k), built along j for each k:
+        // ratio(k, k) = 1/C(d, k), ratio(j, k) = ratio(j−1, k)·j/(j−k).
+        let mut inv_binom = 1.0; // 1/C(d, k)
+        for k in 0..n {
+            if k > 0 {
+                inv_binom *= k as f64 / (d - k + 1) as f64;
+            }
+            let mut ratio = inv_binom;
+            b[k] += ratio * f.a[k];
+            for (j, bj) in b.iter_mut().enumerate().take(n).skip(k + 1) {
+                ratio *= j as f64 / (j - k) as f64;
+                *bj += ratio * f.a[k];
+            }
+        }
+        Bernstein {
+            b,
+            n,
+            noise: f.noise(),
+        }
+    }
+
+    fn sign(&self) -> Sign {
+        let b = &self.b[..self.n];
+        if b.iter().all(|&c| c > self.noise) {
+            Sign::Positive
+        } else if b.iter().all(|&c| c < -self.noise) {
+            Sign::Negative
+        } else {
+            Sign::Unknown
+        }
+    }
+
+    /// The form's value at the interval's start and end (exact in the
+    /// Bernstein form: the end coefficients).
+    fn ends(&self) -> (f64, f64) {
+        (self.b[0], self.b[self.n - 1])
+    }
+
+    /// The two halves (de Casteljau at ½).
+    fn split(&self) -> (Bernstein, Bernstein) {
+        let n = self.n;
+        let mut work = self.b;
+        let mut left = *self;
+        let mut right = *self;
+        left.b[0] = work[0];
+        right.b[n - 1] = work[n - 1];
+        for r in 1..n {
+            for j in 0..n - r {
+                work[j] = 0.5 * (work[j] + work[j + 1]);
+            }
+            left.b[r] = work[0];
+            right.b[n - 1 - r] = work[n - 1 - r];
+        }
+        (left, right)
+    }
+}
+
+/// The first zero of a guard over one step, as a bracket `[lo, hi]` in
+/// the step's own time: the guard is shown positive (or below the
+/// resolution) everywhere before `lo` and seen negative at `hi`. `None`:
+/// the guard stays positive over the whole step, but for excursions
+/// shorter than half of `resolution` (itself in units of the step).
+///
+/// `forms` are the guard's one or two forms, `combine` how they make it.
+pub(crate) fn first_zero(
+    forms: &[StepForm],
+    combine: Combine,
+    resolution: f64,
+) -> Option<(f64, f64)> {
+    debug_assert!(!forms.is_empty() && forms.len() <= 2);
+    if clearly_positive(forms, combine) {
+        return None;
+    }
+    let leaf = (0.25 * resolution).clamp(0.5f64.powi(MAX_DEPTH as i32), 1.0);
+    // Forms that start on their zero are searched as (f − f(0))/s. One
+    // that then starts falling (a graze) counts from where it has risen
+    // (`start`), or not at all when it does not rise in the step.
+    let mut used = [forms[0]; 2];
+    let mut start = [0.0f64; 2];
+    for (i, f) in forms.iter().enumerate() {
+        used[i] = *f;
+        if f.starts_on_zero() && f.n > 1 {
+            let q = f.deflated();
+            if q.a[0] <= 0.0 {
+                let mut negated = q;
+                negated.a.iter_mut().for_each(|c| *c = -*c);
+                start[i] = search_one(&negated, leaf).map_or(f64::INFINITY, |(_, hi)| hi);
+            }
+            used[i] = q;
+        }
+    }
+    let n = forms.len();
+    let (kept, from): (Vec<StepForm>, f64) = match combine {
+        // Both must be negative: a grazing form is not positive before it
+        // rises, so the other decides there.
+        Combine::Max => (used[..n].to_vec(), 0.0),
+        Combine::One | Combine::Min => {
+            let live: Vec<usize> = (0..n).filter(|&i| start[i] < 1.0).collect();
+            if live.is_empty() {
+                return None;
+            }
+            let from = live.iter().map(|&i| start[i]).fold(0.0, f64::max);
+            (live.iter().map(|&i| used[i]).collect(), from)
+        }
+    };
+    let combine = if kept.len() == 1 {
+        Combine::One
+    } else {
+        combine
+    };
+    let mut set = Forms {
+        b: [Bernstein::of(&kept[0]); 2],
+        n: kept.len(),
+    };
+    if kept.len() == 2 {
+        set.b[1] = Bernstein::of(&kept[1]);
+    }
+    search(&set, combine, (0.0, 1.0), leaf, from)
+}
+
+/// Whether the coefficients alone show the guard positive over the whole
+/// step (`f(s) ≥ a_0 − Σ_{k≥1} |a_k|`): the common step, far from every
+/// stop, costs no Bernstein form.
+pub(crate) fn clearly_positive(forms: &[StepForm], combine: Combine) -> bool {
+    let mut signs = [Sign::Unknown; 2];
+    for (sign, f) in signs.iter_mut().zip(forms) {
+        let spread: f64 = f.a[1..f.n].iter().map(|c| c.abs()).sum();
+        if f.a[0] - spread > f.noise() {
+            *sign = Sign::Positive;
+        }
+    }
+    combine.sign(&signs[..forms.len()]) == Sign::Positive
+}
+
+/// [`first_zero`] of one form alone.
+fn search_one(f: &StepForm, leaf: f64) -> Option<(f64, f64)> {
+    let set = Forms {
+        b: [Bernstein::of(f); 2],
+        n: 1,
+    };
+    search(&set, Combine::One, (0.0, 1.0), leaf, 0.0)
+}
+
+/// A guard's one or two forms in Bernstein form on one interval.
+#[derive(Clone, Copy)]
+struct Forms {
+    b: [Bernstein; 2],
+    n: usize,
+}
+
+impl Forms {
+    fn sign(&self, combine: Combine) -> Sign {
+        let signs = [self.b[0].sign(), self.b[1].sign()];
+        combine.sign(&signs[..self.n])
+    }
+
+    fn value_at_end(&self, combine: Combine) -> f64 {
+        let v = [self.b[0].ends().1, self.b[1].ends().1];
+        combine.value(&v[..self.n])
+    }
+
+    fn split(&self) -> (Forms, Forms) {
+        let (mut left, mut right) = (*self, *self);
+        for i in 0..self.n {
+            (left.b[i], right.b[i]) = self.b[i].split();
+        }
+        (left, right)
+    }
+}
+
+/// Depth-first, left half first, over `[lo, hi]`, ignoring zeros before
+/// `from`.
+fn search(
+    forms: &Forms,
+    combine: Combine,
+    (lo, hi): (f64, f64),
+    leaf: f64,
+    from: f64,
+) -> Option<(f64, f64)> {
+    if hi <= from || forms.sign(combine) == Sign::Positive {
+        return None;
+    }
+    let mid = 0.5 * (lo + hi);
+    let (left, right) = forms.split();
+    if hi - lo <= leaf {
+        if forms.value_at_end(combine) < 0.0 {
+            return Some((lo.max(from), hi));
+        }
+        if mid > from && left.value_at_end(combine) < 0.0 {
+            return Some((lo.max(from), mid));
+        }
+        return None;
+    }
+    search(&left, combine, (lo, mid), leaf, from)
+        .or_else(|| search(&right, combine, (mid, hi), leaf, from))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn product(roots: &[f64], scale: f64) -> StepForm {
+        let mut a = vec![scale];
+        for &r in roots {
+            let mut next = vec![0.0; a.len() + 1];
+            for (k, &c) in a.iter().enumerate() {
+                next[k + 1] += c;
+                next[k] -= r * c;
+            }
+            a = next;
+        }
+        StepForm::new(&a)
+    }
+
+    #[test]
+    fn bernstein_form_reproduces_the_polynomial() {
+        let f = StepForm::new(&[0.3, -2.0, 5.0, -1.0, 0.25, 3.0]);
+        let b = Bernstein::of(&f);
+        let d = f.n - 1;
+        for &s in &[0.0f64, 0.1, 0.37, 0.5, 0.93, 1.0] {
+            let mut v = 0.0;
+            let mut binom = 1.0;
+            for j in 0..=d {
+                if j > 0 {
+                    binom *= (d - j + 1) as f64 / j as f64;
+                }
+                v += b.b[j] * binom * s.powi(j as i32) * (1.0 - s).powi((d - j) as i32);
+            }
+            assert!(
+                (v - f.value(s)).abs() < 1e-13,
+                "at {s}: {v} against {}",
+                f.value(s)
+            );
+        }
+        let (l, r) = b.split();
+        assert!((l.ends().1 - f.value(0.5)).abs() < 1e-13);
+        assert!((r.ends().0 - f.value(0.5)).abs() < 1e-13);
+    }
+
+    #[test]
+    fn two_roots_a_hair_apart_are_found() {
+        // Positive at both ends, negative only on (0.4, 0.4 + 1e-5): a
+        // sampler at a few fixed points misses it.
+        let f = product(&[0.4, 0.4 + 1e-5, -0.5, -1.0], 1.0);
+        assert!(f.value(0.0) > 0.0 && f.value(1.0) > 0.0);
+        let (lo, hi) = first_zero(&[f], Combine::One, 1e-6).expect("the dip is found");
+        assert!(lo <= 0.4 + 1e-5 && hi >= 0.4 && hi - lo < 1e-6, "{lo} {hi}");
+    }
+
+    #[test]
+    fn a_form_that_starts_on_its_zero_and_returns_is_found() {
+        // f(0) = 0, rising, back through zero at 0.003.
+        let f = product(&[0.0, 0.003, 2.0], 1.0);
+        let (lo, hi) = first_zero(&[f], Combine::One, 1e-9).expect("the return is found");
+        assert!(lo <= 0.003 && (0.003..0.0031).contains(&hi), "{lo} {hi}");
+        // Without the return it stays open.
+        let g = product(&[0.0, 2.0], -1.0);
+        assert!(g.value(0.5) > 0.0);
+        assert_eq!(first_zero(&[g], Combine::One, 1e-9), None);
+    }
+
+    #[test]
+    fn a_positive_form_has_no_zero() {
+        let f = StepForm::new(&[1e-3, -4e-3, 4e-3 + 1e-6]);
+        // min at s = 0.5: 1e-3 − 2e-3 + 1e-3 + 2.5e-7 > 0.
+        assert_eq!(first_zero(&[f], Combine::One, 1e-12), None);
+    }
+
+    #[test]
+    fn max_needs_both_negative_and_min_either() {
+        let a = product(&[0.3], -1.0); // positive before 0.3
+        let b = product(&[0.6], -1.0); // positive before 0.6
+        let (_, hi) = first_zero(&[a, b], Combine::Max, 1e-9).unwrap();
+        assert!((hi - 0.6).abs() < 1e-9);
+        let (_, hi) = first_zero(&[a, b], Combine::Min, 1e-9).unwrap();
+        assert!((hi - 0.3).abs() < 1e-9);
+    }
+
+    #[test]
+    fn random_polynomials_agree_with_dense_sampling() {
+        // Against a sampler fine enough to see every excursion of these
+        // low-degree polynomials: the first negative sample is in the
+        // bracket, or at most one resolution after it.
+        let mut state = 0x9e3779b97f4a7c15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..400 {
+            let roots: Vec<f64> = (0..4).map(|_| next() * 1.4 - 0.2).collect();
+            let f = product(&roots, if next() < 0.5 { 1.0 } else { -1.0 });
+            if f.value(0.0) <= 0.0 {
+                continue;
+            }
+            let samples = 200_000;
+            let first = (1..=samples)
+                .map(|i| i as f64 / samples as f64)
+                .find(|&s| f.value(s) < 0.0);
+            let found = first_zero(&[f], Combine::One, 1e-7);
+            match (first, found) {
+                (None, None) => {}
+                (Some(s), Some((lo, hi))) => {
+                    assert!(
+                        lo <= s + 1e-12 && hi >= s - 1.0 / samples as f64 - 1e-7,
+                        "{s} in {lo}..{hi}"
+                    )
+                }
+                (a, b) => panic!("sampled {a:?}, located {b:?} for roots {roots:?}"),
+            }
+        }
+    }
+}

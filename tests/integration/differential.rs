@@ -1,0 +1,607 @@
+//! The two-stage engine against a brute-force reference over many seeded
+//! random relays.
+//!
+//! The reference is written here from the equations alone (docs/model.md,
+//! the two-stage relay) and shares no code with the engine: classical
+//! Runge–Kutta 4 at a fixed step of 1 ns, the event functions checked
+//! after every step and each event bisected by re-integrating its step to
+//! the bisection point (60 halvings). Families: a blade with and without
+//! a pole face, a contact released by position and by force,
+//! Kelvin–Voigt and Hunt–Crossley contact surfaces (n = 1 and 3/2), light
+//! and heavy armatures.
+//!
+//! Every relay must give the same sequence of contact and pole-face
+//! events, with every impact and release time within 1e-6 relative, and
+//! the same ending and settle time when `t_end` is doubled.
+//!
+//! `CHATTERSPICE_DIFFERENTIAL=N` sets the number of relays (1 000 by
+//! default); `CHATTERSPICE_DIFFERENTIAL_SEED=S` the first seed.
+//! `scripts/differential` runs 10⁵ of them, optimised, for a release.
+
+use chatterspice::mechanics::Drive;
+use chatterspice::mechanics::cycle::Stops;
+use chatterspice::mechanics::two_stage::{
+    Blade, Horizon, PoleFace, Release, TwoStage, TwoStageRun, simulate_two_stage,
+};
+use chatterspice::{Mechanics, Outcome, Settings, Surface};
+
+/// The reference's step, s.
+const STEP: f64 = 1e-9;
+
+/// A contact or pole-face law of the reference.
+#[derive(Debug, Clone, Copy)]
+enum Law {
+    /// F = s0 δ + r0 δ̇
+    Kv { s0: f64, r0: f64 },
+    /// F = max(0, k δⁿ (1 + χ δ̇))
+    Hc { k: f64, n: f64, chi: f64 },
+}
+
+impl Law {
+    fn force(&self, delta: f64, rate: f64) -> f64 {
+        match *self {
+            Law::Kv { s0, r0 } => s0 * delta + r0 * rate,
+            Law::Hc { k, n, chi } => (k * delta.max(0.0).powf(n) * (1.0 + chi * rate)).max(0.0),
+        }
+    }
+
+    /// Positive while the law pushes (the force rule's release).
+    fn pushing(&self, delta: f64, rate: f64) -> f64 {
+        match *self {
+            Law::Kv { s0, r0 } => s0 * delta + r0 * rate,
+            Law::Hc { chi, .. } => 1.0 + chi * rate,
+        }
+    }
+
+    fn surface(&self) -> Surface {
+        match *self {
+            Law::Kv { s0, r0 } => Surface::KelvinVoigt {
+                stiffness: s0,
+                damping: r0,
+            },
+            Law::Hc { k, n, chi } => Surface::HuntCrossley {
+                stiffness: k,
+                exponent: n,
+                chi,
+            },
+        }
+    }
+}
+
+/// One random relay.
+#[derive(Debug, Clone, Copy)]
+pub struct Relay {
+    m: f64,
+    s: f64,
+    r: f64,
+    f: f64,
+    g: f64,
+    mb: f64,
+    sb: f64,
+    rb: f64,
+    contact: Law,
+    contact_by_force: bool,
+    /// (overtravel, law, released by force)
+    pole: Option<(f64, Law, bool)>,
+}
+
+/// What happened, in order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Touch,
+    Release,
+    PoleTouch,
+    PoleRelease,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Ev {
+    t: f64,
+    kind: Kind,
+}
+
+type S = [f64; 4];
+
+/// `(M, k)`: the step `y ↦ M y + k`.
+type Affine = ([[f64; 4]; 4], S);
+
+impl Relay {
+    /// (ẋ_a, ẍ_a, ẋ_b, ẍ_b) in absolute positions from rest.
+    fn rate(&self, y: &S, contact: bool, pole: bool) -> S {
+        let fb = self.sb * (y[0] - y[2]) + self.rb * (y[1] - y[3]);
+        let fp = match (self.pole, pole) {
+            (Some((o, law, _)), true) => law.force(y[0] - self.g - o, y[1]),
+            _ => 0.0,
+        };
+        let fc = if contact {
+            self.contact.force(y[2] - self.g, y[3])
+        } else {
+            0.0
+        };
+        [
+            y[1],
+            (self.f - self.s * y[0] - self.r * y[1] - fb - fp) / self.m,
+            y[3],
+            (fb - fc) / self.mb,
+        ]
+    }
+
+    fn rk4(&self, y: &S, h: f64, c: bool, p: bool) -> S {
+        let add = |a: &S, k: &S, f: f64| {
+            [
+                a[0] + f * k[0],
+                a[1] + f * k[1],
+                a[2] + f * k[2],
+                a[3] + f * k[3],
+            ]
+        };
+        let k1 = self.rate(y, c, p);
+        let k2 = self.rate(&add(y, &k1, 0.5 * h), c, p);
+        let k3 = self.rate(&add(y, &k2, 0.5 * h), c, p);
+        let k4 = self.rate(&add(y, &k3, h), c, p);
+        let w = h / 6.0;
+        [0, 1, 2, 3].map(|i| y[i] + w * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]))
+    }
+
+    /// The event functions of the contact and the pole face, each
+    /// positive while its mode lasts.
+    fn guards(&self, y: &S, c: bool, p: bool) -> [f64; 2] {
+        let rule = |engaged: bool, by_force: bool, law: &Law, delta: f64, rate: f64| {
+            let push = law.pushing(delta, rate);
+            match (engaged, by_force) {
+                (false, false) => -delta,
+                (false, true) => (-delta).max(-push),
+                (true, false) => delta,
+                (true, true) => delta.min(push),
+            }
+        };
+        let contact = rule(c, self.contact_by_force, &self.contact, y[2] - self.g, y[3]);
+        let pole = match self.pole {
+            None => 1.0,
+            Some((o, law, by_force)) => rule(p, by_force, &law, y[0] - self.g - o, y[1]),
+        };
+        [contact, pole]
+    }
+
+    /// One RK4 step of [`STEP`] in modes `(c, p)` as `y ↦ M y + k`, when
+    /// the equations are linear there.
+    fn affine(&self, c: bool, p: bool, step: f64) -> Option<Affine> {
+        if c && matches!(self.contact, Law::Hc { .. }) {
+            return None;
+        }
+        let k = self.rk4(&[0.0; 4], step, c, p);
+        let mut m = [[0.0; 4]; 4];
+        for j in 0..4 {
+            let mut e = [0.0; 4];
+            e[j] = 1.0;
+            let col = self.rk4(&e, step, c, p);
+            for i in 0..4 {
+                m[i][j] = col[i] - k[i];
+            }
+        }
+        Some((m, k))
+    }
+
+    /// Every event up to `t_end`.
+    fn reference(&self, t_end: f64) -> Vec<Ev> {
+        self.reference_at(t_end, STEP)
+    }
+
+    fn reference_at(&self, t_end: f64, step: f64) -> Vec<Ev> {
+        let mut y: S = [0.0; 4];
+        let (mut c, mut p) = (false, false);
+        let mut t = 0.0;
+        let mut out = Vec::new();
+        // Where the equations are linear (every mode but a Hunt–Crossley
+        // contact engaged), one RK4 step is an affine map of the state:
+        // found once per mode from the step itself, applied as a product.
+        let mut maps: [Option<Option<Affine>>; 4] = [None; 4];
+        while t < t_end {
+            let key = usize::from(c) + 2 * usize::from(p);
+            let map = *maps[key].get_or_insert_with(|| self.affine(c, p, step));
+            let next = match map {
+                Some((m, k)) => std::array::from_fn(|i| {
+                    m[i][0] * y[0] + m[i][1] * y[1] + m[i][2] * y[2] + m[i][3] * y[3] + k[i]
+                }),
+                None => self.rk4(&y, step, c, p),
+            };
+            let gs = self.guards(&next, c, p);
+            if gs[0] >= 0.0 && gs[1] >= 0.0 {
+                y = next;
+                t += step;
+                continue;
+            }
+            let (mut lo, mut hi) = (0.0, step);
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                let g = self.guards(&self.rk4(&y, mid, c, p), c, p);
+                if g[0] < 0.0 || g[1] < 0.0 {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            y = self.rk4(&y, hi, c, p);
+            t += hi;
+            let g = self.guards(&y, c, p);
+            if g[0] < 0.0 {
+                out.push(Ev {
+                    t,
+                    kind: if c { Kind::Release } else { Kind::Touch },
+                });
+                c = !c;
+            }
+            if g[1] < 0.0 {
+                out.push(Ev {
+                    t,
+                    kind: if p {
+                        Kind::PoleRelease
+                    } else {
+                        Kind::PoleTouch
+                    },
+                });
+                p = !p;
+            }
+        }
+        out
+    }
+
+    fn mechanics(&self) -> Mechanics {
+        Mechanics {
+            mass: self.m,
+            stiffness: self.s,
+            damping: self.r,
+            force: self.f,
+            gap: self.g,
+            initial_position: 0.0,
+            initial_velocity: 0.0,
+            preload: 0.0,
+        }
+    }
+
+    fn build(&self) -> TwoStage {
+        let release = |force: bool| {
+            if force {
+                Release::Force
+            } else {
+                Release::Position
+            }
+        };
+        TwoStage {
+            blade: Some(Blade {
+                mass: self.mb,
+                stiffness: self.sb,
+                damping: self.rb,
+            }),
+            pole_face: self.pole.map(|(o, law, by_force)| PoleFace {
+                overtravel: o,
+                surface: law.surface(),
+                release: release(by_force),
+            }),
+            release: release(self.contact_by_force),
+        }
+    }
+
+    fn engine(&self, t_end: f64) -> Result<TwoStageRun, chatterspice::mechanics::DriveError> {
+        let stops = Stops {
+            make: self.contact.surface(),
+            back: None,
+        };
+        let settings = Settings {
+            t_end,
+            ..Settings::default()
+        };
+        simulate_two_stage(
+            &self.mechanics(),
+            &self.build(),
+            &stops,
+            &settings,
+            Drive::Step,
+            Horizon::Closing,
+        )
+    }
+}
+
+/// A small, seeded generator (xorshift64*), so that a failure names the
+/// seed that reproduces it.
+struct Draw(u64);
+
+impl Draw {
+    fn new(seed: u64) -> Draw {
+        Draw(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
+    }
+
+    fn unit(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.unit()
+    }
+
+    fn log(&mut self, lo: f64, hi: f64) -> f64 {
+        (lo.ln() + (hi.ln() - lo.ln()) * self.unit()).exp()
+    }
+}
+
+/// The relay of `seed`: its family from the seed's low bits (pole face or
+/// not, release rule, surface law, light or heavy armature), the numbers
+/// from ranges around small signal and power relays.
+pub fn relay(seed: u64) -> Relay {
+    let mut d = Draw::new(seed);
+    let pole = seed & 1 == 1;
+    let by_force = seed & 2 == 2;
+    let hunt_crossley = seed & 4 == 4;
+    let heavy = seed & 8 == 8;
+    let m = if heavy {
+        d.log(3e-4, 1e-3)
+    } else {
+        d.log(3e-5, 1.5e-4)
+    };
+    let omega = d.uniform(3000.0, 9000.0);
+    let s = m * omega * omega;
+    let r = 2.0 * d.uniform(0.01, 0.1) * (m * s).sqrt();
+    let g = d.uniform(1e-4, 5e-4);
+    let mb = d.log(1e-5, 5e-5);
+    let sb = d.uniform(1000.0, 4000.0);
+    let rb = d.uniform(0.0, 0.01);
+    let contact = if hunt_crossley {
+        let n = if d.unit() < 0.5 { 1.0 } else { 1.5 };
+        // The stiffness at a 1 µm penetration between 2e5 and 2e6 N/m.
+        let k = d.log(2e5, 2e6) * 1e-6f64.powf(1.0 - n);
+        Law::Hc {
+            k,
+            n,
+            chi: d.uniform(0.05, 0.5),
+        }
+    } else {
+        Law::Kv {
+            s0: d.log(2e5, 2e6),
+            r0: d.uniform(0.5, 3.0),
+        }
+    };
+    let o = d.uniform(1e-4, 3e-4);
+    let pole_law = Law::Kv {
+        s0: d.log(1e6, 5e6),
+        r0: d.uniform(1.0, 5.0),
+    };
+    let load = if pole { s * (g + o) + sb * o } else { s * g };
+    let f = load * d.uniform(1.3, 2.5);
+    Relay {
+        m,
+        s,
+        r,
+        f,
+        g,
+        mb,
+        sb,
+        rb,
+        contact,
+        contact_by_force: by_force,
+        pole: pole.then_some((o, pole_law, d.unit() < 0.3)),
+    }
+}
+
+/// The engine's events of `run` up to `horizon`, in time order.
+fn engine_events(run: &TwoStageRun, horizon: f64) -> Vec<Ev> {
+    let mut out = Vec::new();
+    let mut add = |impacts: &[chatterspice::Impact], touch: Kind, release: Kind| {
+        for i in impacts {
+            out.push(Ev {
+                t: i.impact_time,
+                kind: touch,
+            });
+            if let Some(t) = i.release_time {
+                out.push(Ev { t, kind: release });
+            }
+        }
+    };
+    add(&run.contact.impacts, Kind::Touch, Kind::Release);
+    add(&run.pole_face, Kind::PoleTouch, Kind::PoleRelease);
+    out.retain(|e| e.t <= horizon);
+    out.sort_by(|a, b| a.t.total_cmp(&b.t));
+    out
+}
+
+/// Compare the engine with the reference on the relay of `seed`: `Ok` with
+/// the number of contact events, or what differed.
+pub fn compare(seed: u64) -> Result<usize, String> {
+    let relay = relay(seed);
+    let t_end = 0.02;
+    let run = relay
+        .engine(t_end)
+        .map_err(|e| format!("seed {seed}: the engine failed: {e}\n{relay:?}"))?;
+    let contact_events = engine_events(&run, f64::INFINITY);
+    let last = contact_events.last().map_or(0.0, |e| e.t);
+    let settle = run.contact.settle_time.unwrap_or(last).max(last);
+    // The reference goes on past the engine's last event: a contact event
+    // there would be one the engine's ending said could not happen.
+    let horizon = (settle * 1.1 + 3e-4).min(t_end);
+    let reference = relay.reference(horizon);
+    let engine = engine_events(&run, horizon);
+    // The engine stops at its ending; the pole face may still move after
+    // it: compare contact events over the whole horizon, pole-face events
+    // up to the engine's ending.
+    let keep =
+        |e: &Ev| matches!(e.kind, Kind::Touch | Kind::Release) || e.t <= settle * (1.0 + 1e-6);
+    let reference: Vec<Ev> = reference.into_iter().filter(keep).collect();
+    let engine: Vec<Ev> = engine.into_iter().filter(keep).collect();
+    let kinds = |v: &[Ev]| v.iter().map(|e| e.kind).collect::<Vec<_>>();
+    let describe = || {
+        let list = |v: &[Ev]| {
+            v.iter()
+                .map(|e| format!("{:?}@{:.9e}", e.kind, e.t))
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
+        format!(
+            "seed {seed}: {relay:?}\n  ending {:?}, settle {:?}\n  engine    {}\n  reference {}",
+            run.contact.outcome,
+            run.contact.settle_time,
+            list(&engine),
+            list(&reference)
+        )
+    };
+    if kinds(&engine) != kinds(&reference) {
+        return Err(format!("the sequences differ\n{}", describe()));
+    }
+    // Where a time differs by more than 1e-6, the reference is run again
+    // at a quarter of its step: in a long chaotic sequence (a hundred
+    // impacts of a light armature on a Hertz contact) the 1 ns reference
+    // itself can be off by more than that. The engine must then agree with
+    // the finer reference to 1e-6 plus the coarse one's own error.
+    let mut finer: Option<Vec<Ev>> = None;
+    for (k, (a, b)) in engine.iter().zip(&reference).enumerate() {
+        let off = (a.t - b.t).abs();
+        let within = off <= 1e-6 * b.t.abs() || {
+            let fine = finer.get_or_insert_with(|| {
+                relay
+                    .reference_at(horizon, STEP / 4.0)
+                    .into_iter()
+                    .filter(keep)
+                    .collect()
+            });
+            fine.get(k).is_some_and(|f| {
+                f.kind == a.kind && (a.t - f.t).abs() <= 1e-6 * f.t.abs() + 2.0 * (b.t - f.t).abs()
+            })
+        };
+        if !within {
+            return Err(format!(
+                "{:?} at {:e} against {:e} ({:.1e} relative)\n{}",
+                a.kind,
+                a.t,
+                b.t,
+                (a.t - b.t).abs() / b.t,
+                describe()
+            ));
+        }
+    }
+    // The ending does not depend on how long the run was allowed: the
+    // same with `t_end` doubled, unless the longer run's contact was still
+    // moving at the first one's end.
+    let longer = relay
+        .engine(2.0 * t_end)
+        .map_err(|e| format!("seed {seed}, t_end doubled: {e}"))?;
+    let moving_at_end = longer
+        .contact
+        .impacts
+        .iter()
+        .any(|i| i.impact_time > t_end || i.release_time.is_some_and(|r| r > t_end));
+    let same = longer.contact.outcome == run.contact.outcome
+        && longer.contact.settle_time == run.contact.settle_time;
+    let honest = moving_at_end && run.contact.outcome == Outcome::EndOfTime;
+    if !same && !honest {
+        return Err(format!(
+            "doubling t_end changed the ending: {:?} {:?} against {:?} {:?}\n{}",
+            longer.contact.outcome,
+            longer.contact.settle_time,
+            run.contact.outcome,
+            run.contact.settle_time,
+            describe()
+        ));
+    }
+    Ok(run.contact.impacts.len())
+}
+
+fn count() -> u64 {
+    std::env::var("CHATTERSPICE_DIFFERENTIAL")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(1000)
+}
+
+fn first_seed() -> u64 {
+    std::env::var("CHATTERSPICE_DIFFERENTIAL_SEED")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(1)
+}
+
+#[test]
+fn the_engine_agrees_with_a_brute_force_reference_on_random_relays() {
+    let (n, first) = (count(), first_seed());
+    let threads = std::thread::available_parallelism()
+        .map_or(2, |n| n.get())
+        .min(8) as u64;
+    let failures: Vec<String> = std::thread::scope(|scope| {
+        let workers: Vec<_> = (0..threads)
+            .map(|w| {
+                scope.spawn(move || {
+                    let mut bad = Vec::new();
+                    let mut contacts = 0;
+                    for seed in (first + w..first + n).step_by(threads as usize) {
+                        match compare(seed) {
+                            Ok(c) => contacts += c,
+                            Err(e) => bad.push(e),
+                        }
+                    }
+                    (bad, contacts)
+                })
+            })
+            .collect();
+        let mut all = Vec::new();
+        let mut contacts = 0;
+        for w in workers {
+            let (bad, c) = w.join().expect("a worker panicked");
+            all.extend(bad);
+            contacts += c;
+        }
+        // Most relays bounce: the comparison is not of empty sequences.
+        assert!(
+            contacts as u64 > 2 * n,
+            "{contacts} contacts over {n} relays"
+        );
+        all
+    });
+    assert!(
+        failures.is_empty(),
+        "{} of {n} relays disagree:\n{}\n\nthe first in full:\n{}",
+        failures.len(),
+        failures
+            .iter()
+            .map(|f| f.lines().take(2).collect::<Vec<_>>().join(" | "))
+            .collect::<Vec<_>>()
+            .join("\n"),
+        failures[0]
+    );
+}
+
+/// The bundled two-stage example released by position with a 3 200 N/m
+/// blade: the case that once stepped over a 4 µs re-closure.
+#[test]
+fn the_bundled_example_released_by_position_agrees_with_the_reference() {
+    let relay = Relay {
+        m: 1.0e-4,
+        s: 5000.0,
+        r: 0.07,
+        f: 1.0,
+        g: 1.4e-4,
+        mb: 2.0e-5,
+        sb: 3200.0,
+        rb: 0.005,
+        contact: Law::Kv { s0: 5.0e5, r0: 0.3 },
+        contact_by_force: false,
+        pole: Some((1.0e-4, Law::Kv { s0: 2.0e6, r0: 2.0 }, false)),
+    };
+    let run = relay.engine(0.02).unwrap();
+    let settle = run.contact.settle_time.expect("it settles");
+    let reference = relay.reference(settle + 3e-4);
+    let touches: Vec<&Ev> = reference.iter().filter(|e| e.kind == Kind::Touch).collect();
+    assert_eq!(run.contact.impacts.len(), touches.len(), "contacts");
+    for (i, r) in run.contact.impacts.iter().zip(&touches) {
+        assert!(
+            i.impact_velocity > 0.0,
+            "an impact at {} approaches backwards",
+            i.impact_time
+        );
+        assert!(
+            (i.impact_time - r.t).abs() <= 1e-6 * r.t,
+            "{} against {}",
+            i.impact_time,
+            r.t
+        );
+    }
+}
