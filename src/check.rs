@@ -100,6 +100,27 @@ impl LimitCheck {
             note,
         }
     }
+
+    /// A count held to at most `limit`, with a note: how an envelope says
+    /// that some of its relays were not evaluated.
+    pub(crate) fn count_at_most(
+        key: String,
+        quantity: String,
+        limit: usize,
+        actual: usize,
+        note: String,
+    ) -> LimitCheck {
+        let mut check = LimitCheck::new(
+            key,
+            quantity,
+            "",
+            Bound::Max,
+            limit as f64,
+            Ok(actual as f64),
+        );
+        check.note = Some(note);
+        check
+    }
 }
 
 /// Every limit of a scenario, checked.

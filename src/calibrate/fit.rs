@@ -511,10 +511,34 @@ pub fn model_events(s: &Scenario, voltage: Option<f64>) -> Result<Vec<Event>, St
 
 /// The datasheet figures of scenario `s` (which has a coil), computed as
 /// a datasheet measures them; `None` for a figure the relay does not
-/// show (it never closes, say).
+/// show (it never closes, say, or its closing cannot be simulated: see
+/// [`datasheet_figures_or_failure`]).
 pub fn datasheet_figures(s: &Scenario, d: &DatasheetSection) -> Vec<(&'static str, Option<f64>)> {
+    figures_and_failure(s, d).0
+}
+
+/// [`datasheet_figures`], or why the relay's closing on the datasheet's
+/// DC step cannot be simulated (the engine's own words).
+pub fn datasheet_figures_or_failure(
+    s: &Scenario,
+    d: &DatasheetSection,
+) -> Result<Vec<(&'static str, Option<f64>)>, String> {
+    match figures_and_failure(s, d) {
+        (_, Some(failure)) => Err(failure),
+        (figures, None) => Ok(figures),
+    }
+}
+
+/// The figures, each `None` that the closing gives when it cannot be
+/// simulated, and why it cannot.
+type FiguresAndFailure = (Vec<(&'static str, Option<f64>)>, Option<String>);
+
+fn figures_and_failure(s: &Scenario, d: &DatasheetSection) -> FiguresAndFailure {
     let Some(section) = &s.coil else {
-        return d.figures().into_iter().map(|(n, _)| (n, None)).collect();
+        return (
+            d.figures().into_iter().map(|(n, _)| (n, None)).collect(),
+            None,
+        );
     };
     let coil = Coil::from(section);
     let m = s.armature();
@@ -533,10 +557,12 @@ pub fn datasheet_figures(s: &Scenario, d: &DatasheetSection) -> Vec<(&'static st
             &s.surface(),
             &s.settings(),
         )
-        .ok()
+        .map_err(|e| e.to_string())
         .map(|(chatter, _)| chatter),
-        _ => None,
+        _ => Err(String::new()),
     };
+    let failure = closing.as_ref().err().filter(|e| !e.is_empty()).cloned();
+    let closing = closing.ok();
     let operate = closing.as_ref().and_then(|c| c.first_impact);
     let settle = closing.as_ref().and_then(|c| c.settle_time);
     let mut out = Vec::new();
@@ -555,7 +581,7 @@ pub fn datasheet_figures(s: &Scenario, d: &DatasheetSection) -> Vec<(&'static st
         };
         out.push((name, value));
     }
-    out
+    (out, failure)
 }
 
 /// The pick-up of scenario `s` over its whole load line, with that line;

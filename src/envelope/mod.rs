@@ -17,7 +17,7 @@ mod render;
 mod report;
 
 pub use render::{band_table, json_with_envelope};
-pub use report::{Band, EnvelopeReport, WorstRelay};
+pub use report::{Band, EnvelopeReport, FailedRelay, WorstRelay};
 
 use std::collections::BTreeMap;
 use std::num::NonZeroUsize;
@@ -28,14 +28,15 @@ use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::{Rng, SeedableRng};
 use thiserror::Error;
 
-use crate::calibrate::fit::datasheet_figures;
+use crate::calibrate::fit::{datasheet_figures, datasheet_figures_or_failure};
 use crate::chatter::Chatter;
 use crate::check::{self, Evidence, LimitCheck, Verdict};
 use crate::coil::timing::Closing;
 use crate::pipeline::{self, RunOptions, RunResult};
 use crate::plan::Plan;
-use crate::scenario::{EnvelopeRange, Scenario, ScenarioError};
+use crate::scenario::{DatasheetSection, EnvelopeRange, Scenario, ScenarioError};
 use crate::spice::Runner;
+use crate::sweep::run::one_line;
 use gather::Gather;
 
 /// How to sample an envelope.
@@ -283,29 +284,48 @@ pub fn run(
     let mut outcomes = outcomes.into_inner().unwrap_or_else(|e| e.into_inner());
     outcomes.sort_by_key(|(i, _)| *i);
     let mut rejected: BTreeMap<String, usize> = BTreeMap::new();
+    let mut failures = Vec::new();
     let mut kept = Vec::new();
-    for (_, outcome) in outcomes {
+    for (index, outcome) in outcomes {
         match outcome {
             Ok(k) => kept.push(k),
-            Err(reasons) => {
-                for r in reasons {
-                    *rejected.entry(r).or_default() += 1;
+            Err(NotKept::Rejected(figures)) => {
+                for r in figures {
+                    *rejected.entry(r.to_owned()).or_default() += 1;
                 }
             }
+            Err(NotKept::Failed(reason)) => failures.push(FailedRelay {
+                index,
+                values: draw
+                    .keys
+                    .iter()
+                    .cloned()
+                    .zip(draw.relays[index].iter().copied())
+                    .collect(),
+                reason,
+            }),
         }
     }
+    let rejected_relays = draw.relays.len() - kept.len() - failures.len();
     if kept.is_empty() {
+        let mut reasons: Vec<String> = rejected.iter().map(|(k, n)| format!("{k}: {n}")).collect();
+        if let Some(f) = failures.first() {
+            reasons.push(format!(
+                "{} not evaluated, the first because {}",
+                failures.len(),
+                f.reason
+            ));
+        }
         return Err(EnvelopeError::NoneKept {
             path: scenario.origin.clone(),
             samples: draw.relays.len(),
-            reasons: rejected
-                .iter()
-                .map(|(k, n)| format!("{k}: {n}"))
-                .collect::<Vec<_>>()
-                .join(", "),
+            reasons: reasons.join(", "),
         });
     }
-    let (verdict, worst) = worst_case(&kept);
+    let (mut verdict, worst) = worst_case(&kept);
+    if !failures.is_empty() {
+        verdict = not_evaluated(verdict, &failures);
+    }
     let mut names: Vec<&String> = kept.iter().flat_map(|k| k.quantities.keys()).collect();
     names.sort();
     names.dedup();
@@ -329,7 +349,10 @@ pub fn run(
     let report = EnvelopeReport {
         samples: draw.relays.len(),
         kept: kept.len(),
+        rejected_relays,
         rejected,
+        failed: failures.len(),
+        failures,
         source: scenario.envelope.as_ref().and_then(|e| e.source.clone()),
         ranges: draw.keys.iter().cloned().zip(draw.ranges).collect(),
         quantities,
@@ -346,9 +369,42 @@ pub fn run(
 /// its start-up is paid once for them.
 const RELAYS_PER_PROCESS: usize = 16;
 
-/// A relay's place in the draw, and what became of it: kept, or the
-/// reasons it was not.
-type Outcome = (usize, Result<Kept, Vec<String>>);
+/// A relay's place in the draw, and what became of it.
+type Outcome = (usize, Result<Kept, NotKept>);
+
+/// Why a sampled relay is not among the kept ones.
+#[derive(Debug)]
+enum NotKept {
+    /// It misses these printed figures: a relay the datasheet excludes.
+    Rejected(Vec<&'static str>),
+    /// It could not be simulated: never a relay the datasheet excludes,
+    /// so a check over the envelope cannot pass with it.
+    Failed(String),
+}
+
+/// The verdict of `kept`'s worst relays, with one more check that fails:
+/// the relays not evaluated, the first reasons in its note.
+fn not_evaluated(verdict: Verdict, failures: &[FailedRelay]) -> Verdict {
+    let mut checks = verdict.checks;
+    let reasons: Vec<String> = failures
+        .iter()
+        .take(3)
+        .map(|f| format!("relay {}: {}", f.index, f.reason))
+        .collect();
+    checks.push(LimitCheck::count_at_most(
+        "envelope".to_owned(),
+        "relays not evaluated".to_owned(),
+        0,
+        failures.len(),
+        format!(
+            "{} relay{} of the envelope could not be simulated; {}",
+            failures.len(),
+            if failures.len() == 1 { "" } else { "s" },
+            reasons.join("; ")
+        ),
+    ));
+    Verdict::new(checks)
+}
 
 /// One sampled relay: set its values, screen it against the datasheet,
 /// run it. `Err` carries the reasons it was not kept.
@@ -359,19 +415,21 @@ fn relay(
     index: usize,
     runner: Option<&dyn Runner>,
     options: &RunOptions,
-) -> Result<Kept, Vec<String>> {
+) -> Result<Kept, NotKept> {
     let pairs: Vec<(&str, f64)> = keys
         .iter()
         .map(String::as_str)
         .zip(values.iter().copied())
         .collect();
-    if plan.renumber(&pairs).is_err() {
-        return Err(vec!["invalid".to_owned()]);
+    if let Err(e) = plan.renumber(&pairs) {
+        return Err(NotKept::Failed(format!(
+            "the model refuses its values: {e}"
+        )));
     }
     let scenario = plan.scenario();
-    let missed = screen(scenario);
+    let missed = screen_or_failure(scenario).map_err(NotKept::Failed)?;
     if !missed.is_empty() {
-        return Err(missed.into_iter().map(str::to_owned).collect());
+        return Err(NotKept::Rejected(missed));
     }
     let (verdict, evidence) = match runner {
         Some(runner) => match pipeline::run_plan(plan, runner, options) {
@@ -379,11 +437,11 @@ fn relay(
                 check::evaluate(scenario, &result),
                 Evidence::Run(Box::new(result)),
             ),
-            Err(_) => return Err(vec!["failed".to_owned()]),
+            Err(e) => return Err(NotKept::Failed(one_line(&e))),
         },
         None => match check::relay_only(scenario) {
             Ok(found) => found,
-            Err(_) => return Err(vec!["failed".to_owned()]),
+            Err(e) => return Err(NotKept::Failed(one_line(&e))),
         },
     };
     Ok(Kept {
@@ -404,7 +462,20 @@ pub fn screen(scenario: &Scenario) -> Vec<&'static str> {
     let (Some(d), Some(_)) = (&scenario.datasheet, &scenario.coil) else {
         return Vec::new();
     };
-    let model = datasheet_figures(scenario, d);
+    missed(d, datasheet_figures(scenario, d))
+}
+
+/// [`screen`], or why the relay's closing on the datasheet's DC step
+/// cannot be simulated: such a relay is not one the datasheet excludes.
+pub fn screen_or_failure(scenario: &Scenario) -> Result<Vec<&'static str>, String> {
+    let (Some(d), Some(_)) = (&scenario.datasheet, &scenario.coil) else {
+        return Ok(Vec::new());
+    };
+    Ok(missed(d, datasheet_figures_or_failure(scenario, d)?))
+}
+
+/// The bounding figures of `d` that the modelled values miss.
+fn missed(d: &DatasheetSection, model: Vec<(&'static str, Option<f64>)>) -> Vec<&'static str> {
     d.figures()
         .into_iter()
         .zip(model)

@@ -30,21 +30,48 @@ fn value(v: f64, unit: &str) -> String {
 /// quantity's band, and the worst relay's values.
 pub fn band_table(report: &EnvelopeReport) -> String {
     let mut out = String::new();
-    let rejected: usize = report.samples - report.kept;
     let _ = write!(
         out,
         "envelope: {} of {} relays kept",
         report.kept, report.samples
     );
-    if rejected > 0 {
+    if report.rejected_relays > 0 {
         let reasons: Vec<String> = report
             .rejected
             .iter()
             .map(|(k, n)| format!("{k} {n}"))
             .collect();
-        let _ = write!(out, "; rejected {rejected} ({})", reasons.join(", "));
+        let _ = write!(
+            out,
+            "; {} rejected by the datasheet (missed: {}{})",
+            report.rejected_relays,
+            reasons.join(", "),
+            if reasons.len() > 1 {
+                "; a relay that misses several figures counts under each"
+            } else {
+                ""
+            }
+        );
     }
     let _ = writeln!(out);
+    if report.failed > 0 {
+        let _ = writeln!(
+            out,
+            "NOT EVALUATED: {} relay{} could not be simulated (a check over this envelope fails):",
+            report.failed,
+            if report.failed == 1 { "" } else { "s" }
+        );
+        for f in report.failures.iter().take(5) {
+            let _ = writeln!(out, "  relay {}: {}", f.index, f.reason);
+        }
+        if report.failures.len() > 5 {
+            let _ = writeln!(
+                out,
+                "  … and {} more (see the JSON's envelope.failures)",
+                report.failures.len() - 5
+            );
+        }
+    }
     if let Some(source) = &report.source {
         let _ = writeln!(out, "ranges: {source}");
     }

@@ -47,6 +47,17 @@ pub struct WorstRelay {
     pub limit: Option<String>,
 }
 
+/// A sampled relay that could not be simulated.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FailedRelay {
+    /// Its index in the draw, from 0.
+    pub index: usize,
+    /// Its sampled values, by key.
+    pub values: BTreeMap<String, f64>,
+    /// Why: the engine's or the circuit run's own words.
+    pub reason: String,
+}
+
 /// What an envelope gave.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct EnvelopeReport {
@@ -54,10 +65,19 @@ pub struct EnvelopeReport {
     pub samples: usize,
     /// Relays that met every printed figure and ran.
     pub kept: usize,
-    /// Relays rejected, by the figure they missed (`operate_time`, …; a
-    /// relay that misses several counts under each), `invalid` for values
-    /// the model refuses and `failed` for a run that failed.
+    /// Relays the datasheet excludes: they miss at least one printed
+    /// figure.
+    pub rejected_relays: usize,
+    /// The rejections by the figure missed (`operate_time`, …): a relay
+    /// that misses several figures counts under each, so these can add up
+    /// to more than `rejected_relays`.
     pub rejected: BTreeMap<String, usize>,
+    /// Relays that could not be simulated. They are not rejections (the
+    /// datasheet does not exclude them): a check over an envelope with any
+    /// fails ("relays not evaluated").
+    pub failed: usize,
+    /// Each relay that could not be simulated, with its values and why.
+    pub failures: Vec<FailedRelay>,
     /// Where the ranges come from (`[envelope] source`).
     pub source: Option<String>,
     /// What was sampled: each key's range (a printed tolerance included).

@@ -95,6 +95,23 @@ pub enum DriveError {
     /// What the mechanics engine itself failed on.
     #[error(transparent)]
     Mechanics(#[from] MechanicsError),
+    /// The engine's answer breaks what physics guarantees (an impact that
+    /// approaches backwards, energy from nowhere, an opening wider than
+    /// the energy allows): an error of the engine, reported instead of a
+    /// result.
+    #[error(
+        "the simulated motion breaks the physics at t = {time:.6e} s: {what}; the relay: {relay}. \
+         This is a defect of chatterspice's engine, not of your scenario: please report it with \
+         the scenario"
+    )]
+    Impossible {
+        /// s, where it was seen.
+        time: f64,
+        /// What broke, with the numbers.
+        what: String,
+        /// The relay's keys and values.
+        relay: String,
+    },
     /// The armature pressed through the contact to the magnet's pole face.
     #[error(
         "the armature reached the pole face (x = {position} m ≥ `coil.air_gap` = {pole} m) \

@@ -123,3 +123,55 @@ fn an_envelope_that_is_a_point_is_refused_before_anything_runs() {
     let err = refused(dir.path(), "\"surface.dampnig\" = { min = 1.0, max = 2.0 }");
     assert!(err.contains("surface.dampnig"), "{err}");
 }
+
+/// A relay of the envelope that cannot be simulated is named, with its
+/// reason, and counted apart from the datasheet's rejections; a check over
+/// such an envelope cannot pass.
+#[test]
+fn relays_that_cannot_be_simulated_are_named_and_fail_the_check() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("soft.toml");
+    // Contacts down to 50 N/m: the magnet pulls the softest through to
+    // its pole, which the model cannot go past.
+    std::fs::write(
+        &path,
+        "base = \"part:te-axicom-im-5v\"\n\n[limits]\nmax_bounces = 100\n\n\
+         [envelope.\"surface.stiffness\"]\nmin = 50.0\nmax = 5e6\nlog = true\n",
+    )
+    .unwrap();
+    let doc = check_envelope(path.to_str().unwrap(), &[], 1);
+    let env = &doc["envelope"];
+    let failed = env["failed"].as_u64().unwrap();
+    assert!(failed > 0 && failed < 32, "{env}");
+    assert_eq!(env["failures"].as_array().unwrap().len() as u64, failed);
+    let first = &env["failures"][0];
+    assert!(
+        first["reason"].as_str().unwrap().contains("pole"),
+        "{first}"
+    );
+    assert!(
+        first["values"]["surface.stiffness"].as_f64().unwrap() < 5e5,
+        "{first}"
+    );
+    // Not rejections: the datasheet does not exclude them.
+    let kept = env["kept"].as_u64().unwrap();
+    let rejected = env["rejected_relays"].as_u64().unwrap();
+    assert_eq!(kept + rejected + failed, 32, "{env}");
+    assert!(env["rejected"].get("failed").is_none(), "{env}");
+    let check = doc["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["quantity"] == "relays not evaluated")
+        .expect("the check says so");
+    assert_eq!(check["passed"], false);
+    assert_eq!(check["actual"].as_f64(), Some(failed as f64));
+    // Its own envelope, where every relay simulates, passes.
+    std::fs::write(
+        &path,
+        "base = \"part:te-axicom-im-5v\"\n\n[limits]\nmax_bounces = 100\n",
+    )
+    .unwrap();
+    let doc = check_envelope(path.to_str().unwrap(), &[], 0);
+    assert_eq!(doc["envelope"]["failed"], 0);
+}

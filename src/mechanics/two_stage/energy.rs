@@ -255,6 +255,47 @@ fn golden(f: impl Fn(f64) -> f64, lo: f64, hi: f64) -> (f64, f64) {
         .fold((c, fc), |best, p| if p.1 < best.1 { p } else { best })
 }
 
+/// J, the total energy of state `y` under a constant force (the force's
+/// work folded into the potential), or `None` under a drive that varies.
+/// It never grows when every stop is released by position (every damper
+/// and surface dissipates); an event where it has grown is an engine
+/// error, never a result.
+pub(crate) fn step_energy<D: DriveModel>(model: &RelayModel<'_, D>, y: &Y) -> Option<f64> {
+    model.drive.constant()?;
+    Some(Frozen::at(model, 0.0, y).energy(y))
+}
+
+/// m, the widest opening of the contact that energy `j` allows under a
+/// constant force: the contact point cannot go back past the least `x_b`
+/// at which the least potential over the armature, `min V(·, x_b)`, is at
+/// most `j`. The pole face is left out (it only adds energy), so the bound
+/// is loose but never wrong.
+pub(crate) fn widest_opening<D: DriveModel>(model: &RelayModel<'_, D>, j: f64) -> Option<f64> {
+    let force = model.drive.constant()?;
+    let m = model.m;
+    let net = force - m.preload;
+    let s = m.stiffness;
+    // min over x_a of ½ s x_a² − net x_a + ½ s_b (x_a − x_b)²: a quadratic
+    // a x_b² + b x_b + c in x_b (with no blade, ½ s x² − net x itself).
+    let (a, b, c) = match &model.build.blade {
+        Some(blade) => {
+            let sb = blade.stiffness;
+            (
+                0.5 * sb * s / (s + sb),
+                -net * sb / (s + sb),
+                -net * net / (2.0 * (s + sb)),
+            )
+        }
+        None => (0.5 * s, -net, 0.0),
+    };
+    let disc = b * b - 4.0 * a * (c - j);
+    if disc < 0.0 {
+        return Some(0.0);
+    }
+    let back = (-b - disc.sqrt()) / (2.0 * a);
+    Some((m.gap - back).max(0.0))
+}
+
 #[cfg(test)]
 mod tests {
     use super::golden;

@@ -15,6 +15,7 @@
 //! function to turn negative is bisected on the interpolant down to
 //! adjacent floats. At the event the state is set exactly on the surface
 //! and the integrator restarts in the new mode.
+use super::energy::widest_opening;
 use super::linear::{LinearSystem, propagate};
 use super::model::{RelayModel, StopMode, StopModes, Which, Y, law};
 use super::propagation::{Propagation, Tally, decided, finish, start};
@@ -130,10 +131,62 @@ pub(crate) fn run_relay<D: DriveModel>(
 ) -> Result<TwoStageRun, DriveError> {
     let mut progress = start(model, e0);
     advance(model, settings, horizon, &mut progress)?;
+    if let Some((time, what)) = broken(model, &progress) {
+        return Err(DriveError::Impossible {
+            time,
+            what,
+            relay: describe(model),
+        });
+    }
     if horizon == Horizon::Closing {
         prove_ending(model, settings, &mut progress);
     }
     Ok(finish(model, settings, horizon, progress))
+}
+
+/// The first invariant `p` broke: one its events saw, or an opening wider
+/// than the energy at the start allows (a constant force, every stop
+/// released by position).
+fn broken<D: DriveModel>(model: &RelayModel<'_, D>, p: &Propagation) -> Option<(f64, String)> {
+    if p.violation.is_some() {
+        return p.violation.clone();
+    }
+    let widest = widest_opening(model, p.energy0?)?;
+    p.rec.openings().find_map(|(t, opening)| {
+        (opening > widest * (1.0 + 1e-6) + 1e-12).then(|| {
+            (
+                t,
+                format!(
+                    "an opening of {opening:e} m after the release at {t:e} s, where the energy \
+                     allows at most {widest:e} m"
+                ),
+            )
+        })
+    })
+}
+
+/// The relay's keys and values, for an error that must name them.
+fn describe<D: DriveModel>(model: &RelayModel<'_, D>) -> String {
+    let m = model.m;
+    let mut out = format!(
+        "mechanics.mass = {:e} kg, mechanics.stiffness = {:e} N/m, mechanics.damping = {:e} N·s/m, \
+         mechanics.force = {:e} N, mechanics.preload = {:e} N, mechanics.gap = {:e} m, surface = {:?}",
+        m.mass, m.stiffness, m.damping, m.force, m.preload, m.gap, model.contact
+    );
+    if let Some(b) = &model.build.blade {
+        out += &format!(
+            ", blade.mass = {:e} kg, blade.stiffness = {:e} N/m, blade.damping = {:e} N·s/m",
+            b.mass, b.stiffness, b.damping
+        );
+    }
+    if let Some(p) = &model.build.pole_face {
+        out += &format!(
+            ", pole_face.overtravel = {:e} m, pole_face = {:?}",
+            p.overtravel, p.surface
+        );
+    }
+    out += &format!(", surface.release = {:?}", model.build.release);
+    out
 }
 
 /// Propagate `p` to the horizon: exactly when every mode is linear, else
@@ -488,4 +541,136 @@ pub fn driven_run(
         Horizon::Cycle,
     )?;
     Ok(Trajectory::of_two_stage(m, stops, settings, run))
+}
+
+#[cfg(test)]
+mod invariant_tests {
+    use super::*;
+    use crate::mechanics::two_stage::energy::step_energy;
+    use crate::mechanics::two_stage::propagation::invariants;
+    use crate::mechanics::two_stage::{Blade, PoleFace};
+
+    fn relay() -> (Mechanics, TwoStage) {
+        let m = Mechanics {
+            mass: 1e-4,
+            stiffness: 5000.0,
+            damping: 0.07,
+            force: 1.0,
+            gap: 1.4e-4,
+            initial_position: 0.0,
+            initial_velocity: 0.0,
+            preload: 0.0,
+        };
+        let build = TwoStage {
+            blade: Some(Blade {
+                mass: 2e-5,
+                stiffness: 3200.0,
+                damping: 0.005,
+            }),
+            pole_face: Some(PoleFace {
+                overtravel: 1e-4,
+                release: Release::Position,
+                surface: Surface::KelvinVoigt {
+                    stiffness: 2e6,
+                    damping: 2.0,
+                },
+            }),
+            release: Release::Position,
+        };
+        (m, build)
+    }
+
+    fn with_model(check: impl Fn(&RelayModel<'_, Constant>)) {
+        let (m, build) = relay();
+        let constant = Constant {
+            force: m.force,
+            time_scale: (m.mass / m.stiffness).sqrt(),
+        };
+        let model = RelayModel {
+            m: &m,
+            build: &build,
+            contact: Surface::KelvinVoigt {
+                stiffness: 5e5,
+                damping: 0.3,
+            },
+            back: None,
+            rest: false,
+            drive: &constant,
+        };
+        check(&model);
+    }
+
+    const OPEN: StopModes = StopModes {
+        contact: StopMode::Open,
+        pole: StopMode::Open,
+        rest: StopMode::Open,
+    };
+
+    #[test]
+    fn an_impact_that_approaches_backwards_is_an_error() {
+        with_model(|model| {
+            let arriving = Y::new(-1e-5, 0.2, 0.0, -0.15, 0.0);
+            let broken = invariants(
+                model,
+                Which::Contact,
+                OPEN,
+                1e-3,
+                (&arriving, &arriving),
+                None,
+            );
+            let (t, what) = broken.expect("a backward impact is caught");
+            assert_eq!(t, 1e-3);
+            assert!(what.contains("backwards"), "{what}");
+            // Approaching, it holds.
+            let arriving = Y::new(-1e-5, 0.2, 0.0, 0.15, 0.0);
+            assert!(
+                invariants(
+                    model,
+                    Which::Contact,
+                    OPEN,
+                    1e-3,
+                    (&arriving, &arriving),
+                    None
+                )
+                .is_none()
+            );
+        });
+    }
+
+    #[test]
+    fn energy_from_nowhere_is_an_error() {
+        with_model(|model| {
+            let rest = Y::new(-1.4e-4, 0.0, -1.4e-4, 0.0, 0.0);
+            let j0 = step_energy(model, &rest).unwrap();
+            // The blade at the contact, moving at 5 m/s: more than the
+            // force's work over the travel can give.
+            let fast = Y::new(0.0, 0.0, 0.0, 5.0, 0.0);
+            let broken = invariants(model, Which::Contact, OPEN, 2e-3, (&fast, &fast), Some(j0));
+            assert!(broken.expect("caught").1.contains("energy has grown"));
+            let slow = Y::new(0.0, 0.0, 0.0, 0.1, 0.0);
+            assert!(
+                invariants(model, Which::Contact, OPEN, 2e-3, (&slow, &slow), Some(j0)).is_none()
+            );
+        });
+    }
+
+    #[test]
+    fn the_widest_opening_is_where_the_least_potential_meets_the_energy() {
+        with_model(|model| {
+            let (m, build) = relay();
+            let sb = build.blade.unwrap().stiffness;
+            let j = 1e-5;
+            let opening = widest_opening(model, j).unwrap();
+            let xb = m.gap - opening;
+            // The least potential over the armature, found by brute force.
+            let least = (0..200_001)
+                .map(|i| -2e-3 + 4e-3 * i as f64 / 200_000.0)
+                .map(|xa| {
+                    0.5 * m.stiffness * xa * xa - m.force * xa + 0.5 * sb * (xa - xb) * (xa - xb)
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert!((least - j).abs() < 1e-9, "{least} against {j}");
+            assert!(opening > m.gap);
+        });
+    }
 }

@@ -5,8 +5,9 @@
 //! a closing's ending is decided ([`decided`]), and the records it
 //! returns.
 
-use super::energy::EnergyBound;
+use super::energy::{EnergyBound, step_energy};
 use super::model::{RelayModel, StopMode, StopModes, Which, Y};
+use super::relay::Release;
 use super::run::{Horizon, TwoStageRun};
 use super::span::Span;
 use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome};
@@ -34,6 +35,13 @@ impl Tally {
     /// Whether the contact has been touched.
     pub(crate) fn contact_is_empty(&self) -> bool {
         self.contact.is_empty()
+    }
+
+    /// Each release's time and the widest opening after it (m).
+    pub(crate) fn openings(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
+        self.contact
+            .iter()
+            .filter_map(|i| Some((i.release_time?, i.max_gap_after?)))
     }
 
     /// Impacts on the contact so far.
@@ -105,6 +113,11 @@ pub(crate) struct Propagation {
     pub bound: EnergyBound,
     /// The ending, when one was decided before the horizon.
     pub ending: Option<Outcome>,
+    /// J, the energy at the start, under a constant force with every stop
+    /// released by position (when the energy can only fall).
+    pub energy0: Option<f64>,
+    /// The first broken invariant: (time, what).
+    pub violation: Option<(f64, String)>,
 }
 
 impl Propagation {
@@ -119,6 +132,8 @@ impl Propagation {
             steps: 0,
             bound: EnergyBound::new(),
             ending: None,
+            energy0: self.energy0,
+            violation: None,
         }
     }
 
@@ -131,7 +146,11 @@ impl Propagation {
         t: f64,
         mut y: Y,
     ) {
+        let (before, arriving) = (self.modes, y);
         self.modes = transition(model, settings, which, t, &mut y, self.modes, &mut self.rec);
+        if self.violation.is_none() {
+            self.violation = invariants(model, which, before, t, (&arriving, &y), self.energy0);
+        }
         if let Some(last) = self.pieces.last_mut() {
             last.y1 = y;
         }
@@ -208,6 +227,7 @@ pub(super) fn start<D: DriveModel>(model: &RelayModel<'_, D>, e0: f64) -> Propag
     } else if model.rest && x0 == 0.0 {
         rec.lift_offs.push(0.0);
     }
+    let energy0 = by_position(model).then(|| step_energy(model, &y)).flatten();
     Propagation {
         t: 0.0,
         y,
@@ -217,6 +237,8 @@ pub(super) fn start<D: DriveModel>(model: &RelayModel<'_, D>, e0: f64) -> Propag
         steps: 0,
         bound: EnergyBound::new(),
         ending: None,
+        energy0,
+        violation: None,
     }
 }
 
@@ -352,6 +374,66 @@ pub(crate) fn decided<D: DriveModel>(
         StopMode::Open if bound.cannot_reach(model, t, y, modes) => Some(Outcome::EndsOpen),
         _ => None,
     }
+}
+
+/// Whether every stop of `model` is released by position (or rigid), so
+/// that its energy can only fall.
+pub(crate) fn by_position<D: DriveModel>(model: &RelayModel<'_, D>) -> bool {
+    let position = |release: Release, s: &Surface| {
+        release == Release::Position || matches!(s, Surface::Rigid { .. })
+    };
+    position(model.build.release, &model.contact)
+        && model
+            .build
+            .pole_face
+            .is_none_or(|p| position(p.release, &p.surface))
+}
+
+/// What physics guarantees at an event of `which` (the modes `before`
+/// it, the state `arriving` before it and `y` after it): with the contact released by position an
+/// impact approaches the surface; with a constant force and every stop
+/// released by position the energy has not grown. The first broken one,
+/// with its numbers.
+pub(super) fn invariants<D: DriveModel>(
+    model: &RelayModel<'_, D>,
+    which: Which,
+    before: StopModes,
+    t: f64,
+    (arriving, y): (&Y, &Y),
+    energy0: Option<f64>,
+) -> Option<(f64, String)> {
+    let m = model.m;
+    let speed =
+        (m.force.abs() + m.preload.abs() + m.stiffness * m.gap) / (m.mass * m.stiffness).sqrt();
+    if which == Which::Contact
+        && before.contact == StopMode::Open
+        && model.build.release == Release::Position
+    {
+        let v = if model.build.blade.is_some() {
+            arriving[3]
+        } else {
+            arriving[1]
+        };
+        if v < -1e-9 * speed {
+            return Some((
+                t,
+                format!("an impact approaches backwards (impact velocity {v:e} m/s)"),
+            ));
+        }
+    }
+    let (Some(j0), Some(j)) = (energy0, step_energy(model, y)) else {
+        return None;
+    };
+    let scale = (m.force.abs() + m.preload.abs())
+        * (m.gap + model.build.pole_face.map_or(0.0, |p| p.overtravel))
+        + 0.5 * m.stiffness * m.gap * m.gap;
+    if j > j0 + 1e-7 * (scale + j0.abs()) {
+        return Some((
+            t,
+            format!("the energy has grown from {j0:e} J to {j:e} J with nothing to supply it"),
+        ));
+    }
+    None
 }
 
 /// Apply the event of `which` at `t` to the state and the records; the
