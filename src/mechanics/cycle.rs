@@ -51,7 +51,7 @@ use super::driven::{self, DriveModel, State, first_true, monotone_parts, state_o
 use super::error::{DriveError, MAX_DRIVEN_STEPS, MAX_EVENTS, MechanicsError};
 use super::integrate::Dopri5Step;
 pub use super::parameters::Stops;
-use super::parameters::{Mechanics, Settings};
+use super::parameters::{Mechanics, PROOF_SPAN, Settings};
 use super::segment::{Segment, path_of};
 use super::surface::Surface;
 use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome};
@@ -149,7 +149,30 @@ pub(crate) fn run_closing<D: DriveModel>(
         back: None,
     };
     let sim = simulated(m, &stops, settings, drive, e0, true)?;
-    Ok(closing::finish(&sim.model, sim.rec))
+    let mut run = closing::finish(&sim.model, sim.rec);
+    // Closed at t_end but not yet proven to stay: followed on, with the
+    // drive as it is, up to PROOF_SPAN × t_end; stuck (settled where it
+    // was) only if nothing happens to the contact before the proof.
+    let c = &run.chatter;
+    let closed = c
+        .intervals
+        .last()
+        .is_some_and(|i| i.state == ContactState::Closed);
+    if c.outcome == Outcome::EndOfTime && closed {
+        let longer = Settings {
+            t_end: settings.t_end * PROOF_SPAN,
+            ..*settings
+        };
+        let last = c.impacts.last().map(|i| i.impact_time);
+        if let Ok(sim) = simulated(m, &stops, &longer, drive, e0, true) {
+            let proof = closing::finish(&sim.model, sim.rec).chatter;
+            if proof.outcome.is_closed() && proof.settle_time == last {
+                run.chatter.outcome = proof.outcome;
+                run.chatter.settle_time = proof.settle_time;
+            }
+        }
+    }
+    Ok(run)
 }
 
 fn simulated<'a, D: DriveModel>(

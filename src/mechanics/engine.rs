@@ -27,7 +27,7 @@ use super::error::{MAX_EVENTS, MechanicsError};
 use super::hunt_crossley::{HcContact, HcEnd};
 use super::linear::{LinearPiece, Mode, Shift, Zeros};
 pub use super::parameters::validate;
-use super::parameters::{Mechanics, Settings};
+use super::parameters::{Mechanics, PROOF_SPAN, Settings};
 use super::surface::Surface;
 use crate::chatter::{Chatter, ContactState, Impact, Interval, Outcome, bounces};
 
@@ -197,7 +197,16 @@ impl<'a> Engine<'a> {
                 velocity,
             },
             ResponseEnd::Stuck => ContactEnd::Stuck,
-            ResponseEnd::Horizon => ContactEnd::Horizon,
+            // Closed at t_end: the same contact followed on (the response
+            // is a function of the impact alone) up to PROOF_SPAN × t_end;
+            // stuck only if proven so before it releases.
+            ResponseEnd::Horizon => {
+                let longer = PROOF_SPAN * self.settings.t_end - t_hit;
+                match self.law.respond(self.m, v_hit, longer) {
+                    Ok(r) if matches!(r.end, ResponseEnd::Stuck) => ContactEnd::Stuck,
+                    _ => ContactEnd::Horizon,
+                }
+            }
         })
     }
 

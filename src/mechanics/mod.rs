@@ -68,7 +68,7 @@ pub use contact_force as force;
 pub use contact_force::contact_forces;
 pub use engine::{ImpactResponse, ResponseEnd, critical_impact_speed, impact_response, simulate};
 pub use error::{DriveError, MAX_CONTACT_STEPS, MAX_DRIVEN_STEPS, MAX_EVENTS, MechanicsError};
-pub use parameters::{Dimensionless, Mechanics, Settings, validate};
+pub use parameters::{Dimensionless, Mechanics, PROOF_SPAN, Settings, validate};
 pub use surface::Surface;
 pub use trajectory::{Drive, Trajectory, TrajectoryEvent, TrajectoryEventKind, simulate_drive};
 #[allow(deprecated)]

@@ -29,6 +29,13 @@ pub struct Mechanics {
     pub preload: f64,
 }
 
+/// How far a closing that is closed at `t_end`, but not yet proven to
+/// stay closed, is followed on to prove it: to this many times `t_end`
+/// (with the drive as it is). Stuck, with its settle time before `t_end`,
+/// only when proven before any further event; else `end_of_time`, saying
+/// that the contact was closed.
+pub const PROOF_SPAN: f64 = 10.0;
+
 /// When to stop and what is too small to matter (docs/model.md §4).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Settings {

@@ -605,3 +605,63 @@ fn the_bundled_example_released_by_position_agrees_with_the_reference() {
         );
     }
 }
+
+/// The one-mass engines (Kelvin–Voigt in closed form, Hunt–Crossley by
+/// DOP853) and the driven one: the ending and settle time of a closing do
+/// not change when `t_end` is doubled, unless the longer run saw the
+/// contact move after the first one's end. Short horizons (2–6 ms) put
+/// `t_end` inside the last contact of many of these relays.
+#[test]
+fn one_mass_endings_do_not_depend_on_the_horizon() {
+    use chatterspice::mechanics::simulate;
+    let mut closed_at_end = 0;
+    for seed in 1..=300u64 {
+        let r = relay(seed);
+        let hunt_crossley = matches!(r.contact, Law::Hc { .. });
+        let m = Mechanics {
+            mass: r.m + r.mb,
+            ..r.mechanics()
+        };
+        let t_end = 2e-3 + 4e-3 * Draw::new(seed ^ 0xABCD).unit();
+        let at = |t_end: f64| {
+            simulate(
+                &m,
+                &r.contact.surface(),
+                &Settings {
+                    t_end,
+                    ..Settings::default()
+                },
+            )
+            .unwrap_or_else(|e| panic!("seed {seed}: {e}"))
+        };
+        let (short, long) = (at(t_end), at(2.0 * t_end));
+        let moved_after = long
+            .impacts
+            .iter()
+            .any(|i| i.impact_time > t_end || i.release_time.is_some_and(|x| x > t_end));
+        if moved_after {
+            assert_eq!(short.outcome, Outcome::EndOfTime, "seed {seed}");
+            continue;
+        }
+        if short
+            .intervals
+            .last()
+            .is_some_and(|i| i.state == chatterspice::ContactState::Closed)
+            && long.settle_time.is_some_and(|s| s < t_end)
+        {
+            closed_at_end += 1;
+        }
+        assert_eq!(
+            (short.outcome, short.settle_time),
+            (long.outcome, long.settle_time),
+            "seed {seed} ({}): t_end {t_end:e} against twice that",
+            if hunt_crossley {
+                "Hunt–Crossley"
+            } else {
+                "Kelvin–Voigt"
+            }
+        );
+    }
+    // The horizons do cut into closed contacts: the test is not vacuous.
+    assert!(closed_at_end > 10, "{closed_at_end} relays closed at t_end");
+}

@@ -29,7 +29,7 @@ use crate::mechanics::driven::{DriveModel, first_true};
 use crate::mechanics::error::{DriveError, MechanicsError};
 use crate::mechanics::forced::Forced;
 use crate::mechanics::locate::{self, StepForm};
-use crate::mechanics::parameters::{Mechanics, Settings, Stops};
+use crate::mechanics::parameters::{Mechanics, PROOF_SPAN, Settings, Stops};
 use crate::mechanics::step_control::StepTolerance;
 use crate::mechanics::surface::Surface;
 use crate::mechanics::trajectory::{self, Trajectory, simulate_drive};
@@ -202,10 +202,6 @@ fn advance<D: DriveModel>(
         None => integrate(model, settings, horizon, p),
     }
 }
-
-/// How far past `t_end` a closing that is closed there, but not yet
-/// proven to stay closed, is followed: to this many times `t_end`.
-pub const PROOF_SPAN: f64 = 10.0;
 
 /// A closing that ends closed at `t_end` without its ending decided is
 /// followed on, with the drive as it is, until the energy bound proves it
