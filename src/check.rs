@@ -29,7 +29,7 @@ use thiserror::Error;
 
 use crate::analysis::ProbeAnalysis;
 use crate::arc::ArcReport;
-use crate::chatter::{Chatter, Interval};
+use crate::chatter::{Chatter, Impact, Interval};
 use crate::coil::{Closing, Operation};
 use crate::mechanics::{MechanicsError, simulate};
 use crate::pipeline::{self, RunError, RunOptions, RunResult};
@@ -539,8 +539,9 @@ pub fn arc_checks(
 /// What [`run`] did to reach its verdict.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Evidence {
-    /// Only the mechanics: no probe has a limit.
-    Mechanics(Chatter),
+    /// Only the mechanics: no probe has a limit. The armature's impacts on
+    /// the pole face, for a relay that has one.
+    Mechanics(Chatter, Option<Vec<Impact>>),
     /// The whole pipeline through ngspice.
     Run(Box<RunResult>),
 }
@@ -549,7 +550,7 @@ impl Evidence {
     /// The chatter sequence the verdict was reached on.
     pub fn chatter(&self) -> &Chatter {
         match self {
-            Evidence::Mechanics(c) => c,
+            Evidence::Mechanics(c, _) => c,
             Evidence::Run(r) => &r.chatter,
         }
     }
@@ -557,7 +558,7 @@ impl Evidence {
     /// The operations of a coil-driven relay's run; none otherwise.
     pub fn operations(&self) -> &[Operation] {
         match self {
-            Evidence::Mechanics(_) => &[],
+            Evidence::Mechanics(..) => &[],
             Evidence::Run(r) => &r.operations,
         }
     }
@@ -618,7 +619,7 @@ pub fn measured(
         .as_ref()
         .map(|l| relay_checks(l, &chatter, &[]))
         .unwrap_or_default();
-    Ok((Verdict::new(checks), Evidence::Mechanics(chatter)))
+    Ok((Verdict::new(checks), Evidence::Mechanics(chatter, None)))
 }
 
 /// The `[limits]` of `scenario` on the mechanics alone, without ngspice;
@@ -638,13 +639,44 @@ pub fn measured(
 /// # Ok::<(), chatterspice::check::CheckError>(())
 /// ```
 pub fn relay_only(scenario: &Scenario) -> Result<(Verdict, Evidence), CheckError> {
-    let chatter = relay_chatter(scenario)?;
+    let (chatter, pole_face) = relay_closing(scenario)?;
     let checks = scenario
         .limits
         .as_ref()
         .map(|l| relay_checks(l, &chatter, &[]))
         .unwrap_or_default();
-    Ok((Verdict::new(checks), Evidence::Mechanics(chatter)))
+    Ok((
+        Verdict::new(checks),
+        Evidence::Mechanics(chatter, pole_face),
+    ))
+}
+
+/// [`relay_chatter`] with the armature's impacts on the pole face, for a
+/// relay that has one.
+pub fn relay_closing(scenario: &Scenario) -> Result<(Chatter, Option<Vec<Impact>>), CheckError> {
+    let build = scenario.two_stage();
+    let with_pole = build.pole_face.is_some();
+    if scenario.coil.is_some() {
+        let (chatter, run) = dc_step(scenario)?;
+        let pole = with_pole.then(|| run.map(|r| r.pole_face).unwrap_or_default());
+        return Ok((chatter, pole));
+    }
+    if build.is_one_mass() {
+        return relay_chatter(scenario).map(|c| (c, None));
+    }
+    let mechanics = scenario.mechanics()?;
+    let trajectory = crate::mechanics::two_stage::step_closing(
+        &mechanics,
+        &build,
+        &scenario.surface(),
+        &scenario.settings(),
+    )
+    .map_err(|source| CheckError::Motion {
+        path: scenario.origin.clone(),
+        source,
+    })?;
+    let pole = with_pole.then(|| trajectory.pole_face_impacts().to_vec());
+    Ok((trajectory.into_chatter(), pole))
 }
 
 /// The relay's own closing, as built, without a circuit: the step force

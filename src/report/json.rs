@@ -264,13 +264,21 @@ pub fn render_check(
     evidence: &Evidence,
     dimensionless: Option<&Dimensionless>,
 ) -> String {
+    let bounce = BounceJson::new(evidence.chatter(), dimensionless);
+    let pole_face = match evidence {
+        Evidence::Run(run) => run.pole_face.as_deref(),
+        Evidence::Mechanics(_, pole_face) => pole_face.as_deref(),
+    };
     let doc = CheckJson {
         verdict,
-        bounce: BounceJson::new(evidence.chatter(), dimensionless),
+        bounce: match pole_face {
+            Some(impacts) => bounce.with_pole_face(impacts),
+            None => bounce,
+        },
         timing: Closing::first(evidence.chatter(), evidence.operations()),
         run: match evidence {
             Evidence::Run(run) => Some(RunJson::new(run, dimensionless)),
-            Evidence::Mechanics(_) => None,
+            Evidence::Mechanics(..) => None,
         },
     };
     let mut text = serde_json::to_string_pretty(&doc).expect("a check result always serializes");

@@ -5,7 +5,8 @@
 //!
 //! The validator covers the part of JSON Schema (2020-12) the schemas use:
 //! `type`, `properties`, `required`, `additionalProperties`, `items`,
-//! `enum`, `oneOf`, `minimum` and local `$ref`s.
+//! `enum`, `oneOf`, `minimum` and `$ref`s into a schema's own `$defs` or a
+//! sibling file's.
 
 use crate::common;
 
@@ -29,8 +30,15 @@ fn schema(name: &str) -> Value {
 /// JSON-pointer-ish paths with a reason.
 fn validate(root: &Value, schema: &Value, value: &Value, at: &str, errors: &mut Vec<String>) {
     if let Some(r) = schema.get("$ref").and_then(Value::as_str) {
-        let name = r.strip_prefix("#/$defs/").expect("local refs only");
-        validate(root, &root["$defs"][name], value, at, errors);
+        // `#/$defs/name` in this file, or `other.schema.json#/$defs/name`
+        // in a sibling (the definitions shared by the documents live once).
+        let (file, name) = r.split_once("#/$defs/").expect("refs into $defs only");
+        if file.is_empty() {
+            validate(root, &root["$defs"][name], value, at, errors);
+        } else {
+            let other = self::schema(file.strip_suffix(".schema.json").expect("a sibling schema"));
+            validate(&other, &other["$defs"][name], value, at, errors);
+        }
     }
     if let Some(t) = schema.get("type") {
         let types: Vec<&str> = match t {
@@ -345,4 +353,112 @@ fn the_parts_list_and_every_part_match_their_schemas() {
         assert_eq!(part["name"], name.as_str());
         assert!(part["scenario"]["mechanics"]["mass"].is_number(), "{part}");
     }
+}
+
+/// Every command's JSON on every bundled example and every bundled part
+/// (blades, pole faces, arcs, coils, envelopes included) validates: a
+/// field added to any output without its schema fails here.
+#[test]
+fn every_command_on_every_example_and_part_matches_its_schema() {
+    let Some(_) = common::ngspice() else { return };
+    let mut examples: Vec<PathBuf> = std::fs::read_dir(root().join("examples/scenarios"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    examples.sort();
+    assert!(examples.len() >= 12, "{examples:?}");
+    let mut validated = 0;
+    let mut validate_command = |command: &str, name: &str, path: &str, extra: &[&str]| {
+        let out = Command::cargo_bin("chatterspice")
+            .unwrap()
+            .args([command, path, "--format", "json"])
+            .args(extra)
+            .output()
+            .unwrap();
+        // A command that refuses the scenario (`run` without a circuit,
+        // `bounce` of a coil relay without a drive voltage) prints no JSON.
+        if out.status.code() == Some(2) {
+            return;
+        }
+        let doc: Value =
+            serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{command} {path}: {e}"));
+        assert_valid(name, &doc, &format!("{command} {path}"));
+        validated += 1;
+    };
+    for path in &examples {
+        let path = path.to_str().unwrap();
+        validate_command("bounce", "bounce", path, &[]);
+        validate_command("run", "run", path, &[]);
+        validate_command("check", "check", path, &[]);
+    }
+    let dir = tempfile::tempdir().unwrap();
+    for part in chatterspice::calibrate::parts::all().iter().map(|p| p.name) {
+        let path = dir.path().join(format!("{part}.toml"));
+        std::fs::write(
+            &path,
+            format!("base = \"part:{part}\"\n[limits]\nmax_bounces = 1000\n"),
+        )
+        .unwrap();
+        let path = path.to_str().unwrap();
+        validate_command("bounce", "bounce", path, &[]);
+        validate_command("check", "check", path, &[]);
+        validate_command("check", "check", path, &["--envelope", "--samples", "4"]);
+    }
+    assert!(validated >= 60, "{validated} documents validated");
+}
+
+/// `raw --signal … --format json`: the probe analysis of a raw file.
+#[test]
+fn raw_signal_analysis_matches_its_schema() {
+    let raw = root().join("tests/data/raw");
+    let mut n = 0;
+    for entry in std::fs::read_dir(&raw).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "raw") {
+            continue;
+        }
+        let stats = Command::cargo_bin("chatterspice")
+            .unwrap()
+            .args(["raw", path.to_str().unwrap(), "--format", "json"])
+            .output()
+            .unwrap();
+        if !stats.status.success() {
+            continue;
+        }
+        let doc: Value = serde_json::from_slice(&stats.stdout).unwrap();
+        // The first voltage of a transient plot, against fixed thresholds.
+        if doc["plots"][0]["name"] != "Transient Analysis" {
+            continue;
+        }
+        let Some(vector) = doc["plots"][0]["variables"].as_array().and_then(|v| {
+            v.iter()
+                .find(|x| x["name"].as_str().is_some_and(|n| n.starts_with("v(")))
+        }) else {
+            continue;
+        };
+        let name = vector["name"].as_str().unwrap();
+        let out = Command::cargo_bin("chatterspice")
+            .unwrap()
+            .args([
+                "raw",
+                path.to_str().unwrap(),
+                "--signal",
+                name,
+                "--low",
+                "0.3",
+                "--high",
+                "0.6",
+            ])
+            .args(["--format", "json"])
+            .output()
+            .unwrap();
+        if !out.status.success() {
+            continue;
+        }
+        let doc: Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_valid("raw-signal", &doc, &path.display().to_string());
+        n += 1;
+    }
+    assert!(n >= 3, "{n} raw files analysed");
 }
