@@ -823,6 +823,13 @@ pub struct MergeArgs {
     /// Replace OUT.csv if it already exists.
     #[arg(long)]
     pub force: bool,
+
+    /// Accept shards that have no identity file beside them (IN.meta.json,
+    /// which `sweep --shard` writes): their seed, scenario and sample count
+    /// cannot be checked, and summary.json says `"identity": "unverified"`.
+    /// Without it such a shard is refused.
+    #[arg(long)]
+    pub unverified: bool,
 }
 
 fn parse_shard(text: &str) -> Result<Shard, String> {
@@ -1180,6 +1187,7 @@ fn merge(args: &MergeArgs) -> Result<()> {
         args.samples,
         args.allow_missing,
         args.force,
+        args.unverified,
     )?;
     if !report.duplicates.is_empty() {
         eprintln!(
@@ -1201,5 +1209,11 @@ fn merge(args: &MergeArgs) -> Result<()> {
         report.rows,
         args.inputs.len()
     );
+    if args.unverified {
+        eprintln!(
+            "note: --unverified: shards without an identity file were merged unchecked; \
+             summary.json says \"identity\": \"unverified\""
+        );
+    }
     Ok(())
 }

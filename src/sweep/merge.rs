@@ -15,13 +15,16 @@ use super::table::{
 /// [`merge`] of files into the file `output`, through a temporary file
 /// beside it that is renamed into place only when the merge succeeds (a
 /// refused merge leaves no file). Unless `overwrite`, an existing
-/// `output` is an error and stays untouched.
+/// `output` is an error and stays untouched. A shard without its identity
+/// file beside it is refused unless `unverified`, and the summary then
+/// says that the identity was not verified.
 pub fn merge_files(
     output: &Path,
     inputs: &[PathBuf],
     expected: Option<u64>,
     allow_missing: bool,
     overwrite: bool,
+    unverified: bool,
 ) -> Result<MergeReport, MergeFilesError> {
     let io = |source| MergeFilesError::Output {
         path: output.to_owned(),
@@ -29,8 +32,16 @@ pub fn merge_files(
     };
     // Every shard with an identity file beside it must be of one sweep.
     let mut known: Option<(PathBuf, super::resume::Identity)> = None;
+    let mut without_identity = false;
     for path in inputs {
         let Some(meta) = super::resume::meta_beside(path)? else {
+            if !unverified {
+                return Err(MergeFilesError::NoIdentity {
+                    shard: path.clone(),
+                    meta: super::resume::meta_path(path),
+                });
+            }
+            without_identity = true;
             continue;
         };
         match &known {
@@ -65,7 +76,12 @@ pub fn merge_files(
     buffered.flush().map_err(io)?;
     drop(buffered);
     staged.commit()?;
-    write_merged_summary(output, known.map(|(_, i)| i), overwrite)?;
+    let verified = if without_identity {
+        "unverified"
+    } else {
+        "verified"
+    };
+    write_merged_summary(output, known.map(|(_, i)| i), verified, overwrite)?;
     Ok(report)
 }
 
@@ -102,6 +118,7 @@ pub fn layout_of(header: &[u8]) -> Option<(Vec<String>, Vec<String>, Columns)> {
 fn write_merged_summary(
     output: &Path,
     identity: Option<super::resume::Identity>,
+    verified: &'static str,
     overwrite: bool,
 ) -> Result<(), MergeFilesError> {
     let bytes =
@@ -124,7 +141,7 @@ fn write_merged_summary(
     }
     let seed = identity.as_ref().and_then(|i| i.seed);
     let grid = identity.as_ref().is_some_and(|i| i.seed.is_none());
-    let summary = collected
+    let mut summary = collected
         .summary_with(grid, seed, |index| {
             Ok(records
                 .iter()
@@ -133,6 +150,7 @@ fn write_merged_summary(
                 .unwrap_or_default())
         })
         .map_err(|e| MergeFilesError::Summary(e.to_string()))?;
+    summary.identity = Some(verified);
     let path = output.with_file_name("summary.json");
     crate::output::write_new_file(&path, summary.to_json().as_bytes(), overwrite)?;
     Ok(())
@@ -154,6 +172,22 @@ pub enum MergeFilesError {
     /// The inputs could not be merged.
     #[error(transparent)]
     Merge(#[from] MergeError),
+    /// A shard has no identity file beside it (as `scp shards/*.csv`
+    /// leaves them): its seed, scenario and sample count cannot be checked
+    /// against the other shards'.
+    #[error(
+        "{}: its identity file {} is missing, so it cannot be checked to be a shard of the \
+         same sweep as the others (seed, scenario, sample count); copy the .meta.json files \
+         with the CSVs, or merge with --unverified to accept the rows unchecked",
+        shard.display(),
+        meta.display()
+    )]
+    NoIdentity {
+        /// The shard's CSV.
+        shard: PathBuf,
+        /// The identity file that should be beside it.
+        meta: PathBuf,
+    },
     /// Two inputs belong to different sweeps, by the identity files beside
     /// them.
     #[error(

@@ -207,6 +207,7 @@ impl Collected {
                     error: error.clone(),
                 })
                 .collect(),
+            identity: None,
         })
     }
 
@@ -372,6 +373,11 @@ pub struct Summary {
     pub worst: Option<Worst>,
     /// The first few errors.
     pub first_errors: Vec<SampleError>,
+    /// A merged summary only: `verified` when every shard's identity file
+    /// was checked, `unverified` when shards without one were accepted
+    /// (`merge --unverified`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub identity: Option<&'static str>,
 }
 
 impl Summary {

@@ -309,6 +309,7 @@ fn merge_refuses_shards_of_different_sweeps_naming_what_differs() {
             .unwrap();
     assert_eq!(summary["samples"], 40, "{summary}");
     assert_eq!(summary["seed"], 7);
+    assert_eq!(summary["identity"], "verified");
     let whole = dir.path().join("whole");
     chatterspice()
         .arg("sweep")
@@ -994,4 +995,64 @@ fn a_sweep_never_overwrites_an_input() {
         .stderr(predicate::str::contains("input of the run"));
     assert_eq!(std::fs::read(inside.join("sweep.csv")).unwrap(), text);
     assert_eq!(listing(&inside), ["sweep.csv"]);
+}
+
+#[test]
+fn merge_refuses_shards_without_their_identity_unless_told() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = scenario(dir.path(), VARY);
+    let shard = |k: &str, seed: &str, out: &str| {
+        chatterspice()
+            .arg("sweep")
+            .arg(&s)
+            .args([
+                "--mechanics-only",
+                "--samples",
+                "20",
+                "--seed",
+                seed,
+                "--shard",
+                k,
+                "--out",
+            ])
+            .arg(dir.path().join(out))
+            .assert()
+            .success();
+        let name = format!("sweep.{}.csv", k.replace('/', "-of-"));
+        // Copied the way `scp shards/*.csv` copies: without the .meta.json.
+        let copied = dir.path().join("copied").join(&name);
+        std::fs::create_dir_all(copied.parent().unwrap()).unwrap();
+        std::fs::copy(dir.path().join(out).join(&name), &copied).unwrap();
+        copied
+    };
+    // Two different seeds: nothing left to tell them apart.
+    let a = shard("1/2", "7", "a");
+    let b = shard("2/2", "8", "b");
+    let merged = dir.path().join("merged.csv");
+    chatterspice()
+        .arg("merge")
+        .arg(&merged)
+        .args([&a, &b])
+        .assert()
+        .code(2)
+        .stderr(
+            predicate::str::contains("sweep.1-of-2.meta.json")
+                .and(predicate::str::contains("is missing"))
+                .and(predicate::str::contains("--unverified")),
+        );
+    assert!(!merged.exists());
+    assert!(!dir.path().join("summary.json").exists());
+    chatterspice()
+        .arg("merge")
+        .arg(&merged)
+        .args([&a, &b])
+        .arg("--unverified")
+        .assert()
+        .success()
+        .stderr(predicate::str::contains("unverified"));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["identity"], "unverified", "{summary}");
+    assert_eq!(summary["seed"], serde_json::Value::Null);
 }
