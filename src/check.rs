@@ -27,7 +27,7 @@ use std::path::PathBuf;
 use serde::Serialize;
 use thiserror::Error;
 
-use crate::analysis::ProbeAnalysis;
+use crate::analysis::{Debounce, ProbeAnalysis};
 use crate::arc::ArcReport;
 use crate::chatter::{Chatter, Impact, Interval};
 use crate::coil::{Closing, Operation};
@@ -205,9 +205,9 @@ pub enum CheckError {
     /// that match on it.
     #[error(
         "{}: nothing to check: add a [limits] section (max_bounce_time, max_bounces, \
-         max_operate_time, max_settle_time; with a coil max_release_time, \
+         max_operate_time, max_settle_time, max_lockout, max_stable_for; with a coil max_release_time, \
          max_nc_bounce_time, max_nc_bounces; with [arc] max_arc_energy, max_arc_count) or limits on a [[probe]] (max_edges, \
-         max_glitches, max_peak, max_value, min_value, max_last_edge)",
+         max_glitches, max_peak, max_value, min_value, max_last_edge, max_lockout, max_stable_for)",
         path.display()
     )]
     NoLimits {
@@ -275,6 +275,20 @@ pub fn relay_checks(
             })
             .unwrap_or_else(|| Err(never(what)))
     };
+    let debounce = |get: fn(&Debounce) -> f64| {
+        closings
+            .iter()
+            .map(|c| {
+                contact_debounce(chatter, c)
+                    .map(|d| get(&d))
+                    .ok_or_else(|| never("never closes for good"))
+            })
+            .reduce(|a, b| match (a, b) {
+                (Ok(a), Ok(b)) => Ok(a.max(b)),
+                (Err(e), _) | (_, Err(e)) => Err(e),
+            })
+            .unwrap_or_else(|| Err(never("never closes for good")))
+    };
     let operate = longest(|c| c.operate_time, "never touches");
     let settle = longest(|c| c.settle_time, "never closes for good");
     let bounce_time = longest(|c| c.bounce_time, "never closes for good");
@@ -317,6 +331,26 @@ pub fn relay_checks(
             Bound::Max,
             limit,
             operate,
+        ));
+    }
+    if let Some(limit) = limits.max_lockout {
+        out.push(LimitCheck::new(
+            "limits.max_lockout".into(),
+            "contact lockout".into(),
+            "s",
+            Bound::Max,
+            limit,
+            debounce(|d| d.lockout),
+        ));
+    }
+    if let Some(limit) = limits.max_stable_for {
+        out.push(LimitCheck::new(
+            "limits.max_stable_for".into(),
+            "contact stable for".into(),
+            "s",
+            Bound::Max,
+            limit,
+            debounce(|d| d.stable_for),
         ));
     }
     if let Some(limit) = limits.max_settle_time {
@@ -469,7 +503,50 @@ pub fn probe_checks(index: usize, probe: &Probe, a: &ProbeAnalysis) -> Vec<Limit
                 .ok_or_else(|| "the signal never crosses its thresholds".to_owned()),
         ));
     }
+    let debounce = |get: fn(&Debounce) -> f64| {
+        a.debounce
+            .as_ref()
+            .map(get)
+            .ok_or_else(|| "the signal never crosses its thresholds".to_owned())
+    };
+    if let Some(limit) = probe.max_lockout {
+        out.push(LimitCheck::new(
+            key("max_lockout"),
+            what("lockout"),
+            "s",
+            Bound::Max,
+            limit,
+            debounce(|d| d.lockout),
+        ));
+    }
+    if let Some(limit) = probe.max_stable_for {
+        out.push(LimitCheck::new(
+            key("max_stable_for"),
+            what("stable for"),
+            "s",
+            Bound::Max,
+            limit,
+            debounce(|d| d.stable_for),
+        ));
+    }
     out
+}
+
+/// The contact's own debounce figures in `closing`: its transitions (every
+/// make and break) from the first make to closed for good; `None` when the
+/// closing never settles.
+pub fn contact_debounce(chatter: &Chatter, closing: &Closing) -> Option<Debounce> {
+    let first = closing.origin + closing.operate_time?;
+    let settle = closing.origin + closing.settle_time?;
+    let inside = |t: f64| t >= first - 1e-15 && t <= settle + 1e-15;
+    let mut times: Vec<f64> = chatter
+        .impacts
+        .iter()
+        .flat_map(|i| std::iter::once(i.impact_time).chain(i.release_time))
+        .filter(|&t| inside(t))
+        .collect();
+    times.sort_by(f64::total_cmp);
+    Debounce::of(&times)
 }
 
 /// Every limit of `scenario` against a finished run.

@@ -500,6 +500,10 @@ fn quantities(evidence: &Evidence) -> BTreeMap<String, f64> {
     if let Some(t) = timing.settle_time {
         q.insert("settle_time".to_owned(), t);
     }
+    if let Some(d) = check::contact_debounce(chatter, &timing) {
+        q.insert("lockout".to_owned(), d.lockout);
+        q.insert("stable_for".to_owned(), d.stable_for);
+    }
     if let Evidence::Run(run) = evidence {
         probe_quantities(run, &mut q);
     }

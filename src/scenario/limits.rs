@@ -34,6 +34,15 @@ pub struct LimitsSection {
     pub max_arc_energy: Option<f64>,
     /// The most arcs in one operation (needs `[arc]` and a run).
     pub max_arc_count: Option<u64>,
+    /// s, the contact's own debounce lockout in each closing: its last
+    /// transition − its first make, what a debouncer reading the contact
+    /// directly must ignore it for (the bounce time, named as a debouncer
+    /// is sized).
+    pub max_lockout: Option<f64>,
+    /// s, the longest the contact stays in one state between two of its
+    /// transitions during a closing's chatter: a debouncer that waits for
+    /// a stable input must wait longer than this.
+    pub max_stable_for: Option<f64>,
 }
 
 impl LimitsSection {
@@ -80,6 +89,16 @@ impl Check<'_> {
                 "limits.max_arc_energy",
                 l.max_arc_energy,
                 "the most arc energy allowed in one operation, in J",
+            ),
+            (
+                "limits.max_lockout",
+                l.max_lockout,
+                "the longest debounce lockout allowed (first make → last transition), in s",
+            ),
+            (
+                "limits.max_stable_for",
+                l.max_stable_for,
+                "the longest stable stretch allowed between two transitions, in s",
             ),
         ] {
             if let Some(v) = value {

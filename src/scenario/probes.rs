@@ -32,9 +32,19 @@ pub struct Probe {
     /// Lowest value allowed (e.g. −0.3 V below ground on an input).
     #[serde(default)]
     pub min_value: Option<f64>,
-    /// s, the last edge must come by then (the signal has settled).
+    /// s, the last edge must come by then (the signal has settled). Timed
+    /// from t = 0, so it includes the operate time; `max_lockout` does not.
     #[serde(default)]
     pub max_last_edge: Option<f64>,
+    /// s, the longest debounce lockout allowed: last edge − first edge (a
+    /// debouncer that ignores its input for T after the first edge needs
+    /// T > lockout).
+    #[serde(default)]
+    pub max_lockout: Option<f64>,
+    /// s, the longest time allowed between two consecutive edges (a
+    /// debouncer that waits for a stable input for T needs T > stable_for).
+    #[serde(default)]
+    pub max_stable_for: Option<f64>,
 }
 
 impl Probe {
@@ -56,6 +66,8 @@ impl Probe {
             || self.max_value.is_some()
             || self.min_value.is_some()
             || self.max_last_edge.is_some()
+            || self.max_lockout.is_some()
+            || self.max_stable_for.is_some()
     }
 }
 
@@ -92,6 +104,19 @@ impl Check<'_> {
                 v > 0.0,
                 "must be > 0: the time by which the signal must have settled, in s",
             )?;
+        }
+        for (name, value) in [
+            ("max_lockout", p.max_lockout),
+            ("max_stable_for", p.max_stable_for),
+        ] {
+            if let Some(v) = value {
+                self.number(
+                    &key(name),
+                    v,
+                    v > 0.0,
+                    "must be > 0: a debouncer's time, in s",
+                )?;
+            }
         }
         if let Some(v) = p.max_value {
             self.number(&key("max_value"), v, true, "")?;

@@ -336,3 +336,81 @@ fn a_release_limit_past_the_end_of_the_run_fails_as_not_evaluated() {
         "{release}"
     );
 }
+
+/// The debounce limits: on a probe, its lockout (last edge − first edge)
+/// and stable-for (longest gap between edges); in `[limits]`, the
+/// contact's own, worked out here from the bounce record. Below the
+/// value fails with exit 1 and the margin; above passes.
+#[test]
+fn debounce_limits_hold_lockout_and_stable_for() {
+    let _ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    let json = |path: &Path, code: i32| -> Value {
+        let out = chatterspice()
+            .args(["check", path.to_str().unwrap(), "--format", "json"])
+            .assert()
+            .code(code);
+        serde_json::from_slice(&out.get_output().stdout).unwrap()
+    };
+    // The probe's figures from a run with a limit that cannot fail.
+    let loose = scenario(dir.path(), "max_lockout = 1.0\nmax_stable_for = 1.0", "");
+    let doc = json(&loose, 0);
+    let debounce = &doc["run"]["probes"][0]["debounce"];
+    let (lockout, stable) = (
+        debounce["lockout"].as_f64().unwrap(),
+        debounce["stable_for"].as_f64().unwrap(),
+    );
+    assert!(lockout > stable && stable > 0.0, "{debounce}");
+    for (key, value) in [("max_lockout", lockout), ("max_stable_for", stable)] {
+        let tight = scenario(dir.path(), &format!("{key} = {:e}", value * 0.99), "");
+        let out = chatterspice()
+            .args(["check", tight.to_str().unwrap()])
+            .assert()
+            .code(1);
+        let text = String::from_utf8_lossy(&out.get_output().stdout).into_owned();
+        assert!(
+            text.contains(&format!("probe[0].{key}")) && text.contains("FAIL"),
+            "{text}"
+        );
+        let doc = json(&tight, 1);
+        let margin = doc["checks"][0]["margin"].as_f64().unwrap();
+        assert!(
+            (margin + value * 0.01).abs() < 1e-9 * value.max(1.0),
+            "{margin}"
+        );
+        let above = scenario(dir.path(), &format!("{key} = {:e}", value * 1.01), "");
+        json(&above, 0);
+    }
+    // The contact's own, from its transitions in the bounce record.
+    let bounce: Value = serde_json::from_slice(
+        &chatterspice()
+            .args(["bounce", "--format", "json"])
+            .output()
+            .unwrap()
+            .stdout,
+    )
+    .unwrap();
+    let mut times: Vec<f64> = Vec::new();
+    for i in bounce["impacts"].as_array().unwrap() {
+        times.push(i["impact_time"].as_f64().unwrap());
+        if let Some(r) = i["release_time"].as_f64() {
+            times.push(r);
+        }
+    }
+    let contact_lockout = times.last().unwrap() - times[0];
+    let contact_stable = times.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
+    for (key, value) in [
+        ("max_lockout", contact_lockout),
+        ("max_stable_for", contact_stable),
+    ] {
+        let tight = scenario(dir.path(), "", &format!("{key} = {:e}", value * 0.99));
+        let doc = json(&tight, 1);
+        let actual = doc["checks"][0]["actual"].as_f64().unwrap();
+        assert!(
+            (actual - value).abs() < 1e-12,
+            "{key}: {actual} against {value}"
+        );
+        let above = scenario(dir.path(), "", &format!("{key} = {:e}", value * 1.01));
+        json(&above, 0);
+    }
+}
