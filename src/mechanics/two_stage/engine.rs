@@ -220,6 +220,11 @@ fn prove_ending<D: DriveModel>(
     {
         return;
     }
+    // Proven where it stands (the run's summary will say so): nothing to
+    // follow.
+    if p.modes.contact == StopMode::Pressed || p.bound.cannot_release(model, p.t, &p.y, p.modes) {
+        return;
+    }
     let mut later = p.fork();
     let contacts = later.rec.contact_count();
     let span = Settings {

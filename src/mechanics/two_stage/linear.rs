@@ -421,6 +421,19 @@ fn stays_positive(kit: &ModeKit, term: Term, w0: &W, at0: &Reading) -> bool {
     term.value(at0) > series.spread * w0.amax() * (1.0 + 1e-12) + 1e-300
 }
 
+/// Whether `term` stays positive over a step from `w0`, as the Bernstein
+/// coefficients of its series' first terms and a bound on the rest show
+/// (see [`Series::positive_over_step`]): most steps near a stop need no
+/// more.
+fn low_positive(kit: &ModeKit, term: Term, w0: &W, at0: &Reading) -> bool {
+    let series = &kit.forms[term.form];
+    if series.on_zero(term.value(at0), w0) {
+        series.positive_after_zero(w0, term.negated)
+    } else {
+        series.positive_over_step(w0, term.negated)
+    }
+}
+
 /// The first event over `(0, h]` of a step from `w0` (read as `at0`):
 /// (τ, which). Every guard is searched by the one event locator
 /// ([`crate::mechanics::locate`]), which cannot step over a zero of the
@@ -433,35 +446,34 @@ fn first_event(
 ) -> Option<(f64, Which)> {
     let mut best: Option<(f64, Which)> = None;
     for &(which, guard) in &polys.kit.guards {
+        let (kit, w0) = (polys.kit, polys.w0);
+        let positive = |t: Term| stays_positive(kit, t, w0, at0) || low_positive(kit, t, w0, at0);
         let (combine, quick) = match guard {
-            Guard::One(t) => (Combine::One, stays_positive(polys.kit, t, polys.w0, at0)),
-            Guard::Max(a, b) => (
-                Combine::Max,
-                stays_positive(polys.kit, a, polys.w0, at0)
-                    || stays_positive(polys.kit, b, polys.w0, at0),
-            ),
-            Guard::Min(a, b) => (
-                Combine::Min,
-                stays_positive(polys.kit, a, polys.w0, at0)
-                    && stays_positive(polys.kit, b, polys.w0, at0),
-            ),
+            Guard::One(t) => (Combine::One, positive(t)),
+            Guard::Max(a, b) => (Combine::Max, positive(a) || positive(b)),
+            Guard::Min(a, b) => (Combine::Min, positive(a) && positive(b)),
         };
         if quick {
             continue;
         }
-        let terms: Vec<Term> = guard.terms().collect();
-        let step_polys: Vec<Poly> = terms.iter().map(|&t| polys.of(t)).collect();
-        let forms: Vec<StepForm> = step_polys
-            .iter()
-            .map(|p| StepForm::scaled(&p.p, h))
-            .collect();
-        let Some((lo, hi)) = locate::first_zero(&forms, combine, resolution / h) else {
+        let mut step_polys = [None; 2];
+        for (slot, t) in step_polys.iter_mut().zip(guard.terms()) {
+            *slot = Some(polys.of(t));
+        }
+        let step_polys = step_polys.iter().flatten();
+        let mut forms = [StepForm::new(&[0.0]); 2];
+        let mut count = 0;
+        for (form, p) in forms.iter_mut().zip(step_polys.clone()) {
+            *form = StepForm::scaled(&p.p, h);
+            count += 1;
+        }
+        let Some((lo, hi)) = locate::first_zero(&forms[..count], combine, resolution / h) else {
             continue;
         };
         let (lo, hi) = (lo * h, hi * h);
         // Polish on the exact polynomial: the zero of each form that
         // crosses in the bracket; for a max the last, else the first.
-        let crossings = step_polys.iter().filter_map(|poly| {
+        let crossings = step_polys.filter_map(|poly| {
             let (v_lo, v_hi) = (poly.value(lo), poly.value(hi));
             if v_hi >= 0.0 || v_lo < 0.0 {
                 return None;

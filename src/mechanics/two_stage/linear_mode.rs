@@ -109,7 +109,25 @@ pub(super) struct Series {
     /// `Σ_{k≥1} ‖r_k‖₁ h^k` over the mode's step: the form moves less
     /// than this times `‖w0‖∞` within a step from `w0`.
     pub(super) spread: f64,
+    /// `Σ_{k≥LOW_TERMS} ‖r_k‖₁ h^k`: the series past its first
+    /// [`LOW_TERMS`] terms is smaller than this times `‖w0‖∞` over a step.
+    pub(super) tail: f64,
+    /// The Bernstein coefficients (degree `LOW_TERMS − 1`, over the mode's
+    /// full step) of the series' first [`LOW_TERMS`] terms, as rows to dot
+    /// with `w0`: `b_j = k + bern_j·w0`.
+    pub(super) bern: [W; LOW_TERMS],
+    /// `max_j ‖bern_j‖₁`, for the rounding of `bern_j·w0`.
+    pub(super) bern_norm: f64,
+    /// The same for `(f(s) − f(0))/s`, the sign of a form that starts a
+    /// step on its zero (the event that began the mode): the Bernstein
+    /// coefficients of its first `LOW_TERMS − 1` terms.
+    pub(super) bern_after_zero: [W; LOW_TERMS - 1],
 }
+
+/// Terms of a form's series in its cheap sign test: the polynomial of
+/// this many terms in Bernstein form, plus a bound on the rest (below
+/// 1e-4 of the form's swing over a step).
+pub(super) const LOW_TERMS: usize = 13;
 
 impl Series {
     pub(super) fn new(mode: &LinearMode, c: [f64; 4], d: f64) -> Series {
@@ -118,12 +136,96 @@ impl Series {
         let q = W::from_fn(|i, _| c[i] * mode.d[i]);
         let r: [W; TERMS] = std::array::from_fn(|k| mode.powers[k].tr_mul(&q));
         let mut hk = 1.0;
-        let mut spread = 0.0;
-        for rk in &r[1..] {
+        let (mut spread, mut tail) = (0.0, 0.0);
+        for (i, rk) in r.iter().enumerate().skip(1) {
             hk *= mode.h;
             spread += rk.abs().sum() * hk;
+            if i >= LOW_TERMS {
+                tail += rk.abs().sum() * hk;
+            }
         }
-        Series { c, d, k, r, spread }
+        // b_j = Σ_{k ≤ j} C(j, k)/C(n, k) (r_k h^k), n = LOW_TERMS − 1.
+        let n = LOW_TERMS - 1;
+        let mut bern = [W::zeros(); LOW_TERMS];
+        let mut hk = 1.0;
+        let mut inv_binom = 1.0;
+        for (k, rk) in r.iter().enumerate().take(LOW_TERMS) {
+            if k > 0 {
+                hk *= mode.h;
+                inv_binom *= k as f64 / (n - k + 1) as f64;
+            }
+            let mut ratio = inv_binom;
+            for (j, b) in bern.iter_mut().enumerate().skip(k) {
+                if j > k {
+                    ratio *= j as f64 / (j - k) as f64;
+                }
+                *b += rk * (ratio * hk);
+            }
+        }
+        let bern_norm = bern.iter().map(|b| b.abs().sum()).fold(0.0, f64::max);
+        // (f − f(0))/s = Σ_{k≥1} a_k s^{k−1}: degree LOW_TERMS − 2.
+        let m = LOW_TERMS - 2;
+        let mut bern_after_zero = [W::zeros(); LOW_TERMS - 1];
+        let mut hk = 1.0;
+        let mut inv_binom = 1.0;
+        for (k, rk) in r.iter().enumerate().take(LOW_TERMS).skip(1) {
+            hk *= mode.h;
+            let i = k - 1;
+            if i > 0 {
+                inv_binom *= i as f64 / (m - i + 1) as f64;
+            }
+            let mut ratio = inv_binom;
+            for (j, b) in bern_after_zero.iter_mut().enumerate().skip(i) {
+                if j > i {
+                    ratio *= j as f64 / (j - i) as f64;
+                }
+                *b += rk * (ratio * hk);
+            }
+        }
+        Series {
+            c,
+            d,
+            k,
+            r,
+            spread,
+            tail,
+            bern,
+            bern_norm,
+            bern_after_zero,
+        }
+    }
+
+    /// Whether the form, negated when `negated`, starts on its zero and
+    /// is positive over the rest of a step from `w0`: `(f(s) − f(0))/s`
+    /// shown positive as [`Series::positive_over_step`] shows `f`.
+    pub(super) fn positive_after_zero(&self, w0: &W, negated: bool) -> bool {
+        let sign = if negated { -1.0 } else { 1.0 };
+        let scale = w0.amax();
+        let margin =
+            self.tail * scale * (1.0 + 1e-9) + 64.0 * f64::EPSILON * self.bern_norm * scale;
+        self.bern_after_zero
+            .iter()
+            .all(|b| sign * b.dot(w0) > margin)
+    }
+
+    /// Whether the form is on its zero at `value` (its value at `w0`),
+    /// within the rounding the locator allows.
+    pub(super) fn on_zero(&self, value: f64, w0: &W) -> bool {
+        value.abs() <= 64.0 * f64::EPSILON * (self.k.abs() + self.bern_norm * w0.amax())
+    }
+
+    /// Whether the form, negated when `negated`, is positive over a whole
+    /// step of the mode from `w0`: every Bernstein coefficient of its first
+    /// [`LOW_TERMS`] terms exceeds the bound on the rest and the rounding.
+    /// Over the mode's full step, so it holds for a shorter last step too.
+    pub(super) fn positive_over_step(&self, w0: &W, negated: bool) -> bool {
+        let sign = if negated { -1.0 } else { 1.0 };
+        let scale = w0.amax();
+        let margin = self.tail * scale * (1.0 + 1e-9)
+            + 64.0 * f64::EPSILON * (self.k.abs() + self.bern_norm * scale);
+        self.bern
+            .iter()
+            .all(|b| sign * (self.k + b.dot(w0)) > margin)
     }
 
     /// The form along the motion from `w0` (the state `y0`), as a
