@@ -122,6 +122,31 @@ pub struct Tran {
 }
 
 impl Tran {
+    /// The same card with its stop time set to `stop` (s): the step,
+    /// TSTART, TMAX and `uic` kept as the user wrote them, so that a
+    /// suggestion changes nothing but the stop.
+    pub fn with_stop(&self, stop: f64) -> String {
+        let mut card = format!(
+            ".tran {} {}",
+            crate::waveform::format_time(self.tstep),
+            crate::waveform::format_time(stop)
+        );
+        if self.tstart != 0.0 || self.tmax.is_some() {
+            if self.tstart == 0.0 {
+                card += " 0";
+            } else {
+                card += &format!(" {}", crate::waveform::format_time(self.tstart));
+            }
+        }
+        if let Some(tmax) = self.tmax {
+            card += &format!(" {}", crate::waveform::format_time(tmax));
+        }
+        if self.uic {
+            card += " uic";
+        }
+        card
+    }
+
     /// s, the largest step ngspice takes: TMAX, or by default
     /// min(tstep, (tstop − tstart)/50).
     pub fn effective_max_step(&self) -> f64 {
@@ -505,22 +530,26 @@ fn check_tran(
         });
     };
     if tran.tstop < req.chatter_end {
+        let stop = round_up_2(req.stop_at_least.max(req.chatter_end));
         return Err(NetlistError::TranTooShort {
             netlist,
             line: tran.line,
             tstop: tran.tstop,
             tstep: tran.tstep,
             chatter_end: req.chatter_end,
-            stop: round_up_2(req.stop_at_least.max(req.chatter_end)),
+            stop,
+            card: tran.with_stop(stop),
         });
     }
     if tran.tstop < req.stop_at_least {
+        let wanted = round_up_2(req.stop_at_least);
         warnings.push(DeckWarning::StopShort {
             netlist: netlist.clone(),
             line: tran.line,
             tstop: tran.tstop,
             tstep: tran.tstep,
-            wanted: round_up_2(req.stop_at_least),
+            wanted,
+            card: tran.with_stop(wanted),
         });
     }
     Ok(tran)

@@ -174,6 +174,20 @@ fn tran_checks() {
     );
     let d = deck(".TRAN 1u 6ms").unwrap();
     assert!(matches!(d.warnings[..], [DeckWarning::StopShort { .. }]));
+    // A suggestion keeps the user's step, TMAX and UIC.
+    let e = deck(".tran 1e-7 4m 0 2u uic").unwrap_err();
+    assert!(
+        e.to_string().contains("e.g. `.tran 1e-7 8e-3 0 2e-6 uic`"),
+        "{e}"
+    );
+    let d = deck(".tran 1e-7 6m 0 2u UIC").unwrap();
+    assert!(
+        d.warnings[0]
+            .to_string()
+            .contains("use `.tran 1e-7 8e-3 0 2e-6 uic`"),
+        "{}",
+        d.warnings[0]
+    );
     let d = deck(".tran 1u\n+ 10m 0 5u UIC").unwrap();
     assert_eq!(d.tran.tmax, Some(5e-6));
     assert!(d.tran.uic);

@@ -283,12 +283,10 @@ pub enum NetlistError {
     /// The `.tran` stops before the chatter ends.
     #[error(
         "{}: line {line}: `.tran` stops at {} s, before the chatter ends at {} s: set its stop \
-         time to at least {} s, e.g. `.tran {} {}`",
+         time to at least {} s, e.g. `{card}`",
         netlist.display(),
         format_time(*tstop),
         format_time(*chatter_end),
-        format_time(*stop),
-        format_time(*tstep),
         format_time(*stop)
     )]
     TranTooShort {
@@ -304,6 +302,9 @@ pub enum NetlistError {
         chatter_end: f64,
         /// s, the stop time to use.
         stop: f64,
+        /// The user's card with that stop time (step, TSTART, TMAX and
+        /// `uic` kept).
+        card: String,
     },
     /// A probe's signal is not `v(node)`, `v(node1,node2)` or `i(vsource)`.
     #[error(
@@ -357,6 +358,9 @@ pub enum DeckWarning {
         tstep: f64,
         /// s, the stop time to use instead.
         wanted: f64,
+        /// The user's card with that stop time (step, TSTART, TMAX and
+        /// `uic` kept).
+        card: String,
     },
     /// The first line, which ngspice takes as the title, looks like a
     /// dot-card.
@@ -421,16 +425,14 @@ impl fmt::Display for DeckWarning {
                 netlist,
                 line,
                 tstop,
-                tstep,
-                wanted,
+                card,
+                ..
             } => write!(
                 f,
                 "{}: line {line}: `.tran` stops at {} s, soon after the chatter: to see the \
-                 circuit settle, use `.tran {} {}`",
+                 circuit settle, use `{card}`",
                 netlist.display(),
-                format_time(*tstop),
-                format_time(*tstep),
-                format_time(*wanted)
+                format_time(*tstop)
             ),
             DeckWarning::TitleIsCard { netlist, text } => write!(
                 f,

@@ -131,7 +131,7 @@ fn an_ngspice_sweep_with_samples_that_never_close_completes_and_records_them() {
     assert!(
         rows[6].contains(",resolved,19,")
             && rows[6].contains(",error,,")
-            && rows[6].contains("`.tran 1e-7 1.2e-2`"),
+            && rows[6].contains("`.tran 1e-7 1.2e-2 0 2e-6 uic`"),
         "{}",
         rows[6]
     );
