@@ -4,8 +4,10 @@
 //!
 //! A datasheet prints the coil (voltage, resistance), pick-up and drop-out
 //! voltages and operate/release times; it does not print the armature's
-//! mass, travel or magnet geometry. Those are generic assumptions of each
-//! part's prior (`parts/priors/`), and the fit moves the preload, the
+//! mass, travel or magnet geometry, nor the contact blade and the
+//! overtravel to the pole face every part has (docs/model.md §11). Those
+//! are generic assumptions of each part's prior (`parts/priors/`), from the
+//! class ranges of small relays, and the fit moves the preload, the
 //! spring stiffness and (when an operate time is printed) the mass until
 //! the figures are met. The pick-up is computed over the armature's whole
 //! load line ([`crate::coil::pick_up`]), and each part's `[provenance]`
@@ -98,7 +100,7 @@ const PARTS: &[Part] = &[
         class: "reed relay (SIP)",
         source: "Coto Technology 9104 (5 V); Coto 9100/9104 series reed relay datasheet, model 9104 4-pin SIP (5 VDC, coil 175 Ω ±10 %, must operate 3.75 V max., must release 0.5 V min.; operate time including bounce 0.75 ms typ., release time 0.5 ms typ.)",
         contact_rating: "10 W, 0.5 A switching, 1000 V max. (DC/peak AC, resistive)",
-        remark: "the printed operate time includes bounce; it is fitted as the time to first make",
+        remark: "the printed operate time includes bounce; it is fitted as the time to first make. A reed has no separate armature or pole face: the blade stands for the reed's contact tip and the pole face for the seating of the overlapping tips just past the make",
         scenario: bundled_part_text("coto-9104-05"),
     },
     Part {
@@ -122,7 +124,7 @@ const PARTS: &[Part] = &[
         class: "power PCB relay 16 A (industrial)",
         source: "TE Connectivity Schrack RT1 RT314012 (12 VDC); TE datasheet \"Power PCB Relay RT1\" F0144-C Rev. HK1 (operate/release time max. 8/6 ms, bounce time NO/NC max. 4/6 ms) and coil table F0144-B (12 V: pull-in 8.4 V, release 1.2 V, 360 Ω ±10 %)",
         contact_rating: "1 CO 12 A / 16 A, 250 VAC (AgNi 90/10)",
-        remark: "every time is a maximum: the nominal relay is the prior inside them, with the spring moved up to the printed release voltage; the NO contact's bounce time is the one held",
+        remark: "every figure is a bound and the prior (blade and pole face included) meets them all, so the fit held every key: the nominal relay is an assumption inside the datasheet, and the envelope is the honest answer; the NO contact's bounce time is the one held",
         scenario: bundled_part_text("te-rt1-rt314012"),
     },
     Part {
@@ -146,7 +148,7 @@ const PARTS: &[Part] = &[
         class: "miniature PCB relay (white goods, industrial)",
         source: "TE Connectivity Schrack REL, 5 VDC; TE datasheet \"Miniature PCB Relay REL\" Rev. 0511 (5 V: operate 3.75 V, release 0.5 V, 70 Ω ±10 %, 357 mW; operate/release time max. 10/5 ms; bounce time max. 4 ms)",
         contact_rating: "1 form A 5 A, 250 VAC (AgNi 90/10, AgCdO)",
-        remark: "every time is a maximum: the nominal relay is the prior inside them, with the spring moved up to the printed release voltage",
+        remark: "every time is a maximum: the nominal relay is the prior inside them, with the preload moved to the printed operate voltage",
         scenario: bundled_part_text("te-rel-5v"),
     },
 ];

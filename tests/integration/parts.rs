@@ -207,3 +207,45 @@ fn every_part_envelope_keeps_relays_and_gives_a_band() {
         assert!(bounces.max > bounces.min, "{}: {bounces:?}", part.name);
     }
 }
+
+/// Every part's envelope can be simulated relay by relay: at 64 samples
+/// `check --envelope` on `base = "part:NAME"` (no circuit) reports no relay
+/// NOT EVALUATED (none whose armature reaches the magnet's pole, none the
+/// engine refuses) and keeps relays.
+#[test]
+fn every_part_envelope_evaluates_every_relay_at_64_samples() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut names = Vec::new();
+    for part in parts::all() {
+        let file = dir.path().join(format!("{}.toml", part.name));
+        std::fs::write(&file, format!("base = \"part:{}\"\n", part.name)).unwrap();
+        let out = Command::cargo_bin("chatterspice")
+            .unwrap()
+            .args(["check", "--envelope", "--samples", "64", "--jobs", "2"])
+            .args(["--format", "json"])
+            .arg(&file)
+            .output()
+            .unwrap();
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
+            panic!(
+                "{}: {e}: {}",
+                part.name,
+                String::from_utf8_lossy(&out.stderr)
+            )
+        });
+        let envelope = &json["envelope"];
+        assert_eq!(envelope["samples"], 64, "{}", part.name);
+        let failed = envelope["failed"].as_u64().expect("a failed count");
+        let failures = envelope["failures"].as_array().expect("a failures list");
+        assert!(
+            failed == 0 && failures.is_empty(),
+            "{}: {failed} relays not evaluated: {failures:?}",
+            part.name
+        );
+        let kept = envelope["kept"].as_u64().expect("a kept count");
+        assert!(kept > 0, "{}: no relay kept", part.name);
+        names.push(part.name);
+    }
+    assert_eq!(names.len(), parts::all().len());
+    assert!(names.len() >= 11, "{names:?}");
+}
