@@ -778,7 +778,9 @@ pub struct SweepArgs {
     pub resume: Option<PathBuf>,
 
     /// Simulate the mechanics only (bounces and times, no circuit, no
-    /// ngspice): microseconds per sample.
+    /// ngspice): microseconds per sample. A coil-driven relay closes on the
+    /// ideal DC step of its coil (`coil.drive_voltage`, else
+    /// `datasheet.coil_voltage`), as `bounce` and `check` simulate it.
     #[arg(long)]
     pub mechanics_only: bool,
 

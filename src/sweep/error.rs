@@ -95,11 +95,25 @@ pub enum SweepError {
     /// A mechanics-only sweep of a coil-driven relay, which moves only in
     /// its driver circuit.
     #[error(
-        "{}: a coil-driven relay moves only in its driver circuit: drop --mechanics-only \
-         (each sample then runs the coupled ngspice simulation)",
+        "{}: a coil-driven relay without its circuit closes on the DC step of its coil, and \
+         this one gives no voltage for it: set `coil.drive_voltage` (or \
+         `datasheet.coil_voltage`), or drop --mechanics-only (each sample then runs the \
+         coupled ngspice simulation)",
         path.display()
     )]
     CoilNeedsCircuit {
+        /// The scenario file.
+        path: PathBuf,
+    },
+    /// A mechanics-only sweep of a scenario with release limits: the DC
+    /// step never switches the coil off.
+    #[error(
+        "{}: the release limits (max_release_time, max_nc_bounce_time, max_nc_bounces) need \
+         the coil switched off in the driver circuit: drop --mechanics-only, or remove those \
+         limits",
+        path.display()
+    )]
+    ReleaseLimitsNeedCircuit {
         /// The scenario file.
         path: PathBuf,
     },

@@ -251,8 +251,19 @@ pub fn run_from(
 /// The probed signals of a sweep, or why it cannot run.
 fn signals(scenario: &Scenario, options: &SweepOptions<'_>) -> Result<Vec<String>, SweepError> {
     Ok(match options.mode {
-        SweepMode::Mechanics if scenario.coil.is_some() => {
+        SweepMode::Mechanics if scenario.coil.is_some() && scenario.dc_step().is_none() => {
             return Err(SweepError::CoilNeedsCircuit {
+                path: scenario.origin.clone(),
+            });
+        }
+        SweepMode::Mechanics
+            if scenario.limits.is_some_and(|l| {
+                l.max_release_time.is_some()
+                    || l.max_nc_bounce_time.is_some()
+                    || l.max_nc_bounces.is_some()
+            }) =>
+        {
+            return Err(SweepError::ReleaseLimitsNeedCircuit {
                 path: scenario.origin.clone(),
             });
         }
@@ -376,12 +387,21 @@ impl<'a, 'r> Worker<'a, 'r> {
         let plan = &self.plan;
         let scenario = plan.scenario();
         if scenario.coil.is_some() {
-            // The relay moves only in its circuit: the coupled run gives
-            // the chatter too.
+            // Without the circuit, the relay closes on the ideal DC step of
+            // its coil, as `bounce` and `check` simulate it (closing times
+            // from the coil being energized at t = 0).
             let SweepMode::Circuit(runner) = self.options.mode else {
-                record.error = Some("a coil-driven relay needs the circuit".to_owned());
+                match crate::check::relay_chatter(scenario) {
+                    Ok(chatter) => {
+                        record_chatter(&mut record, &chatter);
+                        (record.verdict, record.failed_limits) = verdict(scenario, &chatter, None);
+                    }
+                    Err(e) => record.error = Some(one_line(&e)),
+                }
                 return record;
             };
+            // The relay moves in its circuit: the coupled run gives the
+            // chatter too.
             match pipeline::run_plan(plan, runner, &self.options.run) {
                 Ok(result) => {
                     record_chatter(&mut record, &result.chatter);

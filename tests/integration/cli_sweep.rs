@@ -1056,3 +1056,59 @@ fn merge_refuses_shards_without_their_identity_unless_told() {
     assert_eq!(summary["identity"], "unverified", "{summary}");
     assert_eq!(summary["seed"], serde_json::Value::Null);
 }
+
+/// `--mechanics-only` on a coil-driven part: each sample closes on the DC
+/// step of its coil, as `bounce` simulates it (the same bounce count and
+/// settle time, sample by sample).
+#[test]
+fn a_mechanics_only_sweep_runs_a_coil_part_on_its_dc_step() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = dir.path().join("part.toml");
+    std::fs::write(
+        &s,
+        "base = \"part:te-axicom-im-5v\"\n\n[sweep.grid]\n\
+         \"coil.resistance\" = { from = 160.0, to = 200.0, steps = 3 }\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    chatterspice()
+        .arg("sweep")
+        .arg(&s)
+        .args(["--mechanics-only", "--out"])
+        .arg(&out)
+        .assert()
+        .success();
+    let mut reader = csv::Reader::from_path(out.join("sweep.csv")).unwrap();
+    let header = reader.headers().unwrap().clone();
+    let column = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let rows: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
+    assert_eq!(rows.len(), 3);
+    for row in &rows {
+        assert_eq!(&row[column("error")], "", "{row:?}");
+        let resistance: f64 = row[column("coil.resistance")].parse().unwrap();
+        let one = dir.path().join("one.toml");
+        std::fs::write(
+            &one,
+            format!("base = \"part:te-axicom-im-5v\"\n\n[coil]\nresistance = {resistance:e}\n"),
+        )
+        .unwrap();
+        let bounce: serde_json::Value = serde_json::from_slice(
+            &chatterspice()
+                .args(["bounce", one.to_str().unwrap(), "--format", "json"])
+                .output()
+                .unwrap()
+                .stdout,
+        )
+        .unwrap();
+        assert_eq!(
+            row[column("bounce_count")].parse::<u64>().unwrap(),
+            bounce["bounce_count"].as_u64().unwrap(),
+            "{row:?}"
+        );
+        let settle: f64 = row[column("settle_time")].parse().unwrap();
+        assert!(
+            (settle - bounce["settle_time"].as_f64().unwrap()).abs() < 1e-12,
+            "{row:?}"
+        );
+    }
+}
