@@ -157,8 +157,9 @@ pub struct RunArgs {
     pub format: RunFormat,
 
     /// Also write every artefact into DIR: report.json, waveforms.csv,
-    /// netlist.cir, contact.inc, plot.svg, plot.png. Existing files there are an
-    /// error unless --force.
+    /// waveforms_ideal.csv, waveforms.raw, waveforms_ideal.raw (every saved
+    /// vector, as ngspice binary raw files), netlist.cir, contact.inc,
+    /// plot.svg, plot.png. Existing files there are an error unless --force.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
 
@@ -587,6 +588,8 @@ fn refuse_existing_bundle(dir: &Path, force: bool) -> Result<()> {
         "report.json",
         "waveforms.csv",
         "waveforms_ideal.csv",
+        "waveforms.raw",
+        "waveforms_ideal.raw",
         "netlist.cir",
         pipeline::INCLUDE_FILE,
         "plot.svg",

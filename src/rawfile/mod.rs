@@ -77,6 +77,7 @@ mod stream;
 #[cfg(test)]
 mod tests;
 mod types;
+mod write;
 
 pub use error::{Position, RawError};
 pub use stream::stream_csv;
@@ -84,3 +85,4 @@ pub use types::{
     Complex64, Dialect, Encoding, Flags, MAX_LOADED_BYTES, Plot, RawFile, RawWarning, Step,
     Variable, Vector,
 };
+pub use write::to_binary;

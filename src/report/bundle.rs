@@ -6,6 +6,8 @@
 //! | `report.json` | the `run` JSON ([`json::render_run`]) |
 //! | `waveforms.csv` | time, contact resistance and every probe, at ngspice's time points |
 //! | `waveforms_ideal.csv` | the same for the ideal-contact run, when there was one |
+//! | `waveforms.raw` | the bounced run's whole transient plot, every saved vector, as an ngspice binary raw file |
+//! | `waveforms_ideal.raw` | the same for the ideal-contact run, when there was one |
 //! | `netlist.cir` | the deck that was run: the user's netlist plus the `.include` |
 //! | `contact.inc` | the contact subcircuit (and any data files it reads) |
 //! | `plot.svg` | the contact and the probes over the chatter |
@@ -61,6 +63,16 @@ pub fn run_files(
         files.push((
             "waveforms_ideal.csv".to_owned(),
             csv::waveforms(&ideal.plot, None, &signals)?.into_bytes(),
+        ));
+    }
+    files.push((
+        "waveforms.raw".to_owned(),
+        crate::rawfile::to_binary(&run.simulation.plot),
+    ));
+    if let Some(ideal) = &run.ideal {
+        files.push((
+            "waveforms_ideal.raw".to_owned(),
+            crate::rawfile::to_binary(&ideal.plot),
         ));
     }
     files.push(("netlist.cir".to_owned(), run.deck.text.clone().into_bytes()));

@@ -97,6 +97,8 @@ fn out_writes_every_artefact_and_never_overwrites_without_force() {
         "report.json",
         "waveforms.csv",
         "waveforms_ideal.csv",
+        "waveforms.raw",
+        "waveforms_ideal.raw",
         "netlist.cir",
         "contact.inc",
         "plot.svg",
@@ -126,6 +128,19 @@ fn out_writes_every_artefact_and_never_overwrites_without_force() {
         .unwrap();
     assert!(rerun.status.success(), "{rerun:?}");
     assert!(out.join("again.raw").is_file());
+    // The kept raw file is that run's plot, value for value.
+    let kept = chatterspice::rawfile::RawFile::read(out.join("waveforms.raw")).unwrap();
+    let again = chatterspice::rawfile::RawFile::read(out.join("again.raw")).unwrap();
+    let tran = |f: &chatterspice::rawfile::RawFile| {
+        f.plots
+            .iter()
+            .find(|p| p.name == "Transient Analysis")
+            .cloned()
+            .unwrap()
+    };
+    let (kept, again) = (tran(&kept), tran(&again));
+    assert_eq!(kept.points(), again.points());
+    assert_eq!(kept.real("v(in)"), again.real("v(in)"));
 
     // A second run refuses, names the file, and leaves everything as it was.
     std::fs::write(out.join("plot.svg"), "my edits").unwrap();
