@@ -48,7 +48,20 @@ pub fn run_files(
     run: &RunResult,
     dimensionless: Option<&Dimensionless>,
 ) -> Result<Vec<(String, Vec<u8>)>, BundleError> {
-    let signals: Vec<&str> = run.probes.iter().map(|p| p.probe.signal.as_str()).collect();
+    // The probes' signals; without probes, every vector the run saved.
+    let plot_vectors = |plot: &'_ crate::rawfile::Plot| -> Vec<String> {
+        plot.variables
+            .iter()
+            .skip(1)
+            .map(|v| v.name.clone())
+            .collect()
+    };
+    let all: Vec<String> = plot_vectors(&run.simulation.plot);
+    let signals: Vec<&str> = if run.probes.is_empty() {
+        all.iter().map(String::as_str).collect()
+    } else {
+        run.probes.iter().map(|p| p.probe.signal.as_str()).collect()
+    };
     let mut files = vec![
         (
             "report.json".to_owned(),

@@ -124,6 +124,13 @@ pub fn render_run(run: &RunResult) -> String {
     }
 
     out.push('\n');
+    if run.probes.is_empty() {
+        let _ = writeln!(
+            out,
+            "probes   none: nothing measured; add a [[probe]] to measure a signal, or keep \
+             every saved vector with --out DIR (waveforms.csv, waveforms.raw)"
+        );
+    }
     let mut rows = vec![PROBE_HEADER.map(String::from)];
     for p in &run.probes {
         rows.push(probe_row(&p.analysis.signal, &p.analysis));
@@ -131,7 +138,9 @@ pub fn render_run(run: &RunResult) -> String {
             rows.push(probe_row("  ideal contact", ideal));
         }
     }
-    out.push_str(&align(&rows, 1));
+    if !run.probes.is_empty() {
+        out.push_str(&align(&rows, 1));
+    }
 
     for p in &run.probes {
         out.push('\n');

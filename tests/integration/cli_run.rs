@@ -607,3 +607,48 @@ fn a_coil_driven_bundle_runs_again_by_hand() {
     );
     assert!(out.join("again.raw").metadata().unwrap().len() > 1000);
 }
+
+/// A circuit with no `[[probe]]` runs: the relay, the contact and every
+/// vector ngspice saved (in the CSV and the raw file), nothing measured.
+#[test]
+fn a_circuit_without_probes_runs_and_keeps_every_vector() {
+    let _ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    let default = chatterspice::scenario::DEFAULT_SCENARIO_TOML;
+    let cut = default.find("[[probe]]").unwrap();
+    let netlist = format!("{}/netlists/mcu_input.cir", env!("CARGO_MANIFEST_DIR"));
+    let text = default[..cut].replace("../netlists/mcu_input.cir", &netlist);
+    let path = dir.path().join("noprobe.toml");
+    std::fs::write(&path, text).unwrap();
+    let out = dir.path().join("out");
+    let assert = chatterspice()
+        .args([
+            "run",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .assert()
+        .success();
+    let table = String::from_utf8_lossy(&assert.get_output().stdout).into_owned();
+    assert!(table.contains("probes   none"), "{table}");
+    let csv = std::fs::read_to_string(out.join("waveforms.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    // Every node of the MCU input, not only a probed one.
+    for vector in ["v(vdd)", "v(sw)", "v(in)"] {
+        assert!(header.split(',').any(|c| c == vector), "{header}");
+    }
+    let raw = chatterspice::rawfile::RawFile::read(out.join("waveforms.raw")).unwrap();
+    let plot = raw.plots.last().unwrap();
+    assert_eq!(plot.points(), csv.lines().count() - 1);
+    let doc: serde_json::Value = serde_json::from_slice(
+        &chatterspice()
+            .args(["run", path.to_str().unwrap(), "--format", "json"])
+            .output()
+            .unwrap()
+            .stdout,
+    )
+    .unwrap();
+    assert_eq!(doc["probes"].as_array().unwrap().len(), 0);
+    assert!(doc["bounce"]["bounce_count"].as_u64().unwrap() > 0);
+}
