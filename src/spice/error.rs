@@ -26,7 +26,7 @@ impl fmt::Display for RunContext {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "  work directory: {}", self.workdir.display())?;
         if !self.kept {
-            write!(f, " (removed; keep it with keep_workdir)")?;
+            write!(f, " (removed; keep it with --keep-workdir)")?;
         }
         if self.log_tail.trim().is_empty() {
             write!(f, "\n  ngspice printed nothing")
