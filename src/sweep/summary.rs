@@ -433,7 +433,13 @@ impl Summary {
         ];
         for p in &self.probes {
             rows.push((format!("{} edges", p.signal), &p.edges, ""));
-            rows.push((format!("{} peak", p.signal), &p.peak, ""));
+            // A probe reads a voltage `v(...)` or a current `i(...)`.
+            let unit = if p.signal.to_ascii_lowercase().starts_with("i(") {
+                "A"
+            } else {
+                "V"
+            };
+            rows.push((format!("{} peak", p.signal), &p.peak, unit));
         }
         rows.retain(|(_, d, _)| d.is_some());
         // The name column fits the longest probe name.

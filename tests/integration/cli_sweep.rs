@@ -115,7 +115,13 @@ fn an_ngspice_sweep_with_samples_that_never_close_completes_and_records_them() {
         .assert()
         // One sample could not run (below), so not every sample passed.
         .code(1)
-        .stdout(predicate::str::contains("never_closes 3"));
+        .stdout(predicate::str::contains("never_closes 3"))
+        // The probe's peak in its unit.
+        .stdout(predicate::function(|out: &str| {
+            out.lines()
+                .find(|l| l.starts_with("v(in) peak"))
+                .is_some_and(|l| l.trim_end().ends_with(" V"))
+        }));
     let text = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
     let rows: Vec<&str> = text.lines().skip(1).collect();
     assert_eq!(rows.len(), 10, "{text}");
