@@ -297,6 +297,11 @@ impl Expanded {
     /// line) its key came from: the topmost layer that gives the key or,
     /// failing that, the closest enclosing table.
     pub(super) fn relocate(&self, mut error: ScenarioError) -> ScenarioError {
+        // The parser quotes the merged document, lines and all: keep its
+        // words only, the location below is the file's own.
+        if self.layers.len() > 1 {
+            error.forget_merged_text();
+        }
         let key = error.key().map(str::to_owned);
         let Some(at) = error.location_mut() else {
             return error;

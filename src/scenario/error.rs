@@ -241,6 +241,25 @@ macro_rules! located {
 }
 
 impl ScenarioError {
+    /// The parser's error reduced to its message: for an error found in a
+    /// merged document (a scenario with its bases), whose quoted text and
+    /// line numbers are the merged document's, not any file's.
+    pub(super) fn forget_merged_text(&mut self) {
+        let plain = |e: &toml::de::Error| -> Box<toml::de::Error> {
+            Box::new(<toml::de::Error as serde::de::Error>::custom(e.message()))
+        };
+        match self {
+            ScenarioError::Syntax { source, .. }
+            | ScenarioError::UnknownKey { source, .. }
+            | ScenarioError::BadValue { source, .. } => *source = plain(source),
+            ScenarioError::MissingKey {
+                source: Some(source),
+                ..
+            } => *source = plain(source),
+            _ => {}
+        }
+    }
+
     /// The place in a scenario file the error points at, when it points
     /// at one (its file and line).
     pub fn location(&self) -> Option<&Location> {

@@ -652,3 +652,29 @@ fn a_circuit_without_probes_runs_and_keeps_every_vector() {
     assert_eq!(doc["probes"].as_array().unwrap().len(), 0);
     assert!(doc["bounce"]["bounce_count"].as_u64().unwrap() > 0);
 }
+
+/// An error in the user's own `[[probe]]` under `base = "default"` names
+/// the user's file and its line there, and quotes no line of the merged
+/// document nor any path of the machine the binary was built on.
+#[test]
+fn an_error_under_a_base_names_the_users_own_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("mine.toml");
+    std::fs::write(
+        &path,
+        "base = \"default\"\n\n[[probe]]\nsignal = \"v(in)\"\nlow = 0.99\nhigh = 2.31\n\
+         max_edgez = 3\n",
+    )
+    .unwrap();
+    let out = chatterspice()
+        .args(["run", path.to_str().unwrap()])
+        .assert()
+        .code(2);
+    let stderr = String::from_utf8_lossy(&out.get_output().stderr).into_owned();
+    assert!(stderr.contains("mine.toml:7:"), "{stderr}");
+    assert!(stderr.contains("max_edgez"), "{stderr}");
+    assert!(!stderr.contains(env!("CARGO_MANIFEST_DIR")), "{stderr}");
+    // The file has 7 lines: no other line number may appear.
+    assert!(!stderr.contains("line "), "{stderr}");
+    assert!(!stderr.contains(" | "), "{stderr}");
+}

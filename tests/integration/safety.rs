@@ -374,7 +374,8 @@ fn a_run_bundle_is_all_or_nothing() {
             "plot.png",
             "plot.svg",
             "report.json",
-            "waveforms.csv"
+            "waveforms.csv",
+            "waveforms.raw"
         ]
     );
     // A fresh directory: a run that fails leaves nothing to block its rerun.
