@@ -591,7 +591,11 @@ fn the_bundled_example_released_by_position_agrees_with_the_reference() {
     let reference = relay.reference(settle + 3e-4);
     let touches: Vec<&Ev> = reference.iter().filter(|e| e.kind == Kind::Touch).collect();
     assert_eq!(run.contact.impacts.len(), touches.len(), "contacts");
-    for (i, r) in run.contact.impacts.iter().zip(&touches) {
+    let releases: Vec<&Ev> = reference
+        .iter()
+        .filter(|e| e.kind == Kind::Release)
+        .collect();
+    for (k, (i, r)) in run.contact.impacts.iter().zip(&touches).enumerate() {
         assert!(
             i.impact_velocity > 0.0,
             "an impact at {} approaches backwards",
@@ -603,7 +607,14 @@ fn the_bundled_example_released_by_position_agrees_with_the_reference() {
             i.impact_time,
             r.t
         );
+        // Every contact but the last releases, at the reference's time.
+        match (i.release_time, releases.get(k)) {
+            (Some(t), Some(r)) => assert!((t - r.t).abs() <= 1e-6 * r.t, "{t} against {}", r.t),
+            (None, None) => {}
+            other => panic!("release {k}: {other:?}"),
+        }
     }
+    assert_eq!(run.contact.bounce_count, releases.len());
 }
 
 /// The one-mass engines (Kelvin–Voigt in closed form, Hunt–Crossley by
