@@ -547,7 +547,11 @@ fn check_envelope(
         ),
         RunFormat::Table => format!(
             "{}\n{}",
-            report::table::render_check(
+            report::table::render_check_of(
+                &format!(
+                    "worst relay (index {} of {} drawn)",
+                    worst.index, env.report.samples
+                ),
                 verdict,
                 worst.evidence.chatter(),
                 worst.evidence.operations()

@@ -409,6 +409,17 @@ pub fn render_probes(probes: &[ProbeAnalysis]) -> String {
 /// A check for a person: the verdict, the relay in one line, then one row
 /// per limit with its margin, failures marked.
 pub fn render_check(verdict: &Verdict, chatter: &Chatter, operations: &[Operation]) -> String {
+    render_check_of("relay", verdict, chatter, operations)
+}
+
+/// [`render_check`] with the relay's line labelled `label` (e.g. `worst
+/// relay 16 of 32`, for a check over an envelope).
+pub fn render_check_of(
+    label: &str,
+    verdict: &Verdict,
+    chatter: &Chatter,
+    operations: &[Operation],
+) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
@@ -420,7 +431,7 @@ pub fn render_check(verdict: &Verdict, chatter: &Chatter, operations: &[Operatio
     let closing = Closing::first(chatter, operations);
     let _ = writeln!(
         out,
-        "relay: {}, {} bounces, operate {}, bounce time {}, closed for good {}{}",
+        "{label}: {}, {} bounces, operate {}, bounce time {}, closed for good {}{}",
         chatter.outcome,
         chatter.bounce_count,
         ms(closing.operate_time),
