@@ -1156,7 +1156,7 @@ mod tests {
         assert_eq!(engineering(12.5e-6, "s"), "12.5 µs");
         assert_eq!(engineering(0.05, "Ω"), "50 mΩ");
         assert_eq!(engineering(1e9, "Ω"), "1 GΩ");
-        assert_eq!(engineering(999.6e-6, "s"), "1000 µs");
+        assert_eq!(engineering(999.6e-6, "s"), "1 ms");
         assert_eq!(significant(0.99, 0, "V"), "0.99 V");
         assert_eq!(significant(-0.0001, -3, "A"), "-0.1 mA");
         let a = Axis::linear(-0.2, 3.5, 6).with_unit("V");

@@ -608,6 +608,12 @@ fn sig(value: Option<f64>, unit: &str) -> String {
         return format!("{v}{unit}");
     }
     let magnitude = v.abs().log10().floor() as i32;
+    // Far below the column's unit (a force released at zero, less its
+    // rounding): four significant digits with an exponent, never a row of
+    // zeros.
+    if magnitude < -3 {
+        return format!("{v:.3e}{unit}");
+    }
     let decimals = (DIGITS - 1 - magnitude).clamp(0, 12) as usize;
     format!("{v:.decimals$}{unit}")
 }

@@ -26,7 +26,14 @@ pub fn engineering(value: f64, unit: &str) -> String {
     if value == 0.0 || !value.is_finite() {
         return format!("0 {unit}");
     }
-    let exponent = (3.0 * (value.abs().log10() / 3.0).floor()).clamp(-15.0, 12.0) as i32;
+    let mut exponent = (3.0 * (value.abs().log10() / 3.0).floor()).clamp(-15.0, 12.0) as i32;
+    // 999.96 µs rounds to three digits as 1000 µs: that is 1 ms.
+    let scaled = value.abs() / 10f64.powi(exponent);
+    let digits = (2 - scaled.log10().floor() as i32).clamp(0, 15);
+    let rounded = (scaled * 10f64.powi(digits)).round() / 10f64.powi(digits);
+    if rounded >= 1000.0 && exponent < 12 {
+        exponent += 3;
+    }
     significant(value, exponent, unit)
 }
 
@@ -48,4 +55,18 @@ pub(crate) fn significant(value: f64, exponent: i32, unit: &str) -> String {
         text = "0".to_owned();
     }
     format!("{text} {}{unit}", prefix(exponent))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_value_that_rounds_up_to_the_next_prefix_takes_it() {
+        assert_eq!(engineering(0.000_999_96, "s"), "1 ms");
+        assert_eq!(engineering(999.96, "V"), "1 kV");
+        assert_eq!(engineering(0.000_999_4, "s"), "999 µs");
+        assert_eq!(engineering(12.5e-6, "s"), "12.5 µs");
+        assert_eq!(engineering(-0.000_999_96, "s"), "-1 ms");
+    }
 }
