@@ -254,9 +254,15 @@ pub fn overlay_svg_with(
         .collect();
     lane(&mut svg, 30.0, "measured", &measured_steps, "#1f77b4");
     lane(&mut svg, 170.0, "fitted", &model_steps, "#d62728");
+    // The axis ends in engineering units ("0 s", "12.5 ms"), as the other
+    // plots write them.
+    let (from, to) = (
+        crate::report::units::engineering(start, "s"),
+        crate::report::units::engineering(end, "s"),
+    );
     let _ = writeln!(
         svg,
-        r#"<text x="{left}" y="{}">{start:.4e} s</text><text x="{}" y="{}" text-anchor="end">{end:.4e} s</text>"#,
+        r#"<text x="{left}" y="{}">{from}</text><text x="{}" y="{}" text-anchor="end">{to}</text>"#,
         h - 8.0,
         w - right,
         h - 8.0

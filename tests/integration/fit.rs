@@ -365,6 +365,18 @@ fn the_fit_command_writes_json_a_scenario_and_a_report_and_never_overwrites() {
     let back = Scenario::load(&fitted).expect("the fitted scenario loads");
     assert_eq!(back.surface.damping, Some(damping));
     assert!(report.join("overlay.svg").exists() && report.join("fit.json").exists());
+    // The overlay's time axis reads in engineering units, not `0.0000e0 s`.
+    let overlay = std::fs::read_to_string(report.join("overlay.svg")).unwrap();
+    assert!(
+        !overlay.contains("e0 s") && !overlay.contains("e-3 s"),
+        "{overlay}"
+    );
+    assert!(
+        overlay.contains(">0 s</text>")
+            || overlay.contains(" µs</text>")
+            || overlay.contains(" ms</text>"),
+        "{overlay}"
+    );
     // A second run refuses to overwrite without --force.
     Command::cargo_bin("chatterspice")
         .unwrap()
