@@ -346,7 +346,13 @@ pub fn run(
             .collect(),
         limit,
     });
+    let units = draw
+        .keys
+        .iter()
+        .map(|k| (k.clone(), scenario.unit_of_key(k)))
+        .collect();
     let report = EnvelopeReport {
+        units,
         samples: draw.relays.len(),
         kept: kept.len(),
         rejected_relays,

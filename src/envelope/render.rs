@@ -102,7 +102,14 @@ pub fn band_table(report: &EnvelopeReport) -> String {
             let _ = writeln!(
                 out,
                 "  {key:<22} {}",
-                value(*v, crate::scenario::unit_of(key))
+                value(
+                    *v,
+                    report
+                        .units
+                        .get(key)
+                        .copied()
+                        .unwrap_or_else(|| crate::scenario::unit_of(key))
+                )
             );
         }
     }

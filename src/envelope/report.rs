@@ -88,4 +88,8 @@ pub struct EnvelopeReport {
     pub quantities: BTreeMap<String, Band>,
     /// The worst kept relay.
     pub worst: Option<WorstRelay>,
+    /// Each sampled key's unit in this scenario (a surface's stiffness in
+    /// its law's unit), for the table.
+    #[serde(skip)]
+    pub units: BTreeMap<String, &'static str>,
 }

@@ -144,6 +144,24 @@ impl Scenario {
 
     /// The surface law, with a Hunt–Crossley restitution already converted
     /// to χ.
+    /// The SI unit of number key `key` in this scenario: as
+    /// [`super::unit_of`], with a surface's stiffness in the unit its law
+    /// gives it (N/m for Kelvin–Voigt and Hunt–Crossley with n = 1).
+    pub fn unit_of_key(&self, key: &str) -> &'static str {
+        let law = |s: Option<Surface>| match s {
+            Some(Surface::KelvinVoigt { .. }) => Some("N/m"),
+            Some(Surface::HuntCrossley { exponent, .. }) if exponent == 1.0 => Some("N/m"),
+            Some(Surface::HuntCrossley { exponent, .. }) if exponent == 1.5 => Some("N/m^1.5"),
+            _ => None,
+        };
+        let refined = match key {
+            "surface.stiffness" => law(Some(self.surface())),
+            "pole_face.stiffness" => law(self.two_stage().pole_face.map(|p| p.surface)),
+            _ => None,
+        };
+        refined.unwrap_or_else(|| super::unit_of(key))
+    }
+
     pub fn surface(&self) -> Surface {
         self.resolved_surface
     }
