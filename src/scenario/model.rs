@@ -150,8 +150,8 @@ impl Scenario {
     pub fn unit_of_key(&self, key: &str) -> &'static str {
         let law = |s: Option<Surface>| match s {
             Some(Surface::KelvinVoigt { .. }) => Some("N/m"),
-            Some(Surface::HuntCrossley { exponent, .. }) if exponent == 1.0 => Some("N/m"),
-            Some(Surface::HuntCrossley { exponent, .. }) if exponent == 1.5 => Some("N/m^1.5"),
+            Some(Surface::HuntCrossley { exponent: 1.0, .. }) => Some("N/m"),
+            Some(Surface::HuntCrossley { exponent: 1.5, .. }) => Some("N/m^1.5"),
             _ => None,
         };
         let refined = match key {
