@@ -266,12 +266,27 @@ fn absolute_paths(table: &mut toml::Table, origin: &Path) {
 /// `over` merged into `into`, key by key: tables merge, anything else
 /// (values, arrays) replaces; a table whose `law` changes is replaced.
 fn merge(into: &mut toml::Table, over: toml::Table) {
+    merge_in(into, over, None);
+}
+
+/// [`merge`] of the table at `parent` (its key, at the top: `None`). An
+/// `[envelope]` range written in full (its `min` and its `max`) is the
+/// user's range, `log` included: it replaces the base's, never inheriting
+/// a `log = true` the user did not write.
+fn merge_in(into: &mut toml::Table, over: toml::Table, parent: Option<&str>) {
     for (key, value) in over {
+        let full_range = parent == Some("envelope")
+            && matches!(&value, toml::Value::Table(t) if t.contains_key("min") && t.contains_key("max"));
         match (into.get_mut(&key), value) {
             (Some(toml::Value::Table(below)), toml::Value::Table(above))
-                if !law_changes(below, &above) =>
+                if !law_changes(below, &above) && !full_range =>
             {
-                merge(below, above)
+                let at = if parent.is_none() {
+                    Some(key.as_str())
+                } else {
+                    Some("")
+                };
+                merge_in(below, above, at)
             }
             (_, value) => {
                 into.insert(key, value);

@@ -141,3 +141,29 @@ fn the_bundled_part_texts_are_the_parts() {
         assert!(s.coil.is_some(), "{name}");
     }
 }
+
+#[test]
+fn an_envelope_range_written_in_full_replaces_the_bases() {
+    let base = Scenario::parse("base = \"part:te-axicom-im-5v\"\n", Path::new("x.toml")).unwrap();
+    let range = |s: &Scenario| s.envelope.as_ref().unwrap().ranges["surface.stiffness"];
+    assert!(
+        range(&base).log,
+        "the part samples its stiffness on a log scale"
+    );
+    // Written in full: the user's range, linear as written.
+    let full = Scenario::parse(
+        "base = \"part:te-axicom-im-5v\"\n[envelope.\"surface.stiffness\"]\nmin = 1.0e6\nmax = 2.0e6\n",
+        Path::new("x.toml"),
+    )
+    .unwrap();
+    let r = range(&full);
+    assert_eq!((r.min, r.max, r.log), (1.0e6, 2.0e6, false));
+    // One bound alone still amends the base's range, its scale kept.
+    let partial = Scenario::parse(
+        "base = \"part:te-axicom-im-5v\"\n[envelope.\"surface.stiffness\"]\nmax = 3.0e6\n",
+        Path::new("x.toml"),
+    )
+    .unwrap();
+    let r = range(&partial);
+    assert_eq!((r.min, r.max, r.log), (range(&base).min, 3.0e6, true));
+}
