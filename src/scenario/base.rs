@@ -257,6 +257,10 @@ fn absolute_paths(table: &mut toml::Table, origin: &Path) {
     let Some(toml::Value::String(netlist)) = circuit.get_mut("netlist") else {
         return;
     };
+    if let Some(name) = super::builtin::builtin_netlist(origin, netlist) {
+        *netlist = name.to_owned();
+        return;
+    }
     let dir = origin.parent().unwrap_or(Path::new(""));
     let joined = dir.join(&*netlist);
     let absolute = std::path::absolute(&joined).unwrap_or(joined);

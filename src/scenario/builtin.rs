@@ -6,10 +6,15 @@
 /// edit.
 pub const DEFAULT_SCENARIO_TOML: &str = include_str!("../../scenarios/default.toml");
 
-/// Where the built-in scenario lives in the source tree. Its relative
-/// `circuit.netlist` resolves against this directory.
-pub(super) const DEFAULT_SCENARIO_ORIGIN: &str =
-    concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/default.toml");
+/// The built-in scenario's origin, as the user names it (`base =
+/// "default"`): what its messages name, never a path of the checkout the
+/// binary was built in.
+pub(super) const DEFAULT_SCENARIO_ORIGIN: &str = "default";
+
+/// The name the built-in scenario's circuit goes by in messages and
+/// reports. Its text is compiled in ([`DEFAULT_NETLIST`]): this name is
+/// never read from disk.
+pub(super) const DEFAULT_NETLIST_NAME: &str = "default:netlists/mcu_input.cir";
 
 /// The built-in scenario's circuit (`netlists/mcu_input.cir`), compiled in
 /// so that `run` with no scenario works wherever the binary is.
@@ -17,3 +22,13 @@ pub const DEFAULT_NETLIST: &str = include_str!("../../netlists/mcu_input.cir");
 
 /// The built-in scenario's `circuit.netlist`, relative to its file.
 pub(super) const DEFAULT_NETLIST_PATH: &str = "../netlists/mcu_input.cir";
+
+/// The built-in circuit's name when `written` names it: the built-in
+/// scenario's own `circuit.netlist` (at `origin`), or its name itself (as
+/// a scenario on `base = "default"` carries it). It resolves to the
+/// compiled-in text, not to a file.
+pub(super) fn builtin_netlist(origin: &std::path::Path, written: &str) -> Option<&'static str> {
+    let own =
+        origin == std::path::Path::new(DEFAULT_SCENARIO_ORIGIN) && written == DEFAULT_NETLIST_PATH;
+    (own || written == DEFAULT_NETLIST_NAME).then_some(DEFAULT_NETLIST_NAME)
+}

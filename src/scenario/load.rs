@@ -2,14 +2,15 @@
 //! syntax, then shape, then physics, with the bases merged in), and the
 //! built-in scenario ([`Scenario::builtin_default`]).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 use toml::de::DeTable;
 
 use super::base::{self, lexically_normal};
 use super::builtin::{
-    DEFAULT_NETLIST, DEFAULT_NETLIST_PATH, DEFAULT_SCENARIO_ORIGIN, DEFAULT_SCENARIO_TOML,
+    DEFAULT_NETLIST, DEFAULT_NETLIST_NAME, DEFAULT_SCENARIO_ORIGIN, DEFAULT_SCENARIO_TOML,
+    builtin_netlist,
 };
 use super::check::Check;
 use super::circuit::CircuitSection;
@@ -43,23 +44,7 @@ impl Scenario {
         let scenario = syntax(merged, origin)
             .and_then(|tree| Scenario::parse_tree(tree, merged, origin))
             .map_err(|e| expanded.relocate(e))?;
-        // A circuit that is the built-in default's keeps its compiled-in
-        // text, so that it runs wherever the binary is.
-        let default_netlist = lexically_normal(
-            &Path::new(DEFAULT_SCENARIO_ORIGIN)
-                .parent()
-                .unwrap_or(Path::new(""))
-                .join(DEFAULT_NETLIST_PATH),
-        );
-        let embedded = scenario
-            .circuit
-            .as_ref()
-            .filter(|c| c.netlist == default_netlist)
-            .map(|_| DEFAULT_NETLIST);
-        Ok(Scenario {
-            embedded_netlist: embedded,
-            ..scenario
-        })
+        Ok(scenario)
     }
 
     /// Shape and physics of a scenario whose syntax is already checked.
@@ -79,7 +64,10 @@ impl Scenario {
 
         let base = origin.parent().unwrap_or(Path::new(""));
         let circuit = document.circuit.map(|c| CircuitSection {
-            netlist: lexically_normal(&base.join(&c.netlist)),
+            netlist: match builtin_netlist(origin, &c.netlist.to_string_lossy()) {
+                Some(name) => PathBuf::from(name),
+                None => lexically_normal(&base.join(&c.netlist)),
+            },
             ..c
         });
         Scenario {
@@ -107,6 +95,7 @@ impl Scenario {
             resolved_back_stop,
             embedded_netlist: None,
         }
+        .with_builtin_netlist()
         .with_checked_sweep(&check)
     }
 
@@ -115,11 +104,21 @@ impl Scenario {
     /// input.
     pub fn builtin_default() -> Scenario {
         // The unit tests parse it, so a broken file never ships.
-        let scenario = Scenario::parse(DEFAULT_SCENARIO_TOML, Path::new(DEFAULT_SCENARIO_ORIGIN))
-            .expect("the built-in scenario is valid");
+        Scenario::parse(DEFAULT_SCENARIO_TOML, Path::new(DEFAULT_SCENARIO_ORIGIN))
+            .expect("the built-in scenario is valid")
+    }
+
+    /// A circuit that is the built-in one keeps its compiled-in text, so
+    /// that it runs wherever the binary is.
+    fn with_builtin_netlist(self) -> Scenario {
+        let embedded = self
+            .circuit
+            .as_ref()
+            .filter(|c| c.netlist == Path::new(DEFAULT_NETLIST_NAME))
+            .map(|_| DEFAULT_NETLIST);
         Scenario {
-            embedded_netlist: Some(DEFAULT_NETLIST),
-            ..scenario
+            embedded_netlist: embedded,
+            ..self
         }
     }
 }

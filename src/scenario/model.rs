@@ -75,8 +75,8 @@ pub struct Scenario {
     pub(super) resolved_surface: Surface,
     /// `[back_stop]`'s law, resolved as `resolved_surface`.
     pub(super) resolved_back_stop: Option<Surface>,
-    /// The built-in scenario carries its netlist's text, used when the
-    /// file is not on disk (an installed binary).
+    /// The built-in scenario's circuit: its compiled-in text, used in
+    /// place of any file.
     pub(super) embedded_netlist: Option<&'static str>,
 }
 
@@ -86,17 +86,16 @@ impl Scenario {
     pub fn netlist(&self) -> Option<Result<(PathBuf, String), ScenarioError>> {
         let circuit = self.circuit.as_ref()?;
         let path = circuit.netlist.clone();
-        Some(
-            match (crate::input::read_to_string(&path), self.embedded_netlist) {
-                (Ok(text), _) => Ok((path, text)),
-                (Err(_), Some(text)) => Ok((path, text.to_owned())),
-                (Err(source), None) => Err(ScenarioError::NetlistRead {
+        Some(match self.embedded_netlist {
+            Some(text) => Ok((path, text.to_owned())),
+            None => crate::input::read_to_string(&path)
+                .map(|text| (path.clone(), text))
+                .map_err(|source| ScenarioError::NetlistRead {
                     path,
                     scenario: self.origin.clone(),
                     source,
                 }),
-            },
-        )
+        })
     }
 
     /// The step-force mechanics for the engine. Fails for a coil-driven

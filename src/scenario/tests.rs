@@ -106,11 +106,18 @@ fn netlist_paths_are_folded_lexically() {
 #[test]
 fn the_builtin_default_carries_its_netlist() {
     let (path, text) = Scenario::builtin_default().netlist().unwrap().unwrap();
-    assert!(
-        path.ends_with("netlists/mcu_input.cir"),
-        "{}",
-        path.display()
-    );
+    // Named as the user names the scenario, never by a path of the
+    // checkout the binary was built in.
+    assert_eq!(path, Path::new("default:netlists/mcu_input.cir"));
+    assert!(!path.starts_with(env!("CARGO_MANIFEST_DIR")));
+    // And a scenario on `base = "default"` carries the same circuit.
+    let (on_base, text_on_base) =
+        Scenario::parse("base = \"default\"\n", Path::new("/elsewhere/mine.toml"))
+            .unwrap()
+            .netlist()
+            .unwrap()
+            .unwrap();
+    assert_eq!((on_base, text_on_base), (path.clone(), text.clone()));
     assert_eq!(text, DEFAULT_NETLIST);
     assert!(text.contains(" CONTACT"));
 }
@@ -211,12 +218,12 @@ fn builtin_default_is_the_documented_relay() {
     let bounce_time = c.settle_time.unwrap() - c.first_impact.unwrap();
     assert!((0.5e-3..3e-3).contains(&bounce_time), "{bounce_time}");
     assert_eq!(s.settings().t_end, 0.02);
-    let netlist = s.circuit.unwrap().netlist;
-    assert_eq!(
-        netlist,
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("netlists/mcu_input.cir")
-    );
-    assert!(netlist.is_file(), "{netlist:?}");
+    // Its circuit is the checkout's netlists/mcu_input.cir, compiled in
+    // and named as the built-in one.
+    let (name, text) = s.netlist().unwrap().unwrap();
+    assert_eq!(name, Path::new("default:netlists/mcu_input.cir"));
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("netlists/mcu_input.cir");
+    assert_eq!(text, std::fs::read_to_string(&file).unwrap());
     assert_eq!(s.probes, vec![Probe::new("v(in)", 0.99, 2.31)]);
 }
 
