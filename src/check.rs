@@ -728,9 +728,13 @@ pub fn relay_only(scenario: &Scenario) -> Result<(Verdict, Evidence), CheckError
     ))
 }
 
-/// [`relay_chatter`] with the armature's impacts on the pole face, for a
-/// relay that has one.
+/// The relay's own closing, as built, without a circuit: the step force
+/// (the exact one-mass engine, or the two-stage one), or for a coil-driven
+/// relay the ideal DC step of `coil.drive_voltage` (else
+/// `datasheet.coil_voltage`) on its coil, as a datasheet measures; with
+/// the armature's impacts on the pole face, for a relay that has one.
 pub fn relay_closing(scenario: &Scenario) -> Result<(Chatter, Option<Vec<Impact>>), CheckError> {
+    let path = || scenario.origin.clone();
     let build = scenario.two_stage();
     let with_pole = build.pole_face.is_some();
     if scenario.coil.is_some() {
@@ -738,10 +742,15 @@ pub fn relay_closing(scenario: &Scenario) -> Result<(Chatter, Option<Vec<Impact>
         let pole = with_pole.then(|| run.map(|r| r.pole_face).unwrap_or_default());
         return Ok((chatter, pole));
     }
-    if build.is_one_mass() {
-        return relay_chatter(scenario).map(|c| (c, None));
-    }
     let mechanics = scenario.mechanics()?;
+    if build.is_one_mass() {
+        return simulate(&mechanics, &scenario.surface(), &scenario.settings())
+            .map(|chatter| (chatter, None))
+            .map_err(|source| CheckError::Mechanics {
+                path: path(),
+                source,
+            });
+    }
     let trajectory = crate::mechanics::two_stage::step_closing(
         &mechanics,
         &build,
@@ -749,43 +758,16 @@ pub fn relay_closing(scenario: &Scenario) -> Result<(Chatter, Option<Vec<Impact>
         &scenario.settings(),
     )
     .map_err(|source| CheckError::Motion {
-        path: scenario.origin.clone(),
+        path: path(),
         source,
     })?;
     let pole = with_pole.then(|| trajectory.pole_face_impacts().to_vec());
     Ok((trajectory.into_chatter(), pole))
 }
 
-/// The relay's own closing, as built, without a circuit: the step force
-/// (the exact one-mass engine, or the two-stage one), or for a coil-driven
-/// relay the ideal DC step of `coil.drive_voltage` (else
-/// `datasheet.coil_voltage`) on its coil, as a datasheet measures.
+/// [`relay_closing`]'s chatter alone.
 pub fn relay_chatter(scenario: &Scenario) -> Result<Chatter, CheckError> {
-    let path = || scenario.origin.clone();
-    let build = scenario.two_stage();
-    if scenario.coil.is_some() {
-        return dc_step(scenario).map(|(chatter, _)| chatter);
-    }
-    let mechanics = scenario.mechanics()?;
-    if build.is_one_mass() {
-        return simulate(&mechanics, &scenario.surface(), &scenario.settings()).map_err(|source| {
-            CheckError::Mechanics {
-                path: path(),
-                source,
-            }
-        });
-    }
-    crate::mechanics::two_stage::step_closing(
-        &mechanics,
-        &build,
-        &scenario.surface(),
-        &scenario.settings(),
-    )
-    .map(crate::mechanics::Trajectory::into_chatter)
-    .map_err(|source| CheckError::Motion {
-        path: path(),
-        source,
-    })
+    relay_closing(scenario).map(|(chatter, _)| chatter)
 }
 
 /// A coil-driven relay without its driver circuit: the ideal DC step of
