@@ -18,7 +18,7 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
-use std::sync::atomic::{AtomicI32, Ordering};
+use std::sync::atomic::{AtomicI32, AtomicUsize, Ordering};
 
 /// A finisher: run once, at a stop.
 type Finisher = Box<dyn FnOnce() + Send>;
@@ -44,6 +44,10 @@ fn key(registry: &mut Registry) -> u64 {
     registry.next += 1;
     registry.next
 }
+
+/// Cancellations in force (see [`cancel`]): while any is, no child is
+/// started.
+static CANCELLING: AtomicUsize = AtomicUsize::new(0);
 
 /// The signal a stop is under way for, if one is.
 pub fn stopping() -> Option<i32> {
@@ -78,7 +82,7 @@ pub fn spawn_registered<T>(
     pid_of: impl FnOnce(&T) -> u32,
 ) -> std::io::Result<(T, Registered)> {
     with(|r| {
-        if stopping().is_some() {
+        if stopping().is_some() || CANCELLING.load(Ordering::SeqCst) > 0 {
             return Err(std::io::Error::new(
                 std::io::ErrorKind::Interrupted,
                 "the run is being stopped by a signal",
@@ -110,6 +114,19 @@ pub fn finish_at_stop(finish: impl FnOnce() + Send + 'static) -> Registered {
         r.finishers.push((id, Box::new(finish)));
         Registered(id)
     })
+}
+
+/// Runs `f` unless a stop is under way, excluding the stop while it runs:
+/// a write that a finisher reads back (a sweep's rows) is then either
+/// wholly before the finisher or never made. `f` must not register
+/// anything itself. Blocks for good once a stop holds the registry, as
+/// the process is about to exit.
+pub fn unless_stopping<R>(f: impl FnOnce() -> R) -> Option<R> {
+    let _guard = REGISTRY.lock().unwrap_or_else(|e| e.into_inner());
+    if stopping().is_some() {
+        return None;
+    }
+    Some(f())
 }
 
 /// Stops everything registered, as the signal handler does, and returns
@@ -182,4 +199,39 @@ pub fn install() -> std::io::Result<()> {
 #[cfg(not(unix))]
 pub fn install() -> std::io::Result<()> {
     Ok(())
+}
+
+/// A cancellation in force: until it is dropped, starting a child fails
+/// as it does during a stop.
+#[derive(Debug)]
+#[must_use = "new children are refused only while this lives"]
+pub struct Cancelling(());
+
+impl Drop for Cancelling {
+    fn drop(&mut self) {
+        CANCELLING.fetch_sub(1, Ordering::SeqCst);
+    }
+}
+
+/// Stops the work under way without exiting, for an embedding that goes
+/// on running (the Python package on Ctrl-C): refuses new children while
+/// the returned guard lives and kills every registered process group now
+/// (SIGKILL). The runs see their ngspice killed, fail, and reap it and
+/// remove their work directories as they unwind; nothing is reaped here.
+/// It reaches every run of the process, not one caller's.
+pub fn cancel() -> Cancelling {
+    with(|r| {
+        CANCELLING.fetch_add(1, Ordering::SeqCst);
+        #[cfg(unix)]
+        for (_, pid) in &r.children {
+            // SAFETY: kill(2) with a negative pid signals that process
+            // group; it reads no memory of ours.
+            unsafe {
+                libc::kill(-pid, libc::SIGKILL);
+            }
+        }
+        #[cfg(not(unix))]
+        let _ = r;
+        Cancelling(())
+    })
 }

@@ -230,9 +230,21 @@ pub fn run_from(
         for (c, rows, records) in rx {
             pending.insert(c, (rows, records));
             while let Some((rows, records)) = pending.remove(&expected) {
-                if let Err(e) = out.write_all(&rows).and_then(|()| out.flush()) {
-                    stop.store(true, Ordering::Relaxed);
-                    return Err(SweepError::Write(e));
+                // Excluding a stop's finisher, which counts the rows
+                // written and keeps them for `--resume`.
+                let written = crate::interrupt::unless_stopping(|| {
+                    out.write_all(&rows).and_then(|()| out.flush())
+                });
+                match written {
+                    Some(Ok(())) => {}
+                    Some(Err(e)) => {
+                        stop.store(true, Ordering::Relaxed);
+                        return Err(SweepError::Write(e));
+                    }
+                    None => {
+                        stop.store(true, Ordering::Relaxed);
+                        return Ok(());
+                    }
                 }
                 for record in &records {
                     collected.add(record);
