@@ -16,6 +16,7 @@ use std::path::Path;
 use chatterspice::calibrate::fit::FitError;
 use chatterspice::capture::{CaptureError, EdgeError};
 use chatterspice::check::CheckError;
+use chatterspice::envelope::EnvelopeError;
 use chatterspice::pipeline::{CouplingError, PassError, RunError};
 use chatterspice::rawfile::RawError;
 use chatterspice::scenario::{Location, ScenarioError};
@@ -75,6 +76,14 @@ impl Failure {
             key: None,
             location: None,
             io: None,
+        }
+    }
+
+    /// The work of a call failed for a reason of its own.
+    pub fn simulation(message: impl Into<String>) -> Failure {
+        Failure {
+            kind: Kind::Simulation,
+            ..Failure::input(message)
         }
     }
 
@@ -267,5 +276,14 @@ impl From<RunError> for Failure {
             _ => Kind::Input,
         };
         Failure::of(kind, &e)
+    }
+}
+
+impl From<EnvelopeError> for Failure {
+    fn from(e: EnvelopeError) -> Failure {
+        match e {
+            EnvelopeError::Scenario(e) => e.into(),
+            e => Failure::of(Kind::Input, &e),
+        }
     }
 }

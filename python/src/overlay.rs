@@ -14,6 +14,10 @@
 //!   the default's `mechanics.force`, `[circuit]` and `[[probe]]` (a coil
 //!   is driven by its own circuit).
 //!
+//! Text that sets `base` names its own starting point (`"default"`,
+//! `"part:NAME"` or a file) and is read as a scenario file would be,
+//! without the default laid under it.
+//!
 //! The merged table is written back as TOML and read by
 //! `Scenario::parse`, so every rule of the file format holds. An error
 //! names the line of the text it came from, or of the default scenario
@@ -21,9 +25,8 @@
 //! against the working directory.
 
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
 
-use chatterspice::scenario::{DEFAULT_NETLIST, DEFAULT_SCENARIO_TOML, Scenario, ScenarioError};
+use chatterspice::scenario::{DEFAULT_SCENARIO_TOML, Scenario, ScenarioError};
 use toml::de::{DeTable, DeValue};
 use toml::{Table, Value};
 
@@ -33,9 +36,19 @@ use crate::error::Failure;
 pub const TEXT_ORIGIN: &str = "<toml_text>";
 
 /// `text` over the default scenario: the scenario and the whole TOML it
-/// was read from.
-pub fn parse(text: &str) -> Result<(Scenario, String), Failure> {
-    let origin = Path::new(TEXT_ORIGIN);
+/// was read from. `origin` is the file the text stands for (errors name
+/// it, and relative paths resolve against its directory); without it,
+/// `<toml_text>` in the working directory. Text with a `base` of its own
+/// is read exactly as a file at `origin` would be.
+pub fn parse(text: &str, origin: Option<&Path>) -> Result<(Scenario, String), Failure> {
+    let origin = origin.unwrap_or(Path::new(TEXT_ORIGIN));
+    if let Ok(user) = text.parse::<Table>()
+        && user.contains_key("base")
+    {
+        return Scenario::parse(text, origin)
+            .map(|s| (s, text.to_owned()))
+            .map_err(Failure::from);
+    }
     let Ok(user) = text.parse::<Table>() else {
         // The library says where the syntax breaks, with its excerpt.
         return Scenario::parse(text, origin)
@@ -52,7 +65,7 @@ pub fn parse(text: &str) -> Result<(Scenario, String), Failure> {
             .and_then(Value::as_table)
             .is_some_and(|c| c.contains_key("netlist"));
     if from_default && let Some(Value::Table(circuit)) = merged.get_mut("circuit") {
-        let netlist = default_netlist()?;
+        let netlist = default_netlist();
         circuit.insert(
             "netlist".to_owned(),
             Value::String(netlist.display().to_string()),
@@ -189,34 +202,12 @@ fn line_at(text: &str, offset: usize) -> usize {
         + 1
 }
 
-/// The built-in scenario's netlist on disk: the source tree's, or, when
-/// the package runs where that is gone, a copy of the text compiled in,
-/// written once per process into a temporary directory (left behind when
-/// the process ends: statics are not dropped).
-fn default_netlist() -> Result<PathBuf, Failure> {
-    let in_tree = Scenario::builtin_default()
+/// The built-in scenario's circuit as the library names it: a name that
+/// resolves to the text compiled in, not to a file, so the text runs
+/// wherever the package is.
+fn default_netlist() -> PathBuf {
+    Scenario::builtin_default()
         .circuit
         .map(|c| c.netlist)
-        .expect("the built-in scenario has a circuit");
-    if in_tree.is_file() {
-        return Ok(in_tree);
-    }
-    static COPY: OnceLock<Result<tempfile::TempDir, String>> = OnceLock::new();
-    let copy = COPY.get_or_init(|| {
-        let dir = tempfile::Builder::new()
-            .prefix("chatterspice-")
-            .tempdir()
-            .map_err(|e| e.to_string())?;
-        std::fs::write(dir.path().join("mcu_input.cir"), DEFAULT_NETLIST)
-            .map_err(|e| e.to_string())?;
-        Ok(dir)
-    });
-    match copy {
-        Ok(dir) => Ok(dir.path().join("mcu_input.cir")),
-        Err(e) => Err(Failure::input(format!(
-            "{}: not there, and a copy of the built-in circuit cannot be written ({e}); \
-             give [circuit] netlist in the text",
-            in_tree.display()
-        ))),
-    }
+        .expect("the built-in scenario has a circuit")
 }

@@ -5,12 +5,69 @@
 //! `v(in)`, `frequency`) to a 1-D array, `float64` for a real vector and
 //! `complex128` for a complex one. The file itself reads as its last plot,
 //! the one `chatterspice raw FILE` prints without `--plot`.
+//!
+//! The arrays of a file read by `read_raw` are views of the data the
+//! reader parsed, not copies: the parsed file is kept alive by a Python
+//! object ([`RawData`]) that every array names as its base, and the
+//! arrays are read-only (numpy refuses to make them writeable again, as
+//! that base offers no writeable buffer). A pickled plot carries copies,
+//! read-only again when unpickled.
 
 use chatterspice::rawfile::{self, Vector, export};
-use numpy::PyArray1;
+use numpy::ndarray::ArrayView1;
+use numpy::{Element, PyArray1, PyArrayMethods};
 use pyo3::exceptions::{PyIndexError, PyKeyError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::{PyDict, PyList, PyTuple};
+
+use crate::results::same;
+
+/// A parsed raw file, owned by Python so that arrays can view it.
+#[pyclass(module = "chatterspice", frozen, name = "_RawData")]
+pub struct RawData {
+    raw: rawfile::RawFile,
+}
+
+/// A read-only array viewing `values`, which `owner` holds.
+fn view<'py, T: Element>(values: &[T], owner: &Bound<'py, RawData>) -> Bound<'py, PyAny> {
+    // SAFETY: `values` lies in `owner`'s RawFile, which is never changed
+    // or moved once owned by Python, and the array keeps `owner` alive
+    // as its base.
+    let array =
+        unsafe { PyArray1::borrow_from_array(&ArrayView1::from(values), owner.clone().into_any()) };
+    array.readwrite().make_nonwriteable();
+    array.into_any()
+}
+
+/// The vectors of plot `index` of `owner`'s file as read-only views, by
+/// name, in the file's order (a name given twice keeps its first).
+fn views<'py>(owner: &Bound<'py, RawData>, index: usize) -> PyResult<Bound<'py, PyDict>> {
+    let py = owner.py();
+    let plot = &owner.get().raw.plots[index];
+    let out = PyDict::new(py);
+    for (i, variable) in plot.variables.iter().enumerate() {
+        if out.contains(&variable.name)? {
+            continue;
+        }
+        let array = match plot.vector(i) {
+            Some(Vector::Real(v)) => view(v, owner),
+            Some(Vector::Complex(v)) => view(v, owner),
+            None => PyArray1::<f64>::zeros(py, 0, false).into_any(),
+        };
+        out.set_item(&variable.name, array)?;
+    }
+    Ok(out)
+}
+
+/// Every array of `vectors` made read-only (after unpickling).
+fn freeze(vectors: &Bound<'_, PyDict>) -> PyResult<()> {
+    let kwargs = PyDict::new(vectors.py());
+    kwargs.set_item("write", false)?;
+    for array in vectors.values() {
+        array.call_method("setflags", (), Some(&kwargs))?;
+    }
+    Ok(())
+}
 
 /// The vectors of `plot`, by name, in the file's order. A name given
 /// twice keeps its first vector.
@@ -54,6 +111,56 @@ pub struct Plot {
 
 #[pymethods]
 impl Plot {
+    /// A plot from its fields, as pickle rebuilds it (the arrays made
+    /// read-only).
+    #[new]
+    fn new(
+        name: String,
+        index: usize,
+        complex: bool,
+        points: usize,
+        metadata: Bound<'_, PyDict>,
+        vectors: Bound<'_, PyDict>,
+    ) -> PyResult<Plot> {
+        freeze(&vectors)?;
+        Ok(Plot {
+            name,
+            index,
+            complex,
+            points,
+            metadata: metadata.unbind(),
+            vectors: vectors.unbind(),
+        })
+    }
+
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let p = slf.get();
+        let fields = (
+            &p.name,
+            p.index,
+            p.complex,
+            p.points,
+            p.metadata.bind(py),
+            p.vectors.bind(py),
+        )
+            .into_pyobject(py)?;
+        PyTuple::new(py, [slf.get_type().into_any(), fields.into_any()])
+    }
+
+    fn __eq__(slf: &Bound<'_, Self>, other: &Bound<'_, PyAny>) -> PyResult<bool> {
+        let Ok(other) = other.cast::<Plot>() else {
+            return Ok(false);
+        };
+        let (a, b) = (slf.get(), other.get());
+        let py = slf.py();
+        Ok(
+            (&a.name, a.index, a.complex, a.points) == (&b.name, b.index, b.complex, b.points)
+                && same(a.metadata.bind(py), b.metadata.bind(py))?
+                && same(a.vectors.bind(py), b.vectors.bind(py))?,
+        )
+    }
+
     /// The vectors as a plain dict (the same arrays).
     #[getter]
     fn vectors<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
@@ -158,8 +265,10 @@ impl RawFile {
             .detach(|| rawfile::RawFile::read(path))
             .map_err(crate::error::Failure::from)?;
         let summary = crate::json(py, &export::summary_json(&raw))?;
+        let warnings: Vec<String> = raw.warnings.iter().map(ToString::to_string).collect();
+        let owner = Bound::new(py, RawData { raw })?;
         let plots = PyList::empty(py);
-        for (index, plot) in raw.plots.iter().enumerate() {
+        for (index, plot) in owner.get().raw.plots.iter().enumerate() {
             let metadata = summary
                 .get_item("plots")?
                 .get_item(index)?
@@ -170,11 +279,10 @@ impl RawFile {
                 complex: plot.is_complex(),
                 points: plot.points(),
                 metadata: metadata.unbind(),
-                vectors: vectors(py, plot)?.unbind(),
+                vectors: views(&owner, index)?.unbind(),
             };
             plots.append(Py::new(py, p)?)?;
         }
-        let warnings: Vec<String> = raw.warnings.iter().map(ToString::to_string).collect();
         Ok(RawFile {
             path: path.display().to_string(),
             plots: plots.unbind(),
@@ -194,6 +302,62 @@ impl RawFile {
 
 #[pymethods]
 impl RawFile {
+    /// A file from its fields, as pickle rebuilds it.
+    #[new]
+    fn new(
+        path: String,
+        plots: Bound<'_, PyList>,
+        warnings: Bound<'_, PyList>,
+        summary: Py<PyAny>,
+    ) -> PyResult<RawFile> {
+        for p in plots.iter() {
+            p.cast::<Plot>()?;
+        }
+        Ok(RawFile {
+            path,
+            plots: plots.unbind(),
+            warnings: warnings.unbind(),
+            summary,
+        })
+    }
+
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let r = slf.get();
+        let fields = (
+            &r.path,
+            r.plots.bind(py),
+            r.warnings.bind(py),
+            r.summary.bind(py),
+        )
+            .into_pyobject(py)?;
+        PyTuple::new(py, [slf.get_type().into_any(), fields.into_any()])
+    }
+
+    fn __eq__(slf: &Bound<'_, Self>, other: &Bound<'_, PyAny>) -> PyResult<bool> {
+        let Ok(other) = other.cast::<RawFile>() else {
+            return Ok(false);
+        };
+        let (a, b) = (slf.get(), other.get());
+        let py = slf.py();
+        if a.path != b.path
+            || !same(a.warnings.bind(py), b.warnings.bind(py))?
+            || !same(a.summary.bind(py), b.summary.bind(py))?
+        {
+            return Ok(false);
+        }
+        let (p, q) = (a.plots.bind(py), b.plots.bind(py));
+        if p.len() != q.len() {
+            return Ok(false);
+        }
+        for (x, y) in p.iter().zip(q.iter()) {
+            if !x.eq(y)? {
+                return Ok(false);
+            }
+        }
+        Ok(true)
+    }
+
     /// Plot `which`: its index in the file (negative counts from the end)
     /// or its name (the first plot of that name).
     fn plot<'py>(&self, py: Python<'py>, which: Bound<'py, PyAny>) -> PyResult<Bound<'py, Plot>> {
@@ -215,7 +379,15 @@ impl RawFile {
                 names.join(", ")
             )));
         }
-        let index: isize = which.extract()?;
+        let Ok(index) = which.extract::<isize>() else {
+            return Err(crate::error::Failure::input(format!(
+                "which = {} ({}): give a plot's index (an int, negative from the end) or its \
+                 name (a str)",
+                which.repr()?,
+                which.get_type().name()?
+            ))
+            .into());
+        };
         let n = plots.len() as isize;
         let at = if index < 0 { n + index } else { index };
         if !(0..n).contains(&at) {

@@ -88,3 +88,30 @@ def test_a_broken_file_is_an_input_error_naming_it(tmp_path):
         chatterspice.read_raw(broken)
     with pytest.raises(FileNotFoundError, match="absent.raw"):
         chatterspice.read_raw(tmp_path / "absent.raw")
+
+
+def test_the_arrays_are_read_only_views_of_one_read():
+    raw = chatterspice.read_raw(RAW / "rc_tran.raw")
+    out = raw["v(out)"]
+    assert not out.flags.writeable and not out.flags.owndata
+    with pytest.raises(ValueError):
+        out[0] = 1.0
+    with pytest.raises(ValueError):
+        out.setflags(write=True)
+    # Every access views the same memory: nothing is copied per access.
+    assert np.shares_memory(out, raw.plots[0]["v(out)"])
+    assert np.shares_memory(out, raw.plots[0].vectors["v(out)"])
+    # The data outlive the file object and its plots.
+    plot = raw.plots[0]
+    del raw
+    assert plot["v(out)"][-1] == pytest.approx(1 - np.exp(-5), abs=2e-3)  # t = 5 ms, RC = 1 ms
+    copy = out.copy()
+    copy[0] = 5.0
+    assert copy.flags.writeable and out[0] != 5.0
+
+
+def test_a_plot_asked_for_by_neither_index_nor_name_is_an_input_error():
+    raw = chatterspice.read_raw(RAW / "divider_op_tran.raw")
+    with pytest.raises(chatterspice.InputError, match=r"^which = 1\.5 \(float\)"):
+        raw.plot(1.5)
+    assert raw.plot(1).index == raw.plot(-1).index == 1
