@@ -586,7 +586,19 @@ pub fn arc_checks(
         ),
         None => "the run has no arc report: add an [arc] section".to_owned(),
     };
-    let arcs = arcs.filter(|_| unreached.is_none());
+    // An arc still burning at the end: every figure of the run is a
+    // lower bound, so no arc limit can pass.
+    let burning = arcs.and_then(|a| a.totals.still_burning.as_ref());
+    let missing = || match burning {
+        Some(b) => format!(
+            "the arc at {} still burns when the run ends, after {} s and {} J: the contact \
+             does not break this load within the run (extend the `.tran` stop time to see \
+             whether it ever does)",
+            b.opening, b.duration, b.energy
+        ),
+        None => missing(),
+    };
+    let arcs = arcs.filter(|a| unreached.is_none() && a.totals.still_burning.is_none());
     let mut out = Vec::new();
     if let Some(limit) = limits.max_arc_energy {
         out.push(LimitCheck::new(
@@ -608,6 +620,16 @@ pub fn arc_checks(
             limit as f64,
             arcs.map(|a| a.totals.max_operation_count as f64)
                 .ok_or_else(missing),
+        ));
+    }
+    if let Some(limit) = limits.max_arc_duration {
+        out.push(LimitCheck::new(
+            "limits.max_arc_duration".into(),
+            "longest arc".into(),
+            "s",
+            Bound::Max,
+            limit,
+            arcs.map(|a| a.totals.longest).ok_or_else(missing),
         ));
     }
     out

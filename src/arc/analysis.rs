@@ -117,6 +117,28 @@ pub struct ArcTotals {
     pub max_operation_energy: f64,
     /// The most arcs in one operation: what `max_arc_count` limits.
     pub max_operation_count: usize,
+    /// The arc still burning when the run ended, if one was: the contact
+    /// did not break its load within the run (`null` when every arc went
+    /// out or closed).
+    pub still_burning: Option<StillBurning>,
+}
+
+/// An arc still burning when the run ended.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StillBurning {
+    /// Which operation (0-based).
+    pub operation: usize,
+    /// Which opening, as [`ArcEvent::opening`].
+    pub opening: String,
+    /// s, when it started.
+    pub start: f64,
+    /// s, how long it had burned when the run ended: a lower bound on its
+    /// duration.
+    pub duration: f64,
+    /// J, its energy so far: a lower bound.
+    pub energy: f64,
+    /// m, the gap when the run ended.
+    pub gap: f64,
 }
 
 /// Arcs, breakdowns and totals of one run.
@@ -454,6 +476,17 @@ fn totals(arcs: &[ArcEvent], breakdowns: &[Breakdown]) -> ArcTotals {
         longest: arcs.iter().map(|a| a.duration).fold(0.0, f64::max),
         max_operation_energy: per_operation.iter().map(|p| p.0).fold(0.0, f64::max),
         max_operation_count: per_operation.iter().map(|p| p.1).max().unwrap_or(0),
+        still_burning: arcs
+            .iter()
+            .find(|a| a.ends == "run_end")
+            .map(|a| StillBurning {
+                operation: a.operation,
+                opening: a.opening.clone(),
+                start: a.start,
+                duration: a.duration,
+                energy: a.energy,
+                gap: a.gap_at_end,
+            }),
     }
 }
 

@@ -16,17 +16,20 @@
 //! - [`gap::GapProfile`] is gap(t) from the armature's own trajectory;
 //! - [`vectors`] names what the arc element (written with the contact
 //!   include, so ngspice carries the arc) puts in the raw file;
-//! - [`analysis`] finds every arc and breakdown in the run's raw file.
+//! - [`analysis`] finds every arc and breakdown in the run's raw file;
+//! - [`breaking`] is the largest DC current the contact breaks, and the
+//!   arc constants fitted to a printed breaking curve.
 
 pub mod analysis;
+pub mod breaking;
 pub mod gap;
 mod model;
 pub mod vectors;
 
-pub use analysis::{ArcEvent, ArcReport, ArcTotals, Breakdown};
+pub use analysis::{ArcEvent, ArcReport, ArcTotals, Breakdown, StillBurning};
 pub use gap::GapProfile;
 pub use model::{
-    ArcModel, ArcSection, DEFAULT_FIELD, DEFAULT_OPENING_SPEED, FIELD_EMISSION_FIELD, Material,
-    PASCHEN_MINIMUM, REFERENCE_MATERIAL, breakdown_voltage,
+    ArcModel, ArcSection, DEFAULT_FIELD, DEFAULT_LOW_CURRENT, DEFAULT_OPENING_SPEED,
+    FIELD_EMISSION_FIELD, Material, PASCHEN_MINIMUM, REFERENCE_MATERIAL, breakdown_voltage,
 };
 pub use vectors::ArcVectors;

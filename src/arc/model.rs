@@ -58,6 +58,13 @@ impl Material {
         }
     }
 
+    /// V·A, the default low-current term C of the arc voltage: silver's
+    /// [`DEFAULT_LOW_CURRENT`] for every material, as no breaking curve of
+    /// the others has been fitted (docs/arcs.md).
+    pub fn low_current(self) -> f64 {
+        DEFAULT_LOW_CURRENT
+    }
+
     /// A, the minimum arc current (docs/arcs.md, materials table).
     pub fn i_min(self) -> f64 {
         match self {
@@ -73,6 +80,13 @@ impl Material {
 /// V/m, the default column gradient E: short low-current arcs in air
 /// have gradients of a few kV/m (docs/arcs.md).
 pub const DEFAULT_FIELD: f64 = 2.0e3;
+
+/// V·A, the default low-current term C of the arc voltage
+/// (V_arc = V_min + E·d + (C + D·d)/|i|): the value with which the default
+/// column gradient and a 0.3 mm contact gap break 8 A at 30 V DC on a
+/// resistive load, the DC rating that small silver-contact power relays
+/// print (Finder 40.52, DC1 curve; docs/arcs.md).
+pub const DEFAULT_LOW_CURRENT: f64 = 20.0;
 
 /// m/s, how fast the gap opens and closes where no trajectory is known
 /// (a measured record of states): a typical contact separation speed.
@@ -103,6 +117,14 @@ pub struct ArcSection {
     /// which has no trajectory; a simulated relay uses its own.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub opening_speed: Option<f64>,
+    /// V·A, Ayrton's low-current term C: the arc burns higher the lower
+    /// its current, by (C + D·gap)/|i|. 0 here and in `low_current_gap`
+    /// gives the arc voltage V_min + E·gap alone.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub low_current: Option<f64>,
+    /// V·A/m, the low-current term's growth with the gap, D.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub low_current_gap: Option<f64>,
 }
 
 impl ArcSection {
@@ -117,6 +139,8 @@ impl ArcSection {
             i_min: Some(m.i_min),
             field: Some(m.field),
             opening_speed: Some(m.opening_speed),
+            low_current: Some(m.low_current),
+            low_current_gap: Some(m.low_current_gap),
         }
     }
 
@@ -128,6 +152,8 @@ impl ArcSection {
             i_min: self.i_min.unwrap_or(material.i_min()),
             field: self.field.unwrap_or(DEFAULT_FIELD),
             opening_speed: self.opening_speed.unwrap_or(DEFAULT_OPENING_SPEED),
+            low_current: self.low_current.unwrap_or(material.low_current()),
+            low_current_gap: self.low_current_gap.unwrap_or(0.0),
         }
     }
 }
@@ -143,19 +169,68 @@ pub struct ArcModel {
     pub field: f64,
     /// m/s
     pub opening_speed: f64,
+    /// V·A, C
+    pub low_current: f64,
+    /// V·A/m, D
+    pub low_current_gap: f64,
 }
 
 impl ArcModel {
-    /// V, the burning voltage at gap `gap` (m).
+    /// V, the current-independent part of the burning voltage at gap
+    /// `gap` (m): V_min + E·gap, what the arc burns at when its current
+    /// is large.
     pub fn arc_voltage(&self, gap: f64) -> f64 {
         self.v_min + self.field * gap.max(0.0)
     }
 
+    /// V·A, the low-current term's numerator at gap `gap` (m): C + D·gap.
+    pub fn low_current_term(&self, gap: f64) -> f64 {
+        self.low_current + self.low_current_gap * gap.max(0.0)
+    }
+
+    /// Whether the arc voltage depends on the current (C or D not 0).
+    pub fn has_low_current_term(&self) -> bool {
+        self.low_current != 0.0 || self.low_current_gap != 0.0
+    }
+
+    /// V, the burning voltage at gap `gap` (m) and current `current` (A):
+    /// V_min + E·gap + (C + D·gap)/|i|, with |i| taken as at least I_min
+    /// (below it the arc is out).
+    pub fn burning_voltage(&self, gap: f64, current: f64) -> f64 {
+        self.arc_voltage(gap) + self.low_current_term(gap) / current.abs().max(self.i_min)
+    }
+
+    /// A, the largest current a contact open to gap `gap` (m) breaks on a
+    /// resistive DC load of `voltage` (V), or `None` when it breaks any.
+    ///
+    /// With a = V_min + E·d and K = C + D·d, an arc on the load V, R burns
+    /// at the larger root i_s of R·i² − (V − a)·i + K = 0, and goes out
+    /// when there is none (the load line no longer meets the arc's
+    /// characteristic: R above R_t = (V − a)²/(4K), the tangent) or when
+    /// i_s falls below I_min (R above R_m = ((V − a)·I_min − K)/I_min², when
+    /// I_min is the larger root there). The answer is V/min(R_t, R_m).
+    pub fn breaking_current(&self, voltage: f64, gap: f64) -> Option<f64> {
+        let v = voltage.abs();
+        let margin = v - self.arc_voltage(gap);
+        if margin <= 0.0 {
+            return None;
+        }
+        let k = self.low_current_term(gap);
+        let i_min = self.i_min;
+        let r_m = (margin * i_min - k) / (i_min * i_min);
+        if r_m > 0.0 && 2.0 * r_m * i_min >= margin {
+            return Some(v / r_m);
+        }
+        Some(4.0 * v * k / (margin * margin))
+    }
+
     /// V, the most an open gap `gap` (m) holds before it conducts: the
-    /// breakdown voltage, never below V_min (less cannot sustain a
-    /// discharge at all).
+    /// breakdown voltage, never below V_min + (C + D·gap)/I_min. Less
+    /// cannot sustain a discharge that carries I_min, the least current an
+    /// arc burns with: a breakdown below it is a spark that collapses at
+    /// once, whose energy is negligible (with C = D = 0 the floor is V_min).
     pub fn hold_voltage(&self, gap: f64) -> f64 {
-        breakdown_voltage(gap).max(self.v_min)
+        breakdown_voltage(gap).max(self.v_min + self.low_current_term(gap) / self.i_min)
     }
 }
 
@@ -228,7 +303,7 @@ mod tests {
         .model();
         assert_eq!((w.v_min, w.i_min), (15.0, 2.0));
         assert_eq!(w.arc_voltage(1e-3), 15.0 + DEFAULT_FIELD * 1e-3);
-        assert_eq!(w.hold_voltage(0.0), 15.0);
+        assert_eq!(w.hold_voltage(0.0), 15.0 + DEFAULT_LOW_CURRENT / 2.0);
         for m in Material::ALL {
             assert!(m.v_min() >= 12.0 && m.i_min() >= 0.38, "{}", m.as_str());
         }

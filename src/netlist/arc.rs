@@ -52,8 +52,16 @@ pub const CLAMP_SOFTNESS: f64 = 2e-3;
 /// A, the clamp's current scale (conductance × softness): 10 kS above th.
 pub const CLAMP_SCALE: f64 = 20.0;
 
-/// s, the lag of the hold voltage behind the arc state (an RC of 1 Ω and
-/// this many farads). A restrike drops the hold voltage from the
+/// Ω, the resistance of the element's two lags (RCs of this resistance
+/// and lag / resistance farads). At 1 Ω the sources driving them carried
+/// picoamperes, at ngspice's absolute current tolerance (abstol, 1 pA):
+/// measured, a DC arc burning while a switched-off coil rang down stalled
+/// ngspice in 8 of 38 loads (the time step cycling at 10–80 ps for good);
+/// at 1 kΩ in none.
+pub const LAG_RESISTANCE: f64 = 1e3;
+
+/// s, the lag of the hold voltage behind the arc state (an RC of
+/// [`LAG_RESISTANCE`]). A restrike drops the hold voltage from the
 /// breakdown voltage to V_arc; the lag makes the circuit's capacitance
 /// across the gap discharge into the arc over tens of nanoseconds, with
 /// currents of amperes, as in a real restrike, instead of in one time step
@@ -61,8 +69,8 @@ pub const CLAMP_SCALE: f64 = 20.0;
 /// step resolves).
 pub const THRESHOLD_LAG: f64 = 50e-9;
 
-/// s, the time constant of the current the arc state sees (an RC of 1 Ω
-/// and this many farads). At separation the capacitance across the
+/// s, the time constant of the current the arc state sees (an RC of
+/// [`LAG_RESISTANCE`]). At separation the capacitance across the
 /// contact (wiring, a snubber) takes the current for the nanoseconds the
 /// voltage needs to reach V_arc; a real contact bridges them with its
 /// molten metal bridge, so the state must not see that dip as an
@@ -92,13 +100,16 @@ pub fn with_arc(
     comment(
         &mut arc,
         &format!(
-            "Arc: V_min = {} V, I_min = {} A, column gradient {} V/m. Vsense senses the \
-             contact current; switch Sst holds the arc state V(st) on from I_min; the \
-             clamp Barc holds |V(a,b)| at V_arc = V_min + E*gap(t) while the state is \
-             on, at the gap's breakdown voltage while it is off.",
+            "Arc: V_min = {} V, I_min = {} A, column gradient E = {} V/m, low-current \
+             terms C = {} V*A, D = {} V*A/m. Vsense senses the contact current; switch \
+             Sst holds the arc state V(st) on from I_min; the clamp Barc holds |V(a,b)| \
+             at V_arc = V_min + E*gap(t) + (C + D*gap(t))/|i| while the state is on, at \
+             the gap's breakdown voltage while it is off.",
             format_time(model.v_min),
             format_time(model.i_min),
-            format_time(model.field)
+            format_time(model.field),
+            format_time(model.low_current),
+            format_time(model.low_current_gap)
         ),
     );
     line(&mut arc, "Vsense a ai 0");
@@ -116,11 +127,41 @@ pub fn with_arc(
         samples.iter().map(|&(t, g)| (t, model.hold_voltage(g))),
     );
     line(&mut arc, "Bia iar 0 V = abs(i(Vsense))");
-    line(&mut arc, "Ria iar ia 1");
     line(
         &mut arc,
-        &format!("Cia ia 0 {} IC=0", format_time(STATE_LAG)),
+        &format!("Ria iar ia {}", format_time(LAG_RESISTANCE)),
     );
+    line(
+        &mut arc,
+        &format!("Cia ia 0 {} IC=0", format_time(STATE_LAG / LAG_RESISTANCE)),
+    );
+    // The burning voltage: V_min + E·gap alone, or with Ayrton's
+    // low-current term (C + D·gap)/|i| on the sensed current (at least
+    // I_min, below which the arc is out).
+    let burning = if model.has_low_current_term() {
+        if model.low_current_gap == 0.0 {
+            line(
+                &mut arc,
+                &format!("Vlow lowc 0 DC {}", format_time(model.low_current)),
+            );
+        } else {
+            line(&mut arc, "Vlow lowc 0 PWL(");
+            pairs(
+                &mut arc,
+                samples.iter().map(|&(t, g)| (t, model.low_current_term(g))),
+            );
+        }
+        line(
+            &mut arc,
+            &format!(
+                "Bav av 0 V = V(varc) + V(lowc) / max(V(ia), {})",
+                format_time(model.i_min)
+            ),
+        );
+        "V(av)"
+    } else {
+        "V(varc)"
+    };
     line(&mut arc, "Von on 0 1");
     line(&mut arc, "Sst on st ia 0 arc_state");
     line(&mut arc, "Rst st 0 1k");
@@ -135,14 +176,17 @@ pub fn with_arc(
     );
     line(
         &mut arc,
-        "Bth thr 0 V = V(varc) + (V(vbd) - V(varc)) * (1 - V(st))",
+        &format!("Bth thr 0 V = {burning} + (V(vbd) - {burning}) * (1 - V(st))"),
     );
-    line(&mut arc, "Rth thr th 1");
+    line(
+        &mut arc,
+        &format!("Rth thr th {}", format_time(LAG_RESISTANCE)),
+    );
     line(
         &mut arc,
         &format!(
             "Cth th 0 {} IC={}",
-            format_time(THRESHOLD_LAG),
+            format_time(THRESHOLD_LAG / LAG_RESISTANCE),
             format_time(model.hold_voltage(gap.at(0.0)))
         ),
     );
@@ -210,6 +254,8 @@ mod tests {
             i_min: 0.4,
             field: 1e4,
             opening_speed: 0.3,
+            low_current: 0.0,
+            low_current_gap: 0.0,
         };
         let gap = GapProfile::from_samples([(0.0, 1e-3), (1e-3, 0.0), (2e-3, 0.0), (3e-3, 2e-4)]);
         let plain = include();

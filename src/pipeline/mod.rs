@@ -754,16 +754,19 @@ fn arc_warnings(
                 ));
             }
         }
-        let burning = report.arcs.iter().filter(|a| a.ends == "run_end").map(|a| {
-            format!(
-                "the arc at {} (from {:.4} ms) still burns when the simulation stops: \
-                     the circuit drives more than V_arc = V_min + field·gap across the \
-                     widest gap; extend .tran, or the contact cannot break this load",
+        if let Some(a) = &report.totals.still_burning {
+            warnings.push(format!(
+                "the arc at {} (from {:.4} ms) still burns when the simulation stops, after \
+                 {:.3} ms and {:.4} J: the circuit holds it above the arc voltage \
+                 V_min + E·gap + (C + D·gap)/|i| at a {:.3} mm gap; extend .tran, or the \
+                 contact does not break this load",
                 a.opening,
-                a.start * 1e3
-            )
-        });
-        warnings.extend(burning);
+                a.start * 1e3,
+                a.duration * 1e3,
+                a.energy,
+                a.gap * 1e3
+            ));
+        }
         return warnings;
     }
     let Some(circuit) = &scenario.circuit else {

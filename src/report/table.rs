@@ -328,7 +328,7 @@ pub fn render_arcs(report: &ArcReport) -> String {
     let _ = writeln!(
         out,
         "arcs: {} arc{}, {} in all (most in one operation: {}); {} breakdown{}, {}; \
-         contact peak {} (V_min {}, I_min {}, field {})",
+         contact peak {} (V_min {}, I_min {}, field {}, low-current term {} + {}·gap)",
         t.count,
         if t.count == 1 { "" } else { "s" },
         engineering(t.energy, "J"),
@@ -340,6 +340,8 @@ pub fn render_arcs(report: &ArcReport) -> String {
         engineering(m.v_min, "V"),
         engineering(m.i_min, "A"),
         engineering(m.field, "V/m"),
+        engineering(m.low_current, "V·A"),
+        engineering(m.low_current_gap, "V·A/m"),
     );
     if report.arcs.is_empty() && report.breakdowns.is_empty() {
         return out;

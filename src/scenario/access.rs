@@ -109,11 +109,14 @@ macro_rules! number_field {
             "simulation.t_end" => Field::Plain($($r)* s.simulation.t_end),
             "simulation.min_open_time" => Field::Plain($($r)* s.simulation.min_open_time),
             "simulation.min_gap" => Field::Plain($($r)* s.simulation.min_gap),
-            "arc.v_min" | "arc.i_min" | "arc.field" | "arc.opening_speed" => match $($r)* s.arc {
+            "arc.v_min" | "arc.i_min" | "arc.field" | "arc.opening_speed" | "arc.low_current"
+            | "arc.low_current_gap" => match $($r)* s.arc {
                 Some(a) => Field::Optional(match $key {
                     "arc.v_min" => $($r)* a.v_min,
                     "arc.i_min" => $($r)* a.i_min,
                     "arc.field" => $($r)* a.field,
+                    "arc.low_current" => $($r)* a.low_current,
+                    "arc.low_current_gap" => $($r)* a.low_current_gap,
                     _ => $($r)* a.opening_speed,
                 }),
                 None => Field::NoSection("[arc]"),

@@ -33,6 +33,19 @@ impl Check<'_> {
                 a.opening_speed.is_some_and(|v| v > 0.0),
                 "must be > 0: how fast a measured record's contacts part, in m/s",
             ),
+            (
+                "arc.low_current",
+                a.low_current,
+                a.low_current.is_some_and(|v| v >= 0.0),
+                "must be ≥ 0: Ayrton's low-current term C of the arc voltage, in V·A \
+                 (0 makes the arc voltage independent of its current)",
+            ),
+            (
+                "arc.low_current_gap",
+                a.low_current_gap,
+                a.low_current_gap.is_some_and(|v| v >= 0.0),
+                "must be ≥ 0: the growth D of the low-current term with the gap, in V·A/m",
+            ),
         ] {
             if let Some(v) = value {
                 self.number(key, v, ok, requirement)?;

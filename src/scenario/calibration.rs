@@ -38,6 +38,20 @@ pub struct DatasheetSection {
     /// s, coil de-energized → the normally-open contact opens.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub release_time: Option<PrintedFigure>,
+    /// The DC breaking capacity as printed (resistive load): the largest
+    /// current the contact breaks at each voltage.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub dc_breaking: Vec<BreakingFigure>,
+}
+
+/// One point of a printed DC breaking-capacity curve (resistive load).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BreakingFigure {
+    /// V, the DC supply.
+    pub voltage: f64,
+    /// A, the largest current the contact breaks at that voltage.
+    pub current: f64,
 }
 
 impl DatasheetSection {
@@ -187,6 +201,20 @@ impl super::check::Check<'_> {
                 v > 0.0,
                 "must be > 0: the nominal coil voltage, in V",
             )?;
+        }
+        for (k, f) in d.dc_breaking.iter().enumerate() {
+            for (what, value) in [("voltage", f.voltage), ("current", f.current)] {
+                self.number(
+                    "datasheet.dc_breaking",
+                    value,
+                    value > 0.0,
+                    format!(
+                        "figure {} of the DC breaking capacity: its {what} must be > 0 (in {})",
+                        k + 1,
+                        if what == "voltage" { "V" } else { "A" }
+                    ),
+                )?;
+            }
         }
         for (name, figure) in d.figures() {
             if let Err((field, value, requirement)) = figure.check() {

@@ -125,6 +125,7 @@ impl Check<'_> {
             let given = [
                 ("limits.max_arc_energy", limits.max_arc_energy.is_some()),
                 ("limits.max_arc_count", limits.max_arc_count.is_some()),
+                ("limits.max_arc_duration", limits.max_arc_duration.is_some()),
             ];
             if let Some((key, _)) = given.iter().find(|(_, set)| *set) {
                 return Err(ScenarioError::MissingKey {

@@ -34,6 +34,9 @@ pub struct LimitsSection {
     pub max_arc_energy: Option<f64>,
     /// The most arcs in one operation (needs `[arc]` and a run).
     pub max_arc_count: Option<u64>,
+    /// s, the longest arc (needs `[arc]` and a run); an arc still burning
+    /// when the run ends fails it.
+    pub max_arc_duration: Option<f64>,
     /// s, the contact's own debounce lockout in each closing: its last
     /// transition − its first make, what a debouncer reading the contact
     /// directly must ignore it for (the bounce time, named as a debouncer
@@ -48,7 +51,9 @@ pub struct LimitsSection {
 impl LimitsSection {
     /// Whether an arc limit is set: those need `[arc]` and the circuit run.
     pub fn has_arc_limits(&self) -> bool {
-        self.max_arc_energy.is_some() || self.max_arc_count.is_some()
+        self.max_arc_energy.is_some()
+            || self.max_arc_count.is_some()
+            || self.max_arc_duration.is_some()
     }
 }
 
@@ -89,6 +94,11 @@ impl Check<'_> {
                 "limits.max_arc_energy",
                 l.max_arc_energy,
                 "the most arc energy allowed in one operation, in J",
+            ),
+            (
+                "limits.max_arc_duration",
+                l.max_arc_duration,
+                "the longest arc allowed, in s",
             ),
             (
                 "limits.max_lockout",

@@ -49,7 +49,7 @@ pub use base::{BUNDLED_PARTS, bundled_part, bundled_part_text};
 pub use builder::ScenarioBuilder;
 pub use builtin::{DEFAULT_NETLIST, DEFAULT_SCENARIO_TOML};
 pub use calibration::{
-    DatasheetSection, Determined, FitSection, FittedParameter, ProvenanceSection,
+    BreakingFigure, DatasheetSection, Determined, FitSection, FittedParameter, ProvenanceSection,
 };
 pub use circuit::CircuitSection;
 pub use coil::CoilSection;

@@ -52,6 +52,8 @@ pub const NUMBER_KEYS: &[&str] = &[
     "arc.i_min",
     "arc.field",
     "arc.opening_speed",
+    "arc.low_current",
+    "arc.low_current_gap",
 ];
 
 /// The unit of number key `key` (one of [`NUMBER_KEYS`] or `probe[N].low`
@@ -115,6 +117,8 @@ pub const ENVELOPE: &[(&str, f64, f64, &str)] = &[
     ("arc.i_min", 0.0, 1e4, "A"),
     ("arc.field", 0.0, 1e8, "V/m"),
     ("arc.opening_speed", 0.0, 1e3, "m/s"),
+    ("arc.low_current", 0.0, 1e6, "V·A"),
+    ("arc.low_current_gap", 0.0, 1e10, "V·A/m"),
 ];
 
 /// Number keys under this prefix name a `.param` of the netlist.

@@ -120,8 +120,8 @@ pub enum SweepError {
     /// A mechanics-only sweep of a scenario with arc limits, which only a
     /// circuit run measures.
     #[error(
-        "{}: `limits.max_arc_energy` and `limits.max_arc_count` hold the arcs of the \
-         circuit run: drop --mechanics-only, or remove those limits",
+        "{}: `limits.max_arc_energy`, `limits.max_arc_count` and `limits.max_arc_duration` \
+         hold the arcs of the circuit run: drop --mechanics-only, or remove those limits",
         path.display()
     )]
     ArcLimitsNeedCircuit {

@@ -1,0 +1,318 @@
+//! What a contact can break: the largest resistive DC current the arc
+//! model lets go out at a voltage, and the arc constants fitted to a
+//! printed DC breaking-capacity curve (docs/arcs.md, "Breaking").
+//!
+//! On a resistive load V, R the arc burns at V_arc(i, d) = a + K/|i|, with
+//! a = V_min + E·d and K = C + D·d at the gap d. It can burn only while
+//! the load line V − i·R meets that characteristic; the largest current
+//! broken at the contact's full gap has its load line tangent to it:
+//! V = a + 2·√(K·R), so I = V/R = 4·V·K/(V − a)². Writing
+//! s = √(I/(4·V)) for a printed figure (V, I) turns that into a line,
+//! s·V = s·a + √K, linear in the two unknowns a and √K: two figures fix
+//! them, more are fitted by least squares. One gap cannot tell C from D
+//! (only K = C + D·d is seen), so D is held and C fitted; with one
+//! figure, E is held too.
+//!
+//! The arc also goes out when its steady current falls below I_min, which
+//! caps what the model can show at high voltages: there the breakable
+//! current is V·I_min²/((V − a)·I_min − K), however small the printed
+//! figure ([`ArcModel::breaking_current`]). The fit uses the tangent
+//! relation; the rows show the whole model beside each printed figure.
+
+use serde::Serialize;
+
+use super::model::ArcModel;
+use crate::scenario::BreakingFigure;
+
+/// One printed figure beside the model's answer.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BreakingRow {
+    /// V
+    pub voltage: f64,
+    /// A, as printed.
+    pub printed: f64,
+    /// A, the model's largest breakable current at that voltage and the
+    /// full gap (`null`: it breaks any current, the supply being below
+    /// V_min + E·gap).
+    pub model: Option<f64>,
+}
+
+/// Every figure of `figures` beside `model`'s breakable current at gap
+/// `gap` (m).
+pub fn rows(model: &ArcModel, gap: f64, figures: &[BreakingFigure]) -> Vec<BreakingRow> {
+    figures
+        .iter()
+        .map(|f| BreakingRow {
+            voltage: f.voltage,
+            printed: f.current,
+            model: model.breaking_current(f.voltage, gap),
+        })
+        .collect()
+}
+
+/// The arc constants fitted to a breaking curve.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BreakingFit {
+    /// V/m, the column gradient E (held when one figure was given).
+    pub field: f64,
+    /// V·A, the low-current term C.
+    pub low_current: f64,
+    /// Whether E was fitted (two figures or more) or held.
+    pub field_fitted: bool,
+    /// m, the full contact gap the figures were fitted at.
+    pub gap: f64,
+    /// The figures beside the fitted model.
+    pub rows: Vec<BreakingRow>,
+    /// The root-mean-square of ln(model/printed) over the figures.
+    pub rms_log_error: f64,
+}
+
+/// Why a breaking curve cannot be fitted.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum BreakingFitError {
+    /// No figure.
+    #[error("no DC breaking figure to fit: add [datasheet] dc_breaking")]
+    NoFigures,
+    /// The contact has no gap to fit at.
+    #[error("the contact gap must be > 0 to fit the breaking curve, not {0} m")]
+    NoGap(f64),
+    /// The figures need an arc that burns below V_min, or a negative C.
+    #[error(
+        "the DC breaking figures cannot be met by an arc of V_min = {v_min} V: they need \
+         V_min + E·gap = {a:.3} V and C + D·gap = {k:.4} V·A, and neither may fall below \
+         V_min and D·gap; check the figures' units (V, A) and that they are one curve"
+    )]
+    Unphysical {
+        /// V
+        v_min: f64,
+        /// V, the fitted a.
+        a: f64,
+        /// V·A, the fitted K.
+        k: f64,
+    },
+}
+
+/// Fits E and C (or C alone, for one figure) of `model` to `figures` at
+/// the full gap `gap` (m), holding V_min, I_min and D.
+pub fn fit(
+    model: &ArcModel,
+    gap: f64,
+    figures: &[BreakingFigure],
+) -> Result<BreakingFit, BreakingFitError> {
+    if figures.is_empty() {
+        return Err(BreakingFitError::NoFigures);
+    }
+    if gap.is_nan() || gap <= 0.0 {
+        return Err(BreakingFitError::NoGap(gap));
+    }
+    let points: Vec<(f64, f64)> = figures
+        .iter()
+        .map(|f| {
+            let s = (f.current / (4.0 * f.voltage)).sqrt();
+            (s, s * f.voltage)
+        })
+        .collect();
+    let n = points.len() as f64;
+    let field_fitted = points.len() >= 2;
+    // s·V = s·a + q with q = √K: least squares in (a, q), or in q alone.
+    let (a, q) = if field_fitted {
+        let (sx, sy) = points
+            .iter()
+            .fold((0.0, 0.0), |(x, y), &(s, sv)| (x + s, y + sv));
+        let (mx, my) = (sx / n, sy / n);
+        let (sxx, sxy) = points.iter().fold((0.0, 0.0), |(xx, xy), &(s, sv)| {
+            (xx + (s - mx) * (s - mx), xy + (s - mx) * (sv - my))
+        });
+        let a = if sxx > 0.0 {
+            sxy / sxx
+        } else {
+            model.arc_voltage(gap)
+        };
+        (a, my - a * mx)
+    } else {
+        let a = model.arc_voltage(gap);
+        let q = points.iter().map(|&(s, sv)| sv - s * a).sum::<f64>() / n;
+        (a, q)
+    };
+    let k = q * q;
+    let low_current = k - model.low_current_gap * gap;
+    if a < model.v_min || q <= 0.0 || low_current < 0.0 || !a.is_finite() {
+        return Err(BreakingFitError::Unphysical {
+            v_min: model.v_min,
+            a,
+            k,
+        });
+    }
+    let fitted = ArcModel {
+        field: if field_fitted {
+            (a - model.v_min) / gap
+        } else {
+            model.field
+        },
+        low_current,
+        ..*model
+    };
+    let rows = rows(&fitted, gap, figures);
+    let rms_log_error = (rows
+        .iter()
+        .map(|r| {
+            r.model
+                .map_or(f64::INFINITY, |m| (m / r.printed).ln().powi(2))
+        })
+        .sum::<f64>()
+        / n)
+        .sqrt();
+    Ok(BreakingFit {
+        field: fitted.field,
+        low_current,
+        field_fitted,
+        gap,
+        rows,
+        rms_log_error,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::arc::ArcSection;
+
+    /// The largest current whose load line still meets the arc's
+    /// characteristic at a current of at least I_min, found by brute
+    /// force: bisection on R for the existence of such a point of
+    /// V − i·R = a + K/i on a fine grid of i.
+    fn brute_force(model: &ArcModel, voltage: f64, gap: f64) -> f64 {
+        let burns = |r: f64| {
+            let top = voltage / r;
+            (1..=200_000).any(|k| {
+                let i = top * k as f64 / 200_000.0;
+                i >= model.i_min
+                    && model.arc_voltage(gap) + model.low_current_term(gap) / i <= voltage - i * r
+            })
+        };
+        let (mut lo, mut hi): (f64, f64) = (1e-4, 1e6); // Ω: burns at lo, not at hi
+        for _ in 0..80 {
+            let mid = (lo * hi).sqrt();
+            if burns(mid) { lo = mid } else { hi = mid }
+        }
+        voltage / hi
+    }
+
+    #[test]
+    fn the_tangent_load_line_is_the_largest_breakable_current() {
+        let model = ArcSection {
+            low_current: Some(7.0),
+            low_current_gap: Some(2.0e4),
+            field: Some(2.0e4),
+            ..ArcSection::default()
+        }
+        .model();
+        let gap = 0.4e-3;
+        for voltage in [30.0, 60.0, 110.0, 220.0] {
+            let closed = model.breaking_current(voltage, gap).unwrap();
+            let brute = brute_force(&model, voltage, gap);
+            assert!(
+                (closed / brute - 1.0).abs() < 2e-3,
+                "{voltage} V: {closed} against {brute}"
+            );
+        }
+        // Below V_min + E·gap the arc cannot burn at all.
+        assert_eq!(model.breaking_current(15.0, gap), None);
+        // Without the low-current term the arc burns at (V − a)/R, and
+        // goes out below I_min: I = V·I_min/(V − a).
+        let flat = ArcSection {
+            low_current: Some(0.0),
+            ..ArcSection::default()
+        }
+        .model();
+        let a = flat.arc_voltage(gap);
+        let expected = 30.0 * flat.i_min / (30.0 - a);
+        assert!((flat.breaking_current(30.0, gap).unwrap() / expected - 1.0).abs() < 1e-12);
+        assert!((brute_force(&flat, 30.0, gap) / expected - 1.0).abs() < 2e-3);
+    }
+
+    #[test]
+    fn a_curve_made_by_the_model_is_fitted_back() {
+        let truth = ArcSection {
+            material: Some(crate::arc::Material::AgNi),
+            field: Some(3.1e4),
+            low_current: Some(5.4),
+            low_current_gap: Some(1.0e3),
+            ..ArcSection::default()
+        }
+        .model();
+        let gap = 0.3e-3;
+        let figures: Vec<BreakingFigure> = [24.0, 30.0, 36.0, 48.0]
+            .iter()
+            .map(|&voltage| BreakingFigure {
+                voltage,
+                current: truth.breaking_current(voltage, gap).unwrap(),
+            })
+            .collect();
+        // Start from the defaults, far from the truth.
+        let start = ArcSection {
+            material: Some(crate::arc::Material::AgNi),
+            low_current_gap: Some(1.0e3),
+            ..ArcSection::default()
+        }
+        .model();
+        assert!((start.field / truth.field - 1.0).abs() > 0.5);
+        let fit = fit(&start, gap, &figures).unwrap();
+        assert!(fit.field_fitted);
+        assert!(
+            (fit.field / truth.field - 1.0).abs() < 1e-9,
+            "{}",
+            fit.field
+        );
+        assert!((fit.low_current / truth.low_current - 1.0).abs() < 1e-9);
+        assert!(fit.rms_log_error < 1e-9);
+        // One figure: E held, C through it.
+        let one = super::fit(&start, gap, &figures[..1]).unwrap();
+        assert!(!one.field_fitted);
+        assert_eq!(one.field, start.field);
+        let row = &one.rows[0];
+        assert!((row.model.unwrap() / row.printed - 1.0).abs() < 1e-9);
+        // Figures no arc can meet: an error, not numbers.
+        let wrong = [
+            BreakingFigure {
+                voltage: 30.0,
+                current: 0.1,
+            },
+            BreakingFigure {
+                voltage: 220.0,
+                current: 50.0,
+            },
+        ];
+        assert!(matches!(
+            super::fit(&start, gap, &wrong),
+            Err(BreakingFitError::Unphysical { .. })
+        ));
+        assert_eq!(
+            super::fit(&start, gap, &[]),
+            Err(BreakingFitError::NoFigures)
+        );
+    }
+
+    #[test]
+    fn the_finder_curve_at_30_v_and_the_i_min_floor_above() {
+        // Finder 40.52, DC1 curve (resistive): 8 A at 30 V, 0.3 A at
+        // 110 V, 0.12 A at 220 V.
+        let printed = [(30.0, 8.0), (110.0, 0.3), (220.0, 0.12)]
+            .map(|(voltage, current)| BreakingFigure { voltage, current });
+        let model = ArcSection {
+            material: Some(crate::arc::Material::AgNi),
+            ..ArcSection::default()
+        }
+        .model();
+        let fit = fit(&model, 0.3e-3, &printed).unwrap();
+        // The three points lie on one tangent curve: E of tens of kV/m.
+        assert!(fit.field > 1e4 && fit.field < 1e5, "{}", fit.field);
+        let at_30 = &fit.rows[0];
+        assert!((at_30.model.unwrap() / 8.0 - 1.0).abs() < 0.05, "{at_30:?}");
+        // Above, the steady arc current drops below silver's 0.4 A first:
+        // the model breaks more than printed, and says so.
+        for row in &fit.rows[1..] {
+            assert!(row.model.unwrap() > row.printed, "{row:?}");
+        }
+    }
+}
