@@ -92,12 +92,14 @@ pub enum BreakingFitError {
     },
 }
 
-/// Fits E and C (or C alone, for one figure) of `model` to `figures` at
-/// the full gap `gap` (m), holding V_min, I_min and D.
+/// Fits C, and E when `fit_field` and there are two figures or more, of
+/// `model` to `figures` at the full gap `gap` (m), holding V_min, I_min
+/// and D (and E otherwise).
 pub fn fit(
     model: &ArcModel,
     gap: f64,
     figures: &[BreakingFigure],
+    fit_field: bool,
 ) -> Result<BreakingFit, BreakingFitError> {
     if figures.is_empty() {
         return Err(BreakingFitError::NoFigures);
@@ -113,7 +115,7 @@ pub fn fit(
         })
         .collect();
     let n = points.len() as f64;
-    let field_fitted = points.len() >= 2;
+    let field_fitted = fit_field && points.len() >= 2;
     // s·V = s·a + q with q = √K: least squares in (a, q), or in q alone.
     let (a, q) = if field_fitted {
         let (sx, sy) = points
@@ -257,7 +259,7 @@ mod tests {
         }
         .model();
         assert!((start.field / truth.field - 1.0).abs() > 0.5);
-        let fit = fit(&start, gap, &figures).unwrap();
+        let fit = fit(&start, gap, &figures, true).unwrap();
         assert!(fit.field_fitted);
         assert!(
             (fit.field / truth.field - 1.0).abs() < 1e-9,
@@ -267,7 +269,7 @@ mod tests {
         assert!((fit.low_current / truth.low_current - 1.0).abs() < 1e-9);
         assert!(fit.rms_log_error < 1e-9);
         // One figure: E held, C through it.
-        let one = super::fit(&start, gap, &figures[..1]).unwrap();
+        let one = super::fit(&start, gap, &figures[..1], true).unwrap();
         assert!(!one.field_fitted);
         assert_eq!(one.field, start.field);
         let row = &one.rows[0];
@@ -284,13 +286,18 @@ mod tests {
             },
         ];
         assert!(matches!(
-            super::fit(&start, gap, &wrong),
+            super::fit(&start, gap, &wrong, true),
             Err(BreakingFitError::Unphysical { .. })
         ));
         assert_eq!(
-            super::fit(&start, gap, &[]),
+            super::fit(&start, gap, &[], true),
             Err(BreakingFitError::NoFigures)
         );
+        // E held over several figures: C alone, by least squares.
+        let held = super::fit(&start, gap, &figures, false).unwrap();
+        assert!(!held.field_fitted);
+        assert_eq!(held.field, start.field);
+        assert!(held.low_current > 0.0 && held.low_current != start.low_current);
     }
 
     #[test]
@@ -304,7 +311,7 @@ mod tests {
             ..ArcSection::default()
         }
         .model();
-        let fit = fit(&model, 0.3e-3, &printed).unwrap();
+        let fit = fit(&model, 0.3e-3, &printed, true).unwrap();
         // The three points lie on one tangent curve: E of tens of kV/m.
         assert!(fit.field > 1e4 && fit.field < 1e5, "{}", fit.field);
         let at_30 = &fit.rows[0];

@@ -116,6 +116,14 @@ pub enum FitError {
         "no free keys: list the keys the fit may move in [fit] free = [...] or with --free KEY,..."
     )]
     NoFreeKeys,
+    /// The arc's keys cannot be fitted to the breaking curve.
+    #[error("{path}: {problem}")]
+    Breaking {
+        /// The scenario file.
+        path: String,
+        /// What is wrong and what to do.
+        problem: String,
+    },
     /// A free key is not a number key of the scenario.
     #[error("{path}: free key `{key}`: {source}")]
     UnknownKey {
@@ -401,11 +409,38 @@ pub struct FitReport {
     /// by ` + `.
     #[serde(skip)]
     pub fitted_to: String,
+    /// With `arc.low_current` (and `arc.field`) free: the arc constants
+    /// fitted to the printed DC breaking capacity, each figure beside the
+    /// fitted model's breakable current.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub breaking: Option<crate::arc::breaking::BreakingFit>,
+    /// The scenario's own `[provenance]` when only the arc was fitted: its
+    /// mechanics' record stays, the arc's rows are added to it.
+    #[serde(skip)]
+    pub kept_provenance: Option<ProvenanceSection>,
 }
 
 impl FitReport {
     /// The `[provenance]` section for the fitted scenario.
     pub fn provenance(&self) -> ProvenanceSection {
+        if let Some(kept) = &self.kept_provenance {
+            let mut merged = kept.clone();
+            for p in &self.parameters {
+                merged.parameters.insert(
+                    p.key.clone(),
+                    FittedParameter {
+                        prior: p.prior,
+                        value: p.value,
+                        sigma: p.sigma,
+                        determined: p.determined,
+                    },
+                );
+            }
+            if !merged.fitted_to.contains("dc_breaking") {
+                merged.fitted_to.push_str(" + dc_breaking");
+            }
+            return merged;
+        }
         ProvenanceSection {
             fitted_to: self.fitted_to.clone(),
             rms_residual: self.rms_residual,
@@ -841,6 +876,153 @@ fn event_residuals(measured: &[Event], model: &[Event]) -> (Vec<f64>, f64) {
 /// `[datasheet]` figures take part whenever it has any.
 pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitError> {
     let started = Instant::now();
+    // The arc's keys are fitted in closed form to the breaking curve; the
+    // rest by the mechanics fit below.
+    let free: Vec<String> = if request.free.is_empty() {
+        scenario
+            .fit
+            .as_ref()
+            .map(|f| f.free.clone())
+            .unwrap_or_default()
+    } else {
+        request.free.clone()
+    };
+    let (arc_keys, mechanical): (Vec<String>, Vec<String>) =
+        free.into_iter().partition(|k| k.starts_with("arc."));
+    if arc_keys.is_empty() {
+        return fit_mechanics(scenario, request, started);
+    }
+    let mut report = if mechanical.is_empty() {
+        FitReport {
+            parameters: Vec::new(),
+            events: Vec::new(),
+            bounce_count: None,
+            datasheet: Vec::new(),
+            time_offset: None,
+            rms_residual: 0.0,
+            evaluations: 0,
+            elapsed: 0.0,
+            pick_up_binds: None,
+            notes: Vec::new(),
+            breaking: None,
+            kept_provenance: scenario.provenance.clone(),
+            fitted: scenario.clone(),
+            fitted_to: "dc_breaking".to_owned(),
+        }
+    } else {
+        let mut scenario = scenario.clone();
+        if let Some(f) = scenario.fit.as_mut() {
+            f.free.retain(|k| !k.starts_with("arc."));
+        }
+        let request = FitRequest {
+            record: request.record.clone(),
+            free: if request.free.is_empty() {
+                Vec::new()
+            } else {
+                mechanical
+            },
+        };
+        fit_mechanics(&scenario, &request, started)?
+    };
+    fit_breaking(scenario, &arc_keys, &mut report)?;
+    report.elapsed = started.elapsed().as_secs_f64();
+    Ok(report)
+}
+
+/// The arc constants `keys` (`arc.low_current`, and `arc.field` with two
+/// figures or more) fitted in closed form to `[datasheet] dc_breaking` at
+/// the contact's full gap (crate::arc::breaking), into `report`.
+fn fit_breaking(
+    scenario: &Scenario,
+    keys: &[String],
+    report: &mut FitReport,
+) -> Result<(), FitError> {
+    let path = scenario.origin.display().to_string();
+    for key in keys {
+        if !matches!(key.as_str(), "arc.low_current" | "arc.field") {
+            return Err(FitError::Breaking {
+                path,
+                problem: format!(
+                    "free key `{key}`: of the arc, only arc.low_current and arc.field are \
+                     fitted (to [datasheet] dc_breaking); arc.low_current_gap is held, as one \
+                     gap cannot tell it from arc.low_current"
+                ),
+            });
+        }
+    }
+    let figures = scenario
+        .datasheet
+        .as_ref()
+        .map(|d| d.dc_breaking.clone())
+        .unwrap_or_default();
+    if figures.is_empty() {
+        return Err(FitError::Breaking {
+            path,
+            problem: "the arc's keys are fitted to the DC breaking capacity: add \
+                      [datasheet] dc_breaking = [{ voltage = ..., current = ... }, ...]"
+                .to_owned(),
+        });
+    }
+    let section = scenario.arc.unwrap_or_default();
+    let model = section.model();
+    let gap = report.fitted.mechanics.gap;
+    let fit_field = keys.iter().any(|k| k == "arc.field");
+    let fitted = crate::arc::breaking::fit(&model, gap, &figures, fit_field).map_err(|e| {
+        FitError::Breaking {
+            path: path.clone(),
+            problem: e.to_string(),
+        }
+    })?;
+    let determined = if figures.len() == keys.len() {
+        Determined::Exactly
+    } else {
+        Determined::Yes
+    };
+    let mut rows = vec![ParameterRow {
+        key: "arc.low_current".to_owned(),
+        prior: model.low_current,
+        value: fitted.low_current,
+        sigma: None,
+        determined,
+    }];
+    if fit_field && fitted.field_fitted {
+        rows.insert(
+            0,
+            ParameterRow {
+                key: "arc.field".to_owned(),
+                prior: model.field,
+                value: fitted.field,
+                sigma: None,
+                determined,
+            },
+        );
+    } else if fit_field {
+        report.notes.push(
+            "arc.field held at its value: one DC breaking figure fixes arc.low_current only"
+                .to_owned(),
+        );
+    }
+    report.parameters.extend(rows);
+    report.fitted.arc = Some(crate::arc::ArcSection {
+        field: Some(fitted.field),
+        low_current: Some(fitted.low_current),
+        ..section
+    });
+    if report.fitted_to.is_empty() {
+        report.fitted_to = "dc_breaking".to_owned();
+    } else if !report.fitted_to.contains("dc_breaking") {
+        report.fitted_to.push_str(" + dc_breaking");
+    }
+    report.breaking = Some(fitted);
+    report.fitted.provenance = Some(report.provenance());
+    Ok(())
+}
+
+fn fit_mechanics(
+    scenario: &Scenario,
+    request: &FitRequest,
+    started: Instant,
+) -> Result<FitReport, FitError> {
     let problem = Problem::new(scenario, request)?;
     let u_prior: Vec<f64> = problem.prior.iter().map(|p| p.ln()).collect();
     let mut active: Vec<usize> = (0..problem.keys.len()).collect();

@@ -194,6 +194,8 @@ pub(super) fn assemble(
         notes,
         fitted: scenario.clone(),
         fitted_to: fitted_to.join(" + "),
+        breaking: None,
+        kept_provenance: None,
     };
     fitted.provenance = Some(report.provenance());
     FitReport { fitted, ..report }

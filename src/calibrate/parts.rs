@@ -66,7 +66,7 @@ const PARTS: &[Part] = &[
     Part {
         name: "omron-g5le-1-dc5",
         class: "sugar-cube 10 A PCB power relay",
-        source: "Omron G5LE-1 DC5; Omron datasheet \"G5LE PCB Power Relay: Cubic, Single-pole 10A Power Relay\" (coil ratings: 5 VDC, 79.4 mA, 63 Ω, must operate 75 % max., must release 10 % min.; operate time 10 ms max., release time 5 ms max.)",
+        source: "Omron G5LE-1 DC5; Omron datasheet \"G5LE PCB Power Relay: Cubic, Single-pole 10A Power Relay\" (coil ratings: 5 VDC, 79.4 mA, 63 Ω, must operate 75 % max., must release 10 % min.; operate time 10 ms max., release time 5 ms max.; rated load, resistive: 8 A at 30 VDC, the arc's low-current term fitted to it; AgSnO2 contacts as the earlier edition prints)",
         contact_rating: "single-pole 10 A power relay (SPDT)",
         remark: "times are maxima: the fitted relay is the slowest the datasheet allows",
         scenario: bundled_part_text("omron-g5le-1-dc5"),
@@ -74,7 +74,7 @@ const PARTS: &[Part] = &[
     Part {
         name: "songle-srd-05vdc-sl-c",
         class: "sugar-cube 10 A PCB power relay (hobby modules)",
-        source: "Songle SRD-05VDC-SL-C; Ningbo Songle Relay SRD datasheet, coil data chart (high sensitivity 0.36 W: 5 VDC, 71.4 mA, 70 Ω ±10 %, pull-in 75 % max., drop-out 10 % min.; operation time 10 ms max., release time 5 ms max.)",
+        source: "Songle SRD-05VDC-SL-C; Ningbo Songle Relay SRD datasheet, coil data chart (high sensitivity 0.36 W: 5 VDC, 71.4 mA, 70 Ω ±10 %, pull-in 75 % max., drop-out 10 % min.; operation time 10 ms max., release time 5 ms max.; contact rating, form C resistive: 7 A 28 VDC, the arc's low-current term fitted to it; AgCdO contacts, modelled as silver)",
         contact_rating: "10 A 125 VAC / 10 A 30 VDC resistive (form C)",
         remark: "times are maxima: the fitted relay is the slowest the datasheet allows",
         scenario: bundled_part_text("songle-srd-05vdc-sl-c"),
@@ -90,7 +90,7 @@ const PARTS: &[Part] = &[
     Part {
         name: "finder-40.52-12vdc",
         class: "industrial PCB/plug-in relay",
-        source: "Finder 40.52.9.012.0000; Finder datasheet \"40 Series - Miniature PCB/Plug-in relays 8 - 10 - 12 - 16 A\" (DC coil 0.65 W, operating range 0.73…1.5 U_N, must drop-out 0.1 U_N, operate/release time 7/3 ms); coil resistance 220 Ω as listed for 40.52.9.012.0000",
+        source: "Finder 40.52.9.012.0000; Finder datasheet \"40 Series - Miniature PCB/Plug-in relays 8 - 10 - 12 - 16 A\" (DC coil 0.65 W, operating range 0.73…1.5 U_N, must drop-out 0.1 U_N, operate/release time 7/3 ms); coil resistance 220 Ω as listed for 40.52.9.012.0000; contact specification, \"Breaking capacity DC1: 30/110/220 V\" 8/0.3/0.12 A for 40.52, AgNi contacts (the arc's field and low-current term fitted to those three figures at the part's 0.3 mm gap)",
         contact_rating: "2 CO 8 A 250 VAC",
         remark: "pick-up 8.76 V = 0.73 × 12 V (the lower end of the operating range)",
         scenario: bundled_part_text("finder-40.52-12vdc"),
@@ -106,7 +106,7 @@ const PARTS: &[Part] = &[
     Part {
         name: "te-v23145-12v",
         class: "automotive plug-in Micro ISO relay",
-        source: "TE Connectivity Micro Relay Low Noise V23145 (coil code *01-402); TE datasheet \"Automotive Relays, Plug-in Micro ISO Relays, Micro Relay Low Noise\" (12 VDC, operate 7.2 V, release 1.4 V, 181 Ω ±10 %, 796 mW)",
+        source: "TE Connectivity Micro Relay Low Noise V23145 (coil code *01-402); TE datasheet \"Automotive Relays, Plug-in Micro ISO Relays, Micro Relay Low Noise\" (12 VDC, operate 7.2 V, release 1.4 V, 181 Ω ±10 %, 796 mW; limiting breaking current 30 A at 13.5 VDC, the most for a 12 VDC load, the arc's low-current term fitted to it; silver-based contacts)",
         contact_rating: "20 A NO at 23 °C, 12 VDC",
         remark: "no operate, bounce or release time printed in the coil data: the mass is the prior's",
         scenario: bundled_part_text("te-v23145-12v"),
@@ -199,6 +199,11 @@ pub struct Listing {
     /// The ranges of the keys its datasheet does not fix, with their
     /// source, for `run --envelope` and `check --envelope`.
     pub envelope: Option<crate::scenario::EnvelopeSection>,
+    /// The printed DC breaking capacity (resistive), each figure with the
+    /// part's arc model's largest breakable current at its voltage and
+    /// the full contact gap (`model`; `null`: breaks any current).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub dc_breaking: Vec<crate::arc::breaking::BreakingRow>,
 }
 
 /// The listing of `part`: its datasheet figures against its scenario's.
@@ -231,6 +236,11 @@ pub fn listing(part: &Part) -> Listing {
         remark: part.remark,
         pick_up_binds: pick_up_of(&scenario).map(|(pu, line)| pu.binding_text(&line)),
         envelope: scenario.envelope.clone(),
+        dc_breaking: crate::arc::breaking::rows(
+            &scenario.arc.unwrap_or_default().model(),
+            scenario.mechanics.gap,
+            &d.dc_breaking,
+        ),
     }
 }
 
@@ -283,6 +293,7 @@ pub fn table() -> String {
                 printed_text(printed, unit)
             );
         }
+        out.push_str(&super::render::breaking_rows(&l.dc_breaking));
         if let Some(binds) = &l.pick_up_binds {
             let _ = writeln!(out, "  pick-up binds     {binds}");
         }

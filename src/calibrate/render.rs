@@ -102,6 +102,18 @@ pub fn table(report: &FitReport) -> String {
             );
         }
     }
+    if let Some(b) = &report.breaking {
+        let _ = writeln!(out);
+        let _ = write!(out, "{}", breaking_rows(&b.rows));
+        let _ = writeln!(
+            out,
+            "arc fitted at the full gap {}: field {}, low-current term {} (rms of ln(model/printed) {:.4})",
+            engineering(b.gap, "m"),
+            engineering(b.field, "V/m"),
+            engineering(b.low_current, "V·A"),
+            b.rms_log_error
+        );
+    }
     // A record's misfit is a time; a datasheet's alone is relative.
     let rms = if report.events.is_empty() {
         format!("{:.4} %", report.rms_residual * 100.0)
@@ -269,4 +281,28 @@ pub fn overlay_svg_with(
     );
     svg.push_str("</svg>\n");
     svg
+}
+
+/// DC breaking figures beside the model's breakable current, one line
+/// each: `dc_breaking  30 V: 8 A printed, model 7.93 A (0.991)`.
+pub fn breaking_rows(rows: &[crate::arc::breaking::BreakingRow]) -> String {
+    use std::fmt::Write;
+    let mut out = String::new();
+    for r in rows {
+        let model = match r.model {
+            Some(m) => format!(
+                "model {} ({:.3} of printed)",
+                engineering(m, "A"),
+                m / r.printed
+            ),
+            None => "model: breaks any current (the supply is below V_min + E·gap)".to_owned(),
+        };
+        let _ = writeln!(
+            out,
+            "  dc_breaking       {} at {}  ({model})",
+            engineering(r.printed, "A"),
+            engineering(r.voltage, "V"),
+        );
+    }
+    out
 }

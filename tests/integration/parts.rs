@@ -21,7 +21,12 @@ fn there_are_ten_parts_and_each_meets_its_datasheet() {
         );
         let d = scenario.datasheet.clone().expect("a [datasheet]");
         let provenance = scenario.provenance.clone().expect("a [provenance]");
-        assert_eq!(provenance.fitted_to, "datasheet", "{}", part.name);
+        assert!(
+            ["datasheet", "datasheet + dc_breaking"].contains(&provenance.fitted_to.as_str()),
+            "{}: {}",
+            part.name,
+            provenance.fitted_to
+        );
         let model = datasheet_figures(&scenario, &d);
         let mut checked = 0;
         for (name, printed) in d.figures() {
@@ -248,4 +253,113 @@ fn every_part_envelope_evaluates_every_relay_at_64_samples() {
     }
     assert_eq!(names.len(), parts::all().len());
     assert!(names.len() >= 11, "{names:?}");
+}
+
+/// Every power part that prints a DC breaking figure meets it at the
+/// lowest printed voltage with its fitted arc (the model's largest
+/// breakable current, at its full gap, within 1 %), and `fit` recovers the
+/// arc constants from the figures alone, starting from the defaults.
+#[test]
+fn power_parts_break_what_their_datasheets_print() {
+    let listed: serde_json::Value = serde_json::from_slice(
+        &Command::cargo_bin("chatterspice")
+            .unwrap()
+            .args(["parts", "--format", "json"])
+            .output()
+            .unwrap()
+            .stdout,
+    )
+    .unwrap();
+    let with_figures: Vec<&serde_json::Value> = listed
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|p| p["dc_breaking"].is_array())
+        .collect();
+    assert!(with_figures.len() >= 4, "{}", with_figures.len());
+    for part in &with_figures {
+        let first = &part["dc_breaking"][0];
+        let (printed, model) = (
+            first["printed"].as_f64().unwrap(),
+            first["model"].as_f64().unwrap(),
+        );
+        assert!(
+            (model / printed - 1.0).abs() < 0.01,
+            "{}: {first}",
+            part["name"]
+        );
+    }
+
+    // The Finder's three figures, fitted from silver's defaults.
+    let dir = tempfile::tempdir().unwrap();
+    let part = parts::find("finder-40.52-12vdc").unwrap();
+    let text = part
+        .scenario
+        .replace("field = ", "# field = ")
+        .replace("low_current = ", "# low_current = ");
+    assert!(text.contains("current = 0.3\n"));
+    let prior = dir.path().join("prior.toml");
+    std::fs::write(&prior, &text).unwrap();
+    let defaults = Scenario::load(&prior).unwrap().arc.unwrap().model();
+    assert_eq!(defaults.low_current, chatterspice::arc::DEFAULT_LOW_CURRENT);
+    let fitted = dir.path().join("fitted.toml");
+    let out = Command::cargo_bin("chatterspice")
+        .unwrap()
+        .args(["fit"])
+        .arg(&prior)
+        .args(["--free", "arc.field,arc.low_current", "-o"])
+        .arg(&fitted)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let model = Scenario::load(&fitted).unwrap().arc.unwrap().model();
+    // The three figures lie on one tangent curve: a = 21.0 V, K = 5.40 V·A
+    // at the 0.3 mm gap.
+    assert!(
+        (model.arc_voltage(0.3e-3) / 21.0 - 1.0).abs() < 2e-3,
+        "{model:?}"
+    );
+    assert!((model.low_current / 5.40 - 1.0).abs() < 2e-3, "{model:?}");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("dc_breaking") && stdout.contains("arc.field"),
+        "{stdout}"
+    );
+    // The mechanics' provenance is kept, the arc's added.
+    let written = std::fs::read_to_string(&fitted).unwrap();
+    assert!(written.contains("mechanics.mass") && written.contains("\"arc.low_current\""));
+
+    // A figure that is not a number a datasheet prints names its key.
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, text.replace("current = 0.3\n", "current = -0.3\n")).unwrap();
+    let out = Command::cargo_bin("chatterspice")
+        .unwrap()
+        .args(["fit"])
+        .arg(&bad)
+        .args(["--free", "arc.low_current"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("datasheet.dc_breaking") && stderr.contains("figure 2"),
+        "{stderr}"
+    );
+    // Arc keys without a breaking curve: told what to add.
+    let out = Command::cargo_bin("chatterspice")
+        .unwrap()
+        .args([
+            "fit",
+            "parts/coto-9104-05.toml",
+            "--free",
+            "arc.low_current",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("dc_breaking"));
 }
