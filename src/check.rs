@@ -559,6 +559,7 @@ pub fn evaluate(scenario: &Scenario, run: &RunResult) -> Verdict {
     if let Some(limits) = &scenario.limits {
         checks.extend(arc_checks(limits, run.arcs.as_ref(), &run.operations));
     }
+    checks.extend(making_checks(scenario, &run.makes));
     for (i, (probe, result)) in scenario.probes.iter().zip(&run.probes).enumerate() {
         checks.extend(probe_checks(i, probe, &result.analysis));
     }
@@ -635,6 +636,61 @@ pub fn arc_checks(
     out
 }
 
+/// `max_making_current`, `min_weld_margin` and the datasheet's
+/// `making_current` against the run's worst make.
+pub fn making_checks(scenario: &Scenario, makes: &[crate::arc::making::Make]) -> Vec<LimitCheck> {
+    let worst_current = makes
+        .iter()
+        .map(|m| m.peak_current)
+        .fold(None, |w: Option<f64>, c| Some(w.map_or(c, |w| w.max(c))));
+    let no_make = || "the contact never closed in the run: no make to measure".to_owned();
+    let mut out = Vec::new();
+    let limits = scenario.limits.unwrap_or_default();
+    let printed = scenario
+        .datasheet
+        .as_ref()
+        .and_then(|d| d.making_current)
+        .and_then(|f| f.max.or(f.typ));
+    for (key, limit) in [
+        ("limits.max_making_current", limits.max_making_current),
+        ("datasheet.making_current", printed),
+    ] {
+        if let Some(limit) = limit {
+            out.push(LimitCheck::new(
+                key.into(),
+                "peak current of the worst make".into(),
+                "A",
+                Bound::Max,
+                limit,
+                worst_current.ok_or_else(no_make),
+            ));
+        }
+    }
+    if let Some(limit) = limits.min_weld_margin {
+        let worst = makes
+            .iter()
+            .filter_map(|m| m.weld_margin)
+            .fold(None, |w: Option<f64>, m| Some(w.map_or(m, |w| w.min(m))));
+        out.push(LimitCheck::new(
+            "limits.min_weld_margin".into(),
+            "weld margin U_m/U of the worst make".into(),
+            "",
+            Bound::Min,
+            limit,
+            worst.ok_or_else(|| {
+                if makes.is_empty() {
+                    no_make()
+                } else {
+                    "not evaluated: the contact force at the makes is known for a step-force \
+                     relay only (a coil-driven or measured relay's force is not modelled here)"
+                        .to_owned()
+                }
+            }),
+        ));
+    }
+    out
+}
+
 /// What [`run`] did to reach its verdict.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Evidence {
@@ -686,14 +742,20 @@ pub fn run_with(
     relay_only(scenario)
 }
 
-/// Whether a limit needs the circuit run: a probe's limits, or the arc
-/// limits.
+/// Whether a limit needs the circuit run: a probe's limits, the arc
+/// limits, or the making limits (a printed making current with a
+/// circuit to make it in).
 pub fn needs_circuit(scenario: &Scenario) -> bool {
-    let arc_limits = scenario
+    let circuit_limits = scenario
         .limits
         .as_ref()
-        .is_some_and(LimitsSection::has_arc_limits);
-    scenario.probes.iter().any(Probe::has_limits) || arc_limits
+        .is_some_and(|l| l.has_arc_limits() || l.has_making_limits());
+    let printed_making = scenario.circuit.is_some()
+        && scenario
+            .datasheet
+            .as_ref()
+            .is_some_and(|d| d.making_current.is_some());
+    scenario.probes.iter().any(Probe::has_limits) || circuit_limits || printed_making
 }
 
 /// Check `scenario` against a measured chatter sequence (a scope record)

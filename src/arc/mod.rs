@@ -17,12 +17,15 @@
 //! - [`vectors`] names what the arc element (written with the contact
 //!   include, so ngspice carries the arc) puts in the raw file;
 //! - [`analysis`] finds every arc and breakdown in the run's raw file;
+//! - [`making`] is each make's peak current and what it does to the
+//!   contact spot;
 //! - [`breaking`] is the largest DC current the contact breaks, and the
 //!   arc constants fitted to a printed breaking curve.
 
 pub mod analysis;
 pub mod breaking;
 pub mod gap;
+pub mod making;
 mod model;
 pub mod vectors;
 

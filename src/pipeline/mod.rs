@@ -266,6 +266,10 @@ pub struct RunResult {
     /// With `[pole_face]`: the armature's impacts on the pole face (the
     /// contact's record is then the blade's).
     pub pole_face: Option<Vec<crate::chatter::Impact>>,
+    /// Every make of the contact (the first and each re-make after a
+    /// bounce): its peak current and, where the run knows the contact
+    /// force, the spot's voltage, temperature and weld margin.
+    pub makes: Vec<crate::arc::making::Make>,
 }
 
 /// Run the whole pipeline on `scenario` with `runner`. A scenario with a
@@ -312,11 +316,71 @@ pub fn run_plan(
         .pole_face
         .is_some()
         .then(|| trajectory.pole_face_impacts().to_vec());
-    let chatter = trajectory.into_chatter();
+    let chatter = trajectory.chatter().clone();
     let (waveform, model) = contact_waveform_of(scenario, surface, &chatter)?;
     let mut result = run_chatter(plan, chatter, waveform, &model, gap, runner, options)?;
     result.pole_face = pole_face;
+    // A step-force relay knows its contact force at every instant.
+    result.makes = contact_makes(
+        scenario,
+        plan.netlist().map(|n| n.text.as_str()),
+        &result.simulation.plot,
+        &result.waveform,
+        &result.chatter,
+        Some(&|t| trajectory.contact_force(t)),
+    );
     Ok(result)
+}
+
+/// Every make of `chatter` in `plot`: the contact current is the voltage
+/// across the contact instance's nodes times the waveform's conductance;
+/// `force_at` (N at s) where the run knows the contact force.
+fn contact_makes(
+    scenario: &Scenario,
+    netlist_text: Option<&str>,
+    plot: &Plot,
+    waveform: &Waveform,
+    chatter: &Chatter,
+    force_at: Option<&dyn Fn(f64) -> f64>,
+) -> Vec<crate::arc::making::Make> {
+    let (Some(circuit), Some(text)) = (&scenario.circuit, netlist_text) else {
+        return Vec::new();
+    };
+    let Some((a, b)) = netlist::instance_nodes_of(text, &circuit.subckt)
+        .into_iter()
+        .next()
+    else {
+        return Vec::new();
+    };
+    let Some(crate::rawfile::Vector::Real(time)) = plot.scale() else {
+        return Vec::new();
+    };
+    let zero = vec![0.0; time.len()];
+    let node = |n: &str| {
+        if matches!(n, "0" | "gnd") {
+            Some(zero.as_slice())
+        } else {
+            plot.real(&format!("v({n})"))
+        }
+    };
+    let (Some(va), Some(vb)) = (node(&a), node(&b)) else {
+        return Vec::new();
+    };
+    let current: Vec<f64> = (0..time.len().min(va.len()).min(vb.len()))
+        .map(|k| (va[k] - vb[k]) * waveform.conductance_at(time[k]))
+        .collect();
+    let material = scenario
+        .arc
+        .and_then(|a| a.material)
+        .unwrap_or(crate::arc::REFERENCE_MATERIAL)
+        .spot();
+    crate::arc::making::makes(
+        time,
+        &current,
+        &analysis::closures(chatter),
+        force_at,
+        &material,
+    )
 }
 
 /// Whether the circuit drives the relay's coil: its netlist instantiates
@@ -555,10 +619,19 @@ fn run_chatter(
         &chatter,
         &gap,
     ));
+    let makes = contact_makes(
+        scenario,
+        Some(netlist_text),
+        &simulation.plot,
+        &waveform,
+        &chatter,
+        None,
+    );
     Ok(RunResult {
         coupling: None,
         operations: Vec::new(),
         pole_face: None,
+        makes,
         arcs,
         netlist: netlist_path,
         chatter,
@@ -701,7 +774,16 @@ fn run_coil(plan: &Plan, runner: &dyn Runner, options: &RunOptions) -> Result<Ru
             &gap,
         ));
     }
+    let makes = contact_makes(
+        scenario,
+        netlist_text,
+        &coupled.plot,
+        &waveform,
+        &coupled.chatter,
+        None,
+    );
     Ok(RunResult {
+        makes,
         netlist: netlist_path,
         chatter: coupled.chatter,
         waveform,

@@ -159,6 +159,8 @@ pub struct RunJson<'a> {
     /// With `[arc]`: the numbers the arcs were simulated with.
     #[serde(skip_serializing_if = "Option::is_none")]
     arc_model: Option<&'a ArcModel>,
+    /// Every make: its peak current, the force then and the spot.
+    makes: &'a [crate::arc::making::Make],
 }
 
 /// One probe: the contract's fields (flattened from the analysis), then
@@ -241,6 +243,7 @@ impl<'a> RunJson<'a> {
             arc_totals: run.arcs.as_ref().map(|a| &a.totals),
             breakdowns: run.arcs.as_ref().map(|a| a.breakdowns.as_slice()),
             arc_model: run.arcs.as_ref().map(|a| &a.model),
+            makes: &run.makes,
         }
     }
 }

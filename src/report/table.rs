@@ -146,6 +146,10 @@ pub fn render_run(run: &RunResult) -> String {
         out.push('\n');
         probe_paragraph(&mut out, p);
     }
+    if !run.makes.is_empty() {
+        out.push('\n');
+        out.push_str(&render_makes(&run.makes));
+    }
     if let Some(report) = &run.arcs {
         out.push('\n');
         out.push_str(&render_arcs(report));
@@ -317,6 +321,40 @@ fn probe_paragraph(out: &mut String, p: &ProbeResult) {
         }
         out.push_str(&align(&rows, 1));
     }
+}
+
+/// The makes of a run: one row each, with the spot figures where the
+/// force is known.
+pub fn render_makes(makes: &[crate::arc::making::Make]) -> String {
+    let mut out = String::from(
+        "makes (peak contact current of each closure; weld margin U_m/U at that peak):\n",
+    );
+    let mut rows = vec![
+        [
+            "make",
+            "at",
+            "peak",
+            "force",
+            "spot",
+            "T max",
+            "weld margin",
+        ]
+        .map(str::to_owned),
+    ];
+    for (k, m) in makes.iter().enumerate() {
+        let or_dash = |v: Option<String>| v.unwrap_or_else(|| "-".to_owned());
+        rows.push([
+            (k + 1).to_string(),
+            engineering(m.time, "s"),
+            engineering(m.peak_current, "A"),
+            or_dash(m.force.map(|f| engineering(f, "N"))),
+            or_dash(m.spot_voltage.map(|u| engineering(u, "V"))),
+            or_dash(m.t_max.map(|t| format!("{t:.0} K"))),
+            or_dash(m.weld_margin.map(|w| format!("{w:.3}"))),
+        ]);
+    }
+    out.push_str(&align(&rows, 1));
+    out
 }
 
 /// The arcs of a run: the totals line, then one row per arc and per

@@ -42,6 +42,10 @@ pub struct DatasheetSection {
     /// current the contact breaks at each voltage.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub dc_breaking: Vec<BreakingFigure>,
+    /// A, the printed making (inrush) current rating: `{ max = ... }`, the
+    /// peak current any make may carry; `check` holds every make to it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub making_current: Option<PrintedFigure>,
 }
 
 /// One point of a printed DC breaking-capacity curve (resistive load).
@@ -214,6 +218,16 @@ impl super::check::Check<'_> {
                         if what == "voltage" { "V" } else { "A" }
                     ),
                 )?;
+            }
+        }
+        if let Some(m) = &d.making_current {
+            if let Err((field, value, requirement)) = m.check() {
+                let key = if field.is_empty() {
+                    "datasheet.making_current".to_owned()
+                } else {
+                    format!("datasheet.making_current.{field}")
+                };
+                return Err(self.invalid(&key, value, requirement));
             }
         }
         for (name, figure) in d.figures() {

@@ -37,6 +37,12 @@ pub struct LimitsSection {
     /// s, the longest arc (needs `[arc]` and a run); an arc still burning
     /// when the run ends fails it.
     pub max_arc_duration: Option<f64>,
+    /// A, the largest peak current of any make (the first or a re-make
+    /// after a bounce; needs a run).
+    pub max_making_current: Option<f64>,
+    /// The least static-weld margin U_m/U of any make whose contact force
+    /// the run knows (needs a run).
+    pub min_weld_margin: Option<f64>,
     /// s, the contact's own debounce lockout in each closing: its last
     /// transition − its first make, what a debouncer reading the contact
     /// directly must ignore it for (the bounce time, named as a debouncer
@@ -54,6 +60,11 @@ impl LimitsSection {
         self.max_arc_energy.is_some()
             || self.max_arc_count.is_some()
             || self.max_arc_duration.is_some()
+    }
+
+    /// Whether a making limit is set: those need the circuit run.
+    pub fn has_making_limits(&self) -> bool {
+        self.max_making_current.is_some() || self.min_weld_margin.is_some()
     }
 }
 
@@ -99,6 +110,16 @@ impl Check<'_> {
                 "limits.max_arc_duration",
                 l.max_arc_duration,
                 "the longest arc allowed, in s",
+            ),
+            (
+                "limits.max_making_current",
+                l.max_making_current,
+                "the largest peak current allowed at any make, in A",
+            ),
+            (
+                "limits.min_weld_margin",
+                l.min_weld_margin,
+                "the least weld margin U_m/U allowed at any make (1: the spot just melts)",
             ),
             (
                 "limits.max_lockout",

@@ -709,3 +709,92 @@ fn a_dc_load_the_contact_cannot_break_is_reported_as_still_burning() {
         "{stdout}"
     );
 }
+
+/// Every make onto a capacitor is a new inrush: the peak current of each
+/// closure is what the source drives into the capacitor's voltage at
+/// that instant, (V − v_C)/(R + r_closed), and each carries the contact
+/// force of the built-in (step-force) relay at its peak, from which the
+/// spot's figures follow; `check` holds the worst make to the making
+/// limits.
+#[test]
+fn every_make_onto_a_capacitor_is_a_new_inrush() {
+    let ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    let netlist = "10 V onto 100 uF\nV1 vcc 0 10\nR1 vcc a 1\nX1 a c CONTACT\nC1 c 0 100u IC=0\n\
+                   .tran 0.1u 10m 0 1u uic\n.end\n";
+    let scenario = relay_on(dir.path(), netlist, "");
+    let result = run(&ng, &scenario);
+    let makes = &result.makes;
+    assert_eq!(makes.len(), result.chatter.bounce_count + 1, "{makes:?}");
+    let plot = &result.simulation.plot;
+    let time = match plot.scale() {
+        Some(chatterspice::rawfile::Vector::Real(t)) => t,
+        _ => panic!("a transient"),
+    };
+    let vc = plot.real("v(c)").unwrap();
+    for m in makes {
+        let k = time.partition_point(|&t| t < m.time);
+        let expected = (10.0 - vc[k]) / (1.0 + 0.05);
+        assert!(
+            (m.peak_current / expected - 1.0).abs() < 0.02,
+            "make at {}: {} A, expected {expected} A",
+            m.time,
+            m.peak_current
+        );
+        let force = m.force.expect("a step-force relay knows its force");
+        assert!(force > 0.0);
+        let ag = chatterspice::arc::Material::Ag.spot();
+        let a = (force / (std::f64::consts::PI * ag.hardness)).sqrt();
+        let u = m.peak_current * ag.resistivity / (2.0 * a);
+        assert!((m.spot_voltage.unwrap() / u - 1.0).abs() < 1e-9);
+        assert!((m.weld_margin.unwrap() - ag.melting_voltage() / u).abs() < 1e-9 * u.recip());
+    }
+    // The first make carries the largest inrush.
+    assert!(
+        makes
+            .iter()
+            .all(|m| m.peak_current <= makes[0].peak_current)
+    );
+
+    // The limits, through the command line.
+    let cir = dir.path().join("circuit.cir");
+    let text = std::fs::read_to_string(&cir).unwrap();
+    assert!(text.contains("100u"));
+    let base = scenario_text_with(dir.path(), &cir);
+    for (limits, code) in [
+        ("max_making_current = 12.0\nmin_weld_margin = 1.0\n", 0),
+        ("max_making_current = 5.0\n", 1),
+        ("min_weld_margin = 1.0e6\n", 1),
+    ] {
+        let path = dir.path().join("limits.toml");
+        std::fs::write(&path, format!("{base}\n[limits]\n{limits}")).unwrap();
+        let out = cli()
+            .args(["check", path.to_str().unwrap(), "--format", "json"])
+            .output()
+            .unwrap();
+        assert_eq!(
+            out.status.code(),
+            Some(code),
+            "{limits}: {}",
+            String::from_utf8_lossy(&out.stdout)
+        );
+        let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert!(
+            doc["run"]["makes"]
+                .as_array()
+                .is_some_and(|m| !m.is_empty()),
+            "{doc}"
+        );
+    }
+}
+
+/// The built-in relay's scenario text with `netlist` as its circuit.
+fn scenario_text_with(dir: &Path, netlist: &Path) -> String {
+    let _ = dir;
+    let cut = DEFAULT_SCENARIO_TOML.find("[circuit]").unwrap();
+    format!(
+        "{}[circuit]\nnetlist = {:?}\n",
+        &DEFAULT_SCENARIO_TOML[..cut],
+        netlist.display().to_string()
+    )
+}
