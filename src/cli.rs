@@ -68,6 +68,11 @@ pub enum Command {
     /// The bundled relay parts (each fitted to its datasheet), or one
     /// part's scenario.
     Parts(calibrate::PartsArgs),
+    /// Estimate the contacts' electrical life: simulate each printed
+    /// endurance figure's test load over its switching phases, calibrate
+    /// the erosion constant on the first and predict the others and the
+    /// scenario's own circuit.
+    Life(LifeArgs),
     /// Print a shell completion script: `chatterspice completions bash >
     /// ~/.local/share/bash-completion/completions/chatterspice`.
     Completions(CompletionsArgs),
@@ -113,6 +118,7 @@ impl Command {
             Command::Capture(args) => done(capture::capture(args)),
             Command::Fit(args) => done(calibrate::fit(args)),
             Command::Parts(args) => done(calibrate::parts(args)),
+            Command::Life(args) => done(life(args)),
             Command::Completions(args) => done(completions(args)),
         }
     }
@@ -400,6 +406,56 @@ impl From<BounceFormat> for Format {
             BounceFormat::Table => Format::Table,
         }
     }
+}
+
+#[derive(Debug, Args)]
+pub struct LifeArgs {
+    /// Scenario file (TOML) with [datasheet] electrical_endurance; `-`
+    /// reads it from stdin. Its [circuit], if any, is the load whose life
+    /// is estimated.
+    #[arg(value_name = "SCENARIO")]
+    pub scenario: Option<PathBuf>,
+
+    /// Switching phases averaged over the period of an AC figure.
+    #[arg(long, value_name = "N", default_value_t = chatterspice::life::DEFAULT_PHASES,
+          value_parser = parse_phases)]
+    pub phases: usize,
+
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = RunFormat::Table)]
+    pub format: RunFormat,
+
+    #[command(flatten)]
+    pub simulator: SimulatorArgs,
+}
+
+fn parse_phases(text: &str) -> Result<usize, String> {
+    match text.parse::<usize>() {
+        Ok(n) if (2..=1024).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "`{text}` is not a number of phases: give a whole number from 2 to 1024, e.g. 16"
+        )),
+    }
+}
+
+fn life(args: &LifeArgs) -> Result<()> {
+    let scenario = load_scenario(args.scenario.as_deref())?;
+    let ngspice = args.simulator.ngspice()?;
+    let report = chatterspice::life::estimate(
+        &scenario,
+        &ngspice,
+        &args.simulator.run_options(),
+        args.phases,
+    )?;
+    let text = match args.format {
+        RunFormat::Json => {
+            let mut t = serde_json::to_string_pretty(&report).expect("the report serializes");
+            t.push('\n');
+            t
+        }
+        RunFormat::Table => chatterspice::life::render(&report),
+    };
+    emit(&text, None, false)
 }
 
 fn bounce(args: &BounceArgs) -> Result<()> {

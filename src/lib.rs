@@ -25,6 +25,7 @@ pub mod commands;
 pub mod envelope;
 pub mod input;
 pub mod interrupt;
+pub mod life;
 pub mod mechanics;
 pub mod netlist;
 pub mod output;

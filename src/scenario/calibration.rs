@@ -46,6 +46,13 @@ pub struct DatasheetSection {
     /// peak current any make may carry; `check` holds every make to it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub making_current: Option<PrintedFigure>,
+    /// The electrical endurance figures as printed (operations at a
+    /// load), for `life`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub electrical_endurance: Vec<crate::life::EnduranceFigure>,
+    /// The Weibull shape β of the printed life, for its B10.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub weibull_shape: Option<f64>,
 }
 
 /// One point of a printed DC breaking-capacity curve (resistive load).
@@ -219,6 +226,14 @@ impl super::check::Check<'_> {
                     ),
                 )?;
             }
+        }
+        if let Some(beta) = d.weibull_shape {
+            self.number(
+                "datasheet.weibull_shape",
+                beta,
+                beta > 0.0 && beta <= 20.0,
+                "must be > 0 and at most 20: the Weibull shape β of the printed life",
+            )?;
         }
         if let Some(m) = &d.making_current {
             if let Err((field, value, requirement)) = m.check() {

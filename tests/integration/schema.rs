@@ -462,3 +462,101 @@ fn raw_signal_analysis_matches_its_schema() {
     }
     assert!(n >= 3, "{n} raw files analysed");
 }
+
+/// `life` on the built-in relay: two printed figures at the same DC load
+/// put the same arc energy into the contacts, so calibrated on the first
+/// the model predicts the second at the first's operations; an AC figure
+/// is averaged over the phases asked for; the scenario's own circuit gets
+/// B / E_op; the JSON is as its schema says; figures that cannot be
+/// simulated name their key.
+#[test]
+fn life_calibrates_on_one_figure_and_predicts_the_others() {
+    if common::ngspice().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let netlist = dir.path().join("load.cir");
+    std::fs::write(
+        &netlist,
+        "30 V, 6 ohm\nV1 vcc 0 30\nR1 vcc a 6\nX1 a 0 CONTACT\n.tran 1u 20m 0 2u\n.end\n",
+    )
+    .unwrap();
+    let base = chatterspice::scenario::DEFAULT_SCENARIO_TOML;
+    let cut = base.find("[circuit]").unwrap();
+    let text = format!(
+        "{}[circuit]\nnetlist = {:?}\n\n[arc]\nmaterial = \"Ag\"\n\n[datasheet]\n\
+         electrical_endurance = [\n\
+           {{ operations = 1.0e5, voltage = 30.0, current = 5.0, supply = \"dc\" }},\n\
+           {{ operations = 4.0e5, voltage = 30.0, current = 5.0, supply = \"dc\" }},\n\
+           {{ operations = 5.0e4, voltage = 125.0, current = 10.0, supply = \"ac\", frequency = 60.0 }},\n\
+         ]\nweibull_shape = 2.0\n",
+        &base[..cut],
+        netlist.display().to_string()
+    );
+    let path = dir.path().join("life.toml");
+    std::fs::write(&path, &text).unwrap();
+    let doc = json_of(
+        &[
+            "life",
+            path.to_str().unwrap(),
+            "--phases",
+            "4",
+            "--format",
+            "json",
+        ],
+        0,
+    );
+    assert_valid("life", &doc, "life");
+    let figures = doc["figures"].as_array().unwrap();
+    let e1 = figures[0]["energy_per_operation"].as_f64().unwrap();
+    assert!(e1 > 0.0, "{doc}");
+    let b = doc["constant_j"].as_f64().unwrap();
+    assert!((b / (1.0e5 * e1) - 1.0).abs() < 1e-12);
+    assert!((figures[0]["ratio"].as_f64().unwrap() - 1.0).abs() < 1e-12);
+    // The same load, printed four times longer: predicted at the first's.
+    assert!(
+        (figures[1]["predicted"].as_f64().unwrap() / 1.0e5 - 1.0).abs() < 1e-9,
+        "{doc}"
+    );
+    assert!((figures[1]["ratio"].as_f64().unwrap() - 0.25).abs() < 1e-9);
+    assert_eq!(figures[0]["phases"], 1);
+    assert_eq!(figures[2]["phases"], 4);
+    // 10 A at 125 V AC burns far longer than 5 A at 30 V DC breaks.
+    assert!(
+        figures[2]["energy_per_operation"].as_f64().unwrap() > 10.0 * e1,
+        "{doc}"
+    );
+    let own = &doc["life"];
+    let e_own = own["energy_per_operation"].as_f64().unwrap();
+    assert!(e_own > 0.0);
+    let n = own["operations"].as_f64().unwrap();
+    assert!((n * e_own / b - 1.0).abs() < 1e-12);
+    let expected_b10 = chatterspice::life::b10(n, 2.0);
+    assert!((own["b10"].as_f64().unwrap() / expected_b10 - 1.0).abs() < 1e-12);
+
+    // Bad figures: exit 2, naming what to fix.
+    for (bad, says) in [
+        (
+            text.replacen("current = 5.0, supply", "current = -5.0, supply", 1),
+            "figure 1",
+        ),
+        (
+            text.replace("supply = \"ac\"", "supply = \"ac\", load = \"motor\""),
+            "resistive",
+        ),
+        (
+            text.replace("weibull_shape = 2.0", "weibull_shape = -1.0"),
+            "weibull_shape",
+        ),
+    ] {
+        std::fs::write(&path, &bad).unwrap();
+        let out = Command::cargo_bin("chatterspice")
+            .unwrap()
+            .args(["life", path.to_str().unwrap()])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{bad}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(says), "{says}: {stderr}");
+    }
+}

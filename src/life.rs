@@ -1,0 +1,456 @@
+//! Electrical life: how many operations the contacts last at a load,
+//! from the energy their arcs put into them (docs/arcs.md, "Electrical
+//! life").
+//!
+//! Each operation erodes the contacts in proportion to the energy of its
+//! arcs (the bounce-opening arcs of the make and the break arc): with E_op
+//! that energy the life is N = B / E_op, B a constant of the relay fixed
+//! on one printed endurance figure by simulating its test load. A
+//! datasheet's endurance test switches at random phase of an AC supply,
+//! so an AC figure's E_op is the mean over switching phases spread evenly
+//! over the period; a DC figure has one.
+//!
+//! Each figure's test circuit is built here: the supply (DC, or AC of the
+//! figure's RMS voltage and frequency), a resistive load drawing the
+//! figure's current, and the contact. The relay closes as it does
+//! without a circuit (its step force, or its coil on the ideal DC step),
+//! stays closed for a hold time after it settled, and breaks; the break's
+//! gap opens at the arc's opening speed (the record of states has no
+//! trajectory for it).
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::chatter::{ContactState, Interval};
+use crate::pipeline::{self, RunOptions};
+use crate::scenario::{CircuitSection, Scenario};
+use crate::spice::Runner;
+
+/// One printed electrical endurance figure, as printed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnduranceFigure {
+    /// The operations the datasheet prints at this load.
+    pub operations: f64,
+    /// V, the supply (RMS for AC).
+    pub voltage: f64,
+    /// A, the load current (RMS for AC).
+    pub current: f64,
+    /// `"ac"` or `"dc"`.
+    pub supply: Supply,
+    /// Hz, for AC (default 50).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frequency: Option<f64>,
+    /// The load: only `"resistive"` is simulated.
+    #[serde(default = "resistive")]
+    pub load: String,
+}
+
+fn resistive() -> String {
+    "resistive".to_owned()
+}
+
+/// The kind of supply of an endurance test.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Supply {
+    /// Alternating, sinusoidal.
+    Ac,
+    /// Direct.
+    Dc,
+}
+
+/// s, how long the contact stays closed after it settled before it breaks.
+pub const HOLD: f64 = 5e-3;
+
+/// The default number of switching phases of an AC figure.
+pub const DEFAULT_PHASES: usize = 16;
+
+/// One figure's result.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FigureLife {
+    /// As printed.
+    pub operations: f64,
+    /// The operations the calibrated model predicts at this load (`null`:
+    /// the load puts no arc energy into the contacts, so the model
+    /// predicts no electrical wear).
+    pub predicted: Option<f64>,
+    /// predicted / printed.
+    pub ratio: Option<f64>,
+    /// J, the mean arc energy of one operation at this load.
+    pub energy_per_operation: f64,
+    /// How many switching phases were averaged (1 for DC).
+    pub phases: usize,
+    /// The mean over the even-numbered half of the phases relative to the
+    /// mean over all of them, minus 1: how far the mean still moves (0
+    /// for DC).
+    pub convergence: f64,
+}
+
+/// The life at the scenario's own circuit.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OwnLife {
+    /// Operations: B / E_op (`null`: no arc energy, no electrical wear).
+    pub operations: Option<f64>,
+    /// The B10 life with the printed Weibull shape (`null` without one).
+    pub b10: Option<f64>,
+    /// J, the arc energy of the circuit's operation.
+    pub energy_per_operation: f64,
+}
+
+/// `life`'s report.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LifeReport {
+    /// The figure B was calibrated on (0-based).
+    pub calibrated_on: usize,
+    /// J, B = N_printed · E_op of that figure.
+    pub constant_j: f64,
+    /// Every printed figure.
+    pub figures: Vec<FigureLife>,
+    /// At the scenario's own circuit, when it has one.
+    pub life: Option<OwnLife>,
+}
+
+/// Why the life cannot be estimated.
+#[derive(Debug, thiserror::Error)]
+pub enum LifeError {
+    /// Nothing printed to calibrate on.
+    #[error(
+        "{0}: no [datasheet] electrical_endurance figures: add the endurance figures the \
+         datasheet prints, e.g. {{ operations = 1.0e5, voltage = 30.0, current = 5.0, supply = \"dc\" }}"
+    )]
+    NoFigures(PathBuf),
+    /// A figure that cannot be simulated.
+    #[error("{path}: datasheet.electrical_endurance figure {index}: {problem}")]
+    BadFigure {
+        /// The scenario file.
+        path: PathBuf,
+        /// 1-based.
+        index: usize,
+        /// What is wrong.
+        problem: String,
+    },
+    /// The calibration figure's load does not arc.
+    #[error(
+        "{path}: figure {index}'s test load puts no arc energy into the contacts, so it cannot \
+         fix the erosion constant: calibrate on a figure whose load arcs"
+    )]
+    NoArcEnergy {
+        /// The scenario file.
+        path: PathBuf,
+        /// 1-based.
+        index: usize,
+    },
+    /// The relay's closing.
+    #[error(transparent)]
+    Closing(#[from] crate::check::CheckError),
+    /// A run of a test circuit.
+    #[error("figure {index}'s test circuit, phase {phase}: {source}")]
+    Run {
+        /// 1-based.
+        index: usize,
+        /// 0-based.
+        phase: usize,
+        /// Why.
+        #[source]
+        source: Box<pipeline::RunError>,
+    },
+    /// The scenario's own circuit.
+    #[error("the scenario's own circuit: {0}")]
+    Own(#[source] Box<pipeline::RunError>),
+    /// The work directory for the test circuits.
+    #[error("cannot write the test circuit: {0}")]
+    Io(#[from] std::io::Error),
+}
+
+/// The life estimate of `scenario` with `phases` switching phases per AC
+/// figure, its ngspice runs through `runner`.
+pub fn estimate(
+    scenario: &Scenario,
+    runner: &dyn Runner,
+    options: &RunOptions,
+    phases: usize,
+) -> Result<LifeReport, LifeError> {
+    let path = scenario.origin.clone();
+    let figures = scenario
+        .datasheet
+        .as_ref()
+        .map(|d| d.electrical_endurance.clone())
+        .unwrap_or_default();
+    if figures.is_empty() {
+        return Err(LifeError::NoFigures(path));
+    }
+    for (k, f) in figures.iter().enumerate() {
+        let problem = if !(f.operations > 0.0 && f.voltage > 0.0 && f.current > 0.0) {
+            Some("operations, voltage and current must be > 0".to_owned())
+        } else if f.load != "resistive" {
+            Some(format!(
+                "load \"{}\": only resistive test loads are simulated",
+                f.load
+            ))
+        } else if f.frequency.is_some_and(|h| h.is_nan() || h <= 0.0) {
+            Some("frequency must be > 0 Hz".to_owned())
+        } else {
+            None
+        };
+        if let Some(problem) = problem {
+            return Err(LifeError::BadFigure {
+                path,
+                index: k + 1,
+                problem,
+            });
+        }
+    }
+    let (closing, _) = crate::check::relay_closing(scenario)?;
+    let dir = tempfile::Builder::new()
+        .prefix("chatterspice-life-")
+        .tempdir()?;
+    let _remove = crate::interrupt::remove_at_stop(dir.path());
+    let mut energies = Vec::with_capacity(figures.len());
+    for (k, figure) in figures.iter().enumerate() {
+        energies.push(figure_energy(
+            scenario,
+            &closing,
+            figure,
+            k,
+            phases,
+            dir.path(),
+            runner,
+            options,
+        )?);
+    }
+    let (e0, _, _) = energies[0];
+    if e0.is_nan() || e0 <= 0.0 {
+        return Err(LifeError::NoArcEnergy { path, index: 1 });
+    }
+    let b = figures[0].operations * e0;
+    let rows = figures
+        .iter()
+        .zip(&energies)
+        .map(|(f, &(e, n, convergence))| {
+            let predicted = (e > 0.0).then(|| b / e);
+            FigureLife {
+                operations: f.operations,
+                predicted,
+                ratio: predicted.map(|p| p / f.operations),
+                energy_per_operation: e,
+                phases: n,
+                convergence,
+            }
+        })
+        .collect();
+    let life = match &scenario.circuit {
+        Some(_) => {
+            let run = pipeline::run(scenario, runner, options)
+                .map_err(|e| LifeError::Own(Box::new(e)))?;
+            let e = run
+                .arcs
+                .as_ref()
+                .map_or(0.0, |a| a.totals.max_operation_energy);
+            let operations = (e > 0.0).then(|| b / e);
+            let shape = scenario.datasheet.as_ref().and_then(|d| d.weibull_shape);
+            Some(OwnLife {
+                operations,
+                b10: operations.zip(shape).map(|(n, beta)| b10(n, beta)),
+                energy_per_operation: e,
+            })
+        }
+        None => None,
+    };
+    Ok(LifeReport {
+        calibrated_on: 0,
+        constant_j: b,
+        figures: rows,
+        life,
+    })
+}
+
+/// `life`'s report as a table for people.
+pub fn render(report: &LifeReport) -> String {
+    use std::fmt::Write;
+    let mut out = format!(
+        "erosion constant B = {:.4e} J, calibrated on figure {}\n",
+        report.constant_j,
+        report.calibrated_on + 1
+    );
+    let _ = writeln!(
+        out,
+        "{:>6} {:>12} {:>12} {:>8} {:>14} {:>7} {:>12}",
+        "figure", "printed", "predicted", "ratio", "J/operation", "phases", "convergence"
+    );
+    for (k, f) in report.figures.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "{:>6} {:>12.4e} {:>12} {:>8} {:>14.4e} {:>7} {:>+11.2}%",
+            k + 1,
+            f.operations,
+            f.predicted
+                .map_or("no wear".to_owned(), |p| format!("{p:.4e}")),
+            f.ratio.map_or("-".to_owned(), |r| format!("{r:.3}")),
+            f.energy_per_operation,
+            f.phases,
+            f.convergence * 100.0
+        );
+    }
+    match &report.life {
+        Some(l) => {
+            let _ = writeln!(
+                out,
+                "life at the scenario's circuit: {} operations ({:.4e} J per operation){}",
+                l.operations
+                    .map_or("unlimited by arcs (no arc energy)".to_owned(), |n| format!(
+                        "{n:.4e}"
+                    )),
+                l.energy_per_operation,
+                l.b10.map_or(String::new(), |b| format!(", B10 {b:.4e}"))
+            );
+        }
+        None => out.push_str("the scenario has no [circuit]: no life at its own load\n"),
+    }
+    out
+}
+
+/// The B10 life of a Weibull distribution of shape `beta` whose mean is
+/// `mean`: N·(−ln 0.9)^(1/β) / Γ(1 + 1/β).
+pub fn b10(mean: f64, beta: f64) -> f64 {
+    mean * (-(0.9f64.ln())).powf(1.0 / beta) / gamma(1.0 + 1.0 / beta)
+}
+
+/// Γ(x) for x in [1, 3] (Lanczos, g = 7, relative error below 1e-13).
+fn gamma(x: f64) -> f64 {
+    const G: f64 = 7.0;
+    const C: [f64; 9] = [
+        0.999_999_999_999_809_9,
+        676.520_368_121_885_1,
+        -1_259.139_216_722_402_8,
+        771.323_428_777_653_1,
+        -176.615_029_162_140_6,
+        12.507_343_278_686_905,
+        -0.138_571_095_265_720_12,
+        9.984_369_578_019_572e-6,
+        1.505_632_735_149_311_6e-7,
+    ];
+    let x = x - 1.0;
+    let mut a = C[0];
+    let t = x + G + 0.5;
+    for (k, c) in C.iter().enumerate().skip(1) {
+        a += c / (x + k as f64);
+    }
+    (2.0 * std::f64::consts::PI).sqrt() * t.powf(x + 0.5) * (-t).exp() * a
+}
+
+/// (mean E_op, phases, convergence) of one figure.
+#[allow(clippy::too_many_arguments)]
+fn figure_energy(
+    scenario: &Scenario,
+    closing: &crate::chatter::Chatter,
+    figure: &EnduranceFigure,
+    index: usize,
+    phases: usize,
+    dir: &Path,
+    runner: &dyn Runner,
+    options: &RunOptions,
+) -> Result<(f64, usize, f64), LifeError> {
+    let settle = closing
+        .intervals
+        .iter()
+        .rev()
+        .find(|i| i.state == ContactState::Closed)
+        .map_or(closing.t_end, |i| i.start);
+    let t_break = settle + HOLD;
+    let frequency = figure.frequency.unwrap_or(50.0);
+    let tail = match figure.supply {
+        Supply::Ac => 1.5 / frequency,
+        Supply::Dc => 20e-3,
+    };
+    let t_stop = t_break + tail;
+    let n = match figure.supply {
+        Supply::Ac => phases.max(1),
+        Supply::Dc => 1,
+    };
+    let resistance = figure.voltage / figure.current;
+    let mut intervals: Vec<Interval> = closing
+        .intervals
+        .iter()
+        .filter(|i| i.start < t_break)
+        .map(|i| Interval {
+            end: i.end.min(t_break),
+            ..*i
+        })
+        .collect();
+    if let Some(last) = intervals.last_mut() {
+        last.end = t_break;
+    }
+    intervals.push(Interval {
+        state: ContactState::Open,
+        start: t_break,
+        end: t_stop,
+    });
+    let mut energies = Vec::with_capacity(n);
+    for phase in 0..n {
+        let source = match figure.supply {
+            Supply::Dc => format!("DC {}", figure.voltage),
+            Supply::Ac => format!(
+                "SIN(0 {} {} 0 0 {})",
+                figure.voltage * std::f64::consts::SQRT_2,
+                frequency,
+                360.0 * phase as f64 / n as f64
+            ),
+        };
+        let netlist = format!(
+            "endurance test load {} of the datasheet, phase {phase}\n\
+             V1 supply 0 {source}\nR1 supply a {resistance}\nX1 a 0 CONTACT\n\
+             .tran 1u {t_stop} 0 2u\n.end\n",
+            index + 1
+        );
+        let file = dir.join(format!("figure{}_{phase}.cir", index + 1));
+        std::fs::write(&file, netlist)?;
+        let mut test = scenario.clone();
+        test.circuit = Some(CircuitSection {
+            netlist: file,
+            subckt: "CONTACT".to_owned(),
+            coil_subckt: "COIL".to_owned(),
+            nc_subckt: None,
+            params: std::collections::BTreeMap::new(),
+        });
+        test.probes.clear();
+        test.arc = Some(scenario.arc.unwrap_or_default());
+        let run =
+            pipeline::run_measured(&test, intervals.clone(), runner, options).map_err(|e| {
+                LifeError::Run {
+                    index: index + 1,
+                    phase,
+                    source: Box::new(e),
+                }
+            })?;
+        energies.push(run.arcs.as_ref().map_or(0.0, |a| a.totals.energy));
+    }
+    let mean = energies.iter().sum::<f64>() / n as f64;
+    let half: Vec<f64> = energies.iter().step_by(2).copied().collect();
+    let half_mean = half.iter().sum::<f64>() / half.len() as f64;
+    let convergence = if n > 1 && mean > 0.0 {
+        half_mean / mean - 1.0
+    } else {
+        0.0
+    };
+    Ok((mean, n, convergence))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn b10_of_a_weibull() {
+        // β = 1 (exponential): B10 = mean · (−ln 0.9) = 0.10536·mean.
+        assert!((b10(1.0, 1.0) - 0.105_360_515_657_826_3).abs() < 1e-12);
+        // Γ(1.5) = √π/2.
+        assert!((gamma(1.5) - std::f64::consts::PI.sqrt() / 2.0).abs() < 1e-13);
+        // β = 2: mean·(−ln 0.9)^(1/2)/Γ(1.5).
+        let expected = (0.105_360_515_657_826_3f64).sqrt() / (std::f64::consts::PI.sqrt() / 2.0);
+        assert!((b10(1.0, 2.0) - expected).abs() < 1e-12);
+        // A steeper Weibull puts B10 closer to the mean.
+        assert!(b10(1.0, 3.0) > b10(1.0, 2.0));
+    }
+}
