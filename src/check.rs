@@ -72,7 +72,8 @@ pub struct LimitCheck {
 }
 
 impl LimitCheck {
-    fn new(
+    /// A check of `actual` (or why it could not be measured) against `limit`.
+    pub fn new(
         key: String,
         quantity: String,
         unit: &'static str,

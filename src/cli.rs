@@ -555,6 +555,44 @@ fn check(args: &CheckArgs) -> Result<Status> {
         // The relay's limits alone: no circuit, no ngspice needed.
         check::relay_only(&scenario)?
     };
+    let verdict = match scenario.limits.and_then(|l| l.min_electrical_life) {
+        Some(limit) => {
+            let ngspice = args.simulator.ngspice()?;
+            let life = chatterspice::life::estimate(
+                &scenario,
+                &ngspice,
+                &options,
+                chatterspice::life::DEFAULT_PHASES,
+            )?;
+            let operations = match &life.life {
+                Some(own) => own.operations.ok_or_else(|| {
+                    "unlimited by arcs: the circuit's operation puts no arc energy into the \
+                     contacts"
+                        .to_owned()
+                }),
+                None => Err("the scenario has no [circuit] to estimate the life at".to_owned()),
+            };
+            // No arc energy means no electrical wear: the limit holds.
+            let operations = match operations {
+                Err(e) if life.life.is_some() => {
+                    eprintln!("note: min_electrical_life: {e}");
+                    Ok(f64::MAX)
+                }
+                other => other,
+            };
+            let mut checks = verdict.checks;
+            checks.push(check::LimitCheck::new(
+                "limits.min_electrical_life".into(),
+                "electrical life at this circuit (operations)".into(),
+                "",
+                check::Bound::Min,
+                limit,
+                operations,
+            ));
+            check::Verdict::new(checks)
+        }
+        None => verdict,
+    };
     let dimensionless = chatterspice::commands::dimensionless(&scenario);
     let text = match args.format {
         RunFormat::Json => report::json::render_check(&verdict, &evidence, dimensionless.as_ref()),

@@ -43,6 +43,9 @@ pub struct LimitsSection {
     /// The least static-weld margin U_m/U of any make whose contact force
     /// the run knows (needs a run).
     pub min_weld_margin: Option<f64>,
+    /// Operations: the least electrical life at the scenario's circuit,
+    /// as `life` estimates it from `[datasheet] electrical_endurance`.
+    pub min_electrical_life: Option<f64>,
     /// s, the contact's own debounce lockout in each closing: its last
     /// transition − its first make, what a debouncer reading the contact
     /// directly must ignore it for (the bounce time, named as a debouncer
@@ -120,6 +123,11 @@ impl Check<'_> {
                 "limits.min_weld_margin",
                 l.min_weld_margin,
                 "the least weld margin U_m/U allowed at any make (1: the spot just melts)",
+            ),
+            (
+                "limits.min_electrical_life",
+                l.min_electrical_life,
+                "the least electrical life allowed at this circuit, in operations",
             ),
             (
                 "limits.max_lockout",

@@ -534,6 +534,38 @@ fn life_calibrates_on_one_figure_and_predicts_the_others() {
     let expected_b10 = chatterspice::life::b10(n, 2.0);
     assert!((own["b10"].as_f64().unwrap() / expected_b10 - 1.0).abs() < 1e-12);
 
+    // `check` holds the circuit's life to min_electrical_life.
+    for (limit, code) in [(0.5 * n, 0), (2.0 * n, 1)] {
+        std::fs::write(
+            &path,
+            format!("{text}\n[limits]\nmin_electrical_life = {limit}\n"),
+        )
+        .unwrap();
+        let out = Command::cargo_bin("chatterspice")
+            .unwrap()
+            .args(["check", path.to_str().unwrap(), "--format", "json"])
+            .output()
+            .unwrap();
+        assert_eq!(
+            out.status.code(),
+            Some(code),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let verdict: Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_valid("check", &verdict, "check with min_electrical_life");
+        let row = verdict["checks"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["key"] == "limits.min_electrical_life")
+            .expect("the life check");
+        assert!(
+            (row["actual"].as_f64().unwrap() / n - 1.0).abs() < 0.05,
+            "{row}"
+        );
+    }
+
     // Bad figures: exit 2, naming what to fix.
     for (bad, says) in [
         (
