@@ -425,8 +425,17 @@ pub struct LifeArgs {
     #[arg(long, value_enum, default_value_t = RunFormat::Table)]
     pub format: RunFormat,
 
+    /// ngspice runs at a time [default: the number of CPUs].
+    #[arg(long, value_name = "N")]
+    pub jobs: Option<std::num::NonZeroUsize>,
+
     #[command(flatten)]
     pub simulator: SimulatorArgs,
+}
+
+/// The number of CPUs, at least 1.
+fn cpus() -> usize {
+    std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
 }
 
 fn parse_phases(text: &str) -> Result<usize, String> {
@@ -446,6 +455,7 @@ fn life(args: &LifeArgs) -> Result<()> {
         &ngspice,
         &args.simulator.run_options(),
         args.phases,
+        args.jobs.map_or_else(cpus, std::num::NonZeroUsize::get),
     )?;
     let text = match args.format {
         RunFormat::Json => {
@@ -563,6 +573,7 @@ fn check(args: &CheckArgs) -> Result<Status> {
                 &ngspice,
                 &options,
                 chatterspice::life::DEFAULT_PHASES,
+                cpus(),
             )?;
             let operations = match &life.life {
                 Some(own) => own.operations.ok_or_else(|| {

@@ -165,12 +165,13 @@ pub enum LifeError {
 }
 
 /// The life estimate of `scenario` with `phases` switching phases per AC
-/// figure, its ngspice runs through `runner`.
+/// figure, its ngspice runs through `runner`, `jobs` at a time.
 pub fn estimate(
     scenario: &Scenario,
     runner: &dyn Runner,
     options: &RunOptions,
     phases: usize,
+    jobs: usize,
 ) -> Result<LifeReport, LifeError> {
     let path = scenario.origin.clone();
     let figures = scenario
@@ -218,6 +219,7 @@ pub fn estimate(
             dir.path(),
             runner,
             options,
+            jobs,
         )?);
     }
     let (e0, _, _) = energies[0];
@@ -351,6 +353,7 @@ fn figure_energy(
     dir: &Path,
     runner: &dyn Runner,
     options: &RunOptions,
+    jobs: usize,
 ) -> Result<(f64, usize, f64), LifeError> {
     let settle = closing
         .intervals
@@ -387,8 +390,7 @@ fn figure_energy(
         start: t_break,
         end: t_stop,
     });
-    let mut energies = Vec::with_capacity(n);
-    for phase in 0..n {
+    let run_phase = |phase: usize| -> Result<f64, LifeError> {
         let source = match figure.supply {
             Supply::Dc => format!("DC {}", figure.voltage),
             Supply::Ac => format!(
@@ -424,7 +426,46 @@ fn figure_energy(
                     source: Box::new(e),
                 }
             })?;
-        energies.push(run.arcs.as_ref().map_or(0.0, |a| a.totals.energy));
+        Ok(run.arcs.as_ref().map_or(0.0, |a| a.totals.energy))
+    };
+    // The phases in parallel, `jobs` ngspice runs at a time; the first
+    // error (in phase order) is the answer.
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let results: std::sync::Mutex<Vec<Option<Result<f64, LifeError>>>> =
+        std::sync::Mutex::new((0..n).map(|_| None).collect());
+    std::thread::scope(|scope| {
+        for _ in 0..jobs.clamp(1, n) {
+            scope.spawn(|| {
+                loop {
+                    let phase = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    if phase >= n || crate::interrupt::stopping().is_some() {
+                        break;
+                    }
+                    let result = run_phase(phase);
+                    let failed = result.is_err();
+                    results.lock().unwrap_or_else(|e| e.into_inner())[phase] = Some(result);
+                    if failed {
+                        next.store(n, std::sync::atomic::Ordering::Relaxed);
+                    }
+                }
+            });
+        }
+    });
+    let mut energies = Vec::with_capacity(n);
+    for result in results.into_inner().unwrap_or_else(|e| e.into_inner()) {
+        match result {
+            Some(Ok(e)) => energies.push(e),
+            Some(Err(e)) => return Err(e),
+            // A phase not run: an earlier error stopped the others.
+            None => continue,
+        }
+    }
+    if energies.len() < n {
+        // Only a stop leaves phases unrun without an error.
+        return Err(LifeError::Io(std::io::Error::new(
+            std::io::ErrorKind::Interrupted,
+            "stopped before every phase ran",
+        )));
     }
     let mean = energies.iter().sum::<f64>() / n as f64;
     let half: Vec<f64> = energies.iter().step_by(2).copied().collect();
