@@ -423,19 +423,20 @@ pub struct FitReport {
 impl FitReport {
     /// The `[provenance]` section for the fitted scenario.
     pub fn provenance(&self) -> ProvenanceSection {
+        let fitted = self.parameters.iter().map(|p| {
+            (
+                p.key.clone(),
+                FittedParameter {
+                    prior: p.prior,
+                    value: p.value,
+                    sigma: p.sigma,
+                    determined: p.determined,
+                },
+            )
+        });
         if let Some(kept) = &self.kept_provenance {
             let mut merged = kept.clone();
-            for p in &self.parameters {
-                merged.parameters.insert(
-                    p.key.clone(),
-                    FittedParameter {
-                        prior: p.prior,
-                        value: p.value,
-                        sigma: p.sigma,
-                        determined: p.determined,
-                    },
-                );
-            }
+            merged.parameters.extend(fitted);
             if !merged.fitted_to.contains("dc_breaking") {
                 merged.fitted_to.push_str(" + dc_breaking");
             }
@@ -446,21 +447,7 @@ impl FitReport {
             rms_residual: self.rms_residual,
             time_offset: self.time_offset,
             pick_up_binds: self.pick_up_binds.clone(),
-            parameters: self
-                .parameters
-                .iter()
-                .map(|p| {
-                    (
-                        p.key.clone(),
-                        FittedParameter {
-                            prior: p.prior,
-                            value: p.value,
-                            sigma: p.sigma,
-                            determined: p.determined,
-                        },
-                    )
-                })
-                .collect(),
+            parameters: fitted.collect(),
         }
     }
 }

@@ -760,7 +760,7 @@ fn every_make_onto_a_capacitor_is_a_new_inrush() {
     let cir = dir.path().join("circuit.cir");
     let text = std::fs::read_to_string(&cir).unwrap();
     assert!(text.contains("100u"));
-    let base = scenario_text_with(dir.path(), &cir);
+    let base = scenario_text_with(&cir);
     for (limits, code) in [
         ("max_making_current = 12.0\nmin_weld_margin = 1.0\n", 0),
         ("max_making_current = 5.0\n", 1),
@@ -789,8 +789,7 @@ fn every_make_onto_a_capacitor_is_a_new_inrush() {
 }
 
 /// The built-in relay's scenario text with `netlist` as its circuit.
-fn scenario_text_with(dir: &Path, netlist: &Path) -> String {
-    let _ = dir;
+fn scenario_text_with(netlist: &Path) -> String {
     let cut = DEFAULT_SCENARIO_TOML.find("[circuit]").unwrap();
     format!(
         "{}[circuit]\nnetlist = {:?}\n",
