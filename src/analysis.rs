@@ -39,6 +39,29 @@
 //! over the whole record and per closure of the contact (the closed
 //! intervals of the chatter sequence, see [`closures`]).
 //!
+//! # Integration overshoot at a contact's edge
+//! A contact switches its conductance by ten decades within one edge
+//! time, and a capacitor across it (or an inductor in series) then has a
+//! time constant far shorter than ngspice's steps. The trapezoidal rule,
+//! ngspice's default, is not damped there: in one step its solution goes
+//! past where the signal is going, and it may alternate up and down from
+//! one time point to the next while it decays, for instance to −157 mV on
+//! an input that discharges from 3.3 V to 16 µV. Such samples are the
+//! integrator's, not the circuit's. After each contact edge (the starts
+//! and ends of the closures given), [`integration_ringing`] looks, within
+//! [`RINGING_LOOKAHEAD`] samples of the edge, for a local extremum that
+//! is either the first of at least [`RINGING_EXTREMA`] extrema in a row
+//! (one per sample, the last swing smaller than the first) or a sharp
+//! turn (left by a step at most [`SHARP_TURN`] of the one that reached
+//! it). Those samples, and the samples that then move monotonically back
+//! up to the next reversal or the next edge, are left out of `min` and
+//! `max` (so out of the `min_value`, `max_value` and `max_peak` limits)
+//! and listed in [`ProbeAnalysis::ringing`]. A physical oscillation,
+//! which ngspice resolves with several points per period, is reached and
+//! left by comparable steps and never alternates point to point; a
+//! monotone stretch has its extremes at its ends, and the end it settles
+//! at is kept. Edges and currents use every sample.
+//!
 //! # Comparison with an ideal contact
 //! [`compare`] sets a probe's analysis beside the same circuit's with a
 //! single clean make at the first impact and reports what the bounce
@@ -362,6 +385,126 @@ pub struct ProbeAnalysis {
     pub pulses: Option<usize>,
     /// What a debouncer of this signal must cover; `None` without an edge.
     pub debounce: Option<Debounce>,
+    /// The integration ringing found after contact edges, whose samples
+    /// `min` and `max` leave out (see the module overview); empty when
+    /// there is none. Not part of the JSON contract: a run reports it as
+    /// a warning ([`ProbeAnalysis::threshold_warning`]).
+    #[serde(skip)]
+    pub ringing: Vec<Ringing>,
+}
+
+/// Samples of a probe right after a contact edge that the integrator,
+/// not the circuit, put there: an overshoot past where the signal was
+/// going, or the trapezoidal rule's ringing (up and down from one time
+/// point to the next), and the recovery from it. They are left out of
+/// the probe's `min` and `max`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Ringing {
+    /// s, the contact edge (a closure's start or end) it follows.
+    pub edge: f64,
+    /// s, the first sample left out: the first overshoot.
+    pub start: f64,
+    /// s, the last sample left out: the end of the recovery.
+    pub end: f64,
+    /// How many samples overshoot (one per local extremum in a row); the
+    /// recovery after them is left out too.
+    pub samples: usize,
+    /// The lowest sample left out, in the signal's unit.
+    pub min: f64,
+    /// The highest sample left out.
+    pub max: f64,
+}
+
+/// An integrator's overshoot starts within this many samples of a
+/// contact edge: the first steps after the edge are the ones that
+/// overshoot.
+pub const RINGING_LOOKAHEAD: usize = 6;
+
+/// The fewest local extrema in a row, one per sample and swinging less
+/// and less, that are taken for ringing whatever their shape: a real
+/// signal's extremum is one sample, a resolved oscillation's extrema are
+/// several samples apart.
+pub const RINGING_EXTREMA: usize = 3;
+
+/// A local extremum right after a contact edge that the signal leaves
+/// with a step at most this fraction of the one that reached it is an
+/// overshoot of the integrator: it went past where the signal was going
+/// in one step and is pulled back by a smaller one. A resolved extremum
+/// of a smooth signal is reached and left by comparable steps.
+pub const SHARP_TURN: f64 = 0.5;
+
+/// The integrator's overshoots of (`time`, `values`) after each contact
+/// edge at `edges` (s), and for each sample whether it is left out of the
+/// range (see the module overview). After the overshooting samples, the
+/// samples that move monotonically back from them, up to the next
+/// reversal or the next edge, are left out too: a monotone stretch has
+/// its extremes at its ends, and the end it settles at is kept, so no
+/// extreme of the signal is lost with them.
+pub fn integration_ringing(
+    time: &[f64],
+    values: &[f64],
+    edges: &[f64],
+) -> (Vec<Ringing>, Vec<bool>) {
+    let n = values.len().min(time.len());
+    let mut left_out = vec![false; n];
+    let mut found = Vec::new();
+    if n < 4 {
+        return (found, left_out);
+    }
+    let step = |k: usize| values[k + 1] - values[k];
+    // Sample k (not the first or last) is a local extremum: the steps on
+    // either side of it go opposite ways.
+    let extremum = |k: usize| {
+        let (before, after) = (step(k - 1), step(k));
+        before != 0.0 && after != 0.0 && (before > 0.0) != (after > 0.0)
+    };
+    let mut sorted: Vec<f64> = edges.iter().copied().filter(|t| t.is_finite()).collect();
+    sorted.sort_by(f64::total_cmp);
+    sorted.dedup();
+    for (i, &edge) in sorted.iter().enumerate() {
+        let next_edge = sorted.get(i + 1).copied().unwrap_or(f64::INFINITY);
+        let first = time[..n].partition_point(|&t| t < edge).max(1);
+        let mut k = first;
+        while k < (first + RINGING_LOOKAHEAD).min(n - 1) {
+            if left_out[k] || !extremum(k) {
+                k += 1;
+                continue;
+            }
+            let mut last = k;
+            while last + 1 < n - 1 && extremum(last + 1) {
+                last += 1;
+            }
+            let into = step(k - 1).abs();
+            let ringing = last + 1 - k >= RINGING_EXTREMA && step(last).abs() < into;
+            let overshoot = step(k).abs() <= SHARP_TURN * into;
+            if !(ringing || overshoot) {
+                k = last + 1;
+                continue;
+            }
+            // The recovery: on in the direction the last overshoot left.
+            let back = step(last) > 0.0;
+            let mut end = last;
+            while end + 2 < n
+                && time[end + 1] < next_edge
+                && step(end + 1) != 0.0
+                && (step(end + 1) > 0.0) == back
+            {
+                end += 1;
+            }
+            let out = &values[k..=end];
+            found.push(Ringing {
+                edge,
+                start: time[k],
+                end: time[end],
+                samples: last + 1 - k,
+                min: out.iter().copied().fold(f64::INFINITY, f64::min),
+                max: out.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            });
+            left_out[k..=end].iter_mut().for_each(|x| *x = true);
+            break;
+        }
+    }
+    (found, left_out)
 }
 
 /// The two figures a designer sizes a debouncer with, from a probe's
@@ -389,11 +532,74 @@ impl Debounce {
 }
 
 impl ProbeAnalysis {
-    /// When the signal crossed neither threshold it would have to (no
-    /// edge, and its whole range on one side of a threshold): a sentence
-    /// saying so, with its range, for a warning. Such a probe reports 0
-    /// edges however much the signal moved.
+    /// What a reader of the probe's figures must be told, as one warning:
+    /// that the signal crossed neither threshold it would have to (no
+    /// edge, and its whole range on one side of a threshold: such a probe
+    /// reports 0 edges however much the signal moved), and that samples
+    /// of integration ringing beyond the signal's range were left out of
+    /// its `min` and `max` ([`ProbeAnalysis::ringing_warning`]). `None`
+    /// when neither applies.
     pub fn threshold_warning(&self) -> Option<String> {
+        let parts: Vec<String> = [self.no_edge_warning(), self.ringing_warning()]
+            .into_iter()
+            .flatten()
+            .collect();
+        (!parts.is_empty()).then(|| parts.join("; "))
+    }
+
+    /// When samples left out as the integrator's overshoot lie beyond the
+    /// range of the others (so that they would have been the minimum or
+    /// the maximum): a sentence saying where, how far, and how to avoid
+    /// it.
+    pub fn ringing_warning(&self) -> Option<String> {
+        let lowest = self
+            .ringing
+            .iter()
+            .map(|r| r.min)
+            .fold(f64::INFINITY, f64::min);
+        let highest = self
+            .ringing
+            .iter()
+            .map(|r| r.max)
+            .fold(f64::NEG_INFINITY, f64::max);
+        if !(lowest < self.min || highest > self.max) {
+            return None;
+        }
+        let unit = self.kind.unit();
+        let e = |v: f64| crate::report::units::engineering(v, unit);
+        let beyond = |r: &Ringing| (self.min - r.min).max(r.max - self.max);
+        let worst = self
+            .ringing
+            .iter()
+            .max_by(|a, b| beyond(a).total_cmp(&beyond(b)))
+            .expect("a ringing lies beyond the range");
+        let edges = self.ringing.iter().filter(|r| beyond(r) > 0.0).count();
+        let far = if worst.min < self.min {
+            worst.min
+        } else {
+            worst.max
+        };
+        Some(format!(
+            "{}: right after {edges} contact edge{} ngspice's samples overshoot where the signal \
+             is going, some ringing up and down from one time point to the next (out to {}, \
+             after the edge at {:.4} ms): the integration of the contact's sharp edge, not the \
+             signal; those samples are left out of min and max, which are {} to {} without them \
+             ({} to {} with them). `.options method=gear trtol=1` in the netlist avoids the \
+             overshoot",
+            self.signal,
+            if edges == 1 { "" } else { "s" },
+            e(far),
+            worst.edge * 1e3,
+            e(self.min),
+            e(self.max),
+            e(lowest.min(self.min)),
+            e(highest.max(self.max)),
+        ))
+    }
+
+    /// When the signal crossed neither threshold it would have to: the
+    /// first half of [`ProbeAnalysis::threshold_warning`].
+    fn no_edge_warning(&self) -> Option<String> {
         if self.edges > 0 {
             return None;
         }
@@ -546,7 +752,9 @@ fn differential_nodes(signal: &str) -> Option<(&str, &str)> {
 
 /// Analyse sampled data: `time` (s, non-decreasing) and `values` of
 /// `probe.signal`, in the unit of `probe.low`/`probe.high`. The current
-/// analysis over `closures` (s) is done when `kind` is a current.
+/// analysis over `closures` (s) is done when `kind` is a current; for
+/// every signal, the closures' starts and ends are the contact edges
+/// after which integration ringing is looked for.
 pub fn analyze_samples(
     probe: &Probe,
     kind: ProbeKind,
@@ -555,9 +763,14 @@ pub fn analyze_samples(
     closures: &[(f64, f64)],
 ) -> Result<ProbeAnalysis, AnalysisError> {
     let schmitt = schmitt(&probe.signal, time, values, probe.low, probe.high)?;
+    let contact_edges: Vec<f64> = closures.iter().flat_map(|&(a, b)| [a, b]).collect();
+    let (ringing, left_out) = integration_ringing(time, values, &contact_edges);
+    // The first and last samples are never left out: the range has one.
     let (min, max) = values
         .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+        .zip(&left_out)
+        .filter(|(_, out)| !**out)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), (&v, _)| {
             (lo.min(v), hi.max(v))
         });
     let current = match kind {
@@ -590,6 +803,7 @@ pub fn analyze_samples(
         transitions: schmitt.edges,
         current,
         debounce: Debounce::of(&times),
+        ringing,
     })
 }
 

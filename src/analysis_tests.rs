@@ -403,3 +403,151 @@ fn closures_are_the_closed_intervals() {
         vec![(0.0012, 0.00121), (0.0014, 0.001405), (0.0016, 0.02)]
     );
 }
+
+/// An MCU input the contact shorts: 3.3 V through 10 kΩ onto 1 nF, the
+/// contact across the capacitor ramping from 1 nS to 20 S over 10 ns from
+/// `make`. Integrated on ngspice's kind of time grid (100 ns steps, then
+/// the `inner` steps from the edge on, then steps growing 1.5× back to
+/// 100 ns) by the trapezoidal rule and by backward Euler, whose solution
+/// of this linear circuit never overshoots. Returns (time, trapezoidal,
+/// backward Euler).
+fn make_onto_a_capacitor(make: f64, inner: &[f64]) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let (vdd, r, c) = (3.3, 1e4, 1e-9);
+    let g = |t: f64| {
+        if t < make {
+            1e-9
+        } else if t < make + 1e-8 {
+            1e-9 + (20.0 - 1e-9) * (t - make) / 1e-8
+        } else {
+            20.0
+        }
+    };
+    let mut time = vec![0.0];
+    while time.last().unwrap() + 100e-9 < make {
+        time.push(time.last().unwrap() + 100e-9);
+    }
+    time.push(make);
+    for h in inner {
+        time.push(time.last().unwrap() + h);
+    }
+    let mut h = *inner.last().unwrap();
+    while *time.last().unwrap() < make + 50e-6 {
+        h = (h * 1.5).min(100e-9);
+        time.push(time.last().unwrap() + h);
+    }
+    let a = |t: f64| -(1.0 / r + g(t)) / c;
+    let b = vdd / (r * c);
+    let (mut trap, mut euler) = (vec![vdd], vec![vdd]);
+    for k in 1..time.len() {
+        let (t0, t1) = (time[k - 1], time[k]);
+        let h = t1 - t0;
+        let v = trap[k - 1];
+        trap.push((v * (1.0 + h * a(t0) / 2.0) + h * b) / (1.0 - h * a(t1) / 2.0));
+        euler.push((euler[k - 1] + h * b) / (1.0 - h * a(t1)));
+    }
+    (time, trap, euler)
+}
+
+fn range(values: &[f64]) -> (f64, f64) {
+    values
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        })
+}
+
+#[test]
+fn integration_overshoot_after_a_make_is_left_out_of_the_range() {
+    let make = 100e-6;
+    let closures = [(make, 200e-6)];
+    // Steps like ngspice's around a make: the trapezoidal rule rings up
+    // and down (first), or overshoots once and creeps back (second).
+    let ringing = [1e-9, 2e-9, 1.16e-9, 0.65e-9, 0.34e-9];
+    let overshoot = [0.65e-9, 1.3e-9, 0.78e-9];
+    for inner in [&ringing[..], &overshoot[..]] {
+        let steps: Vec<f64> = inner.iter().copied().chain([0.1e-9; 40]).collect();
+        let (time, trap, euler) = make_onto_a_capacitor(make, &steps);
+        let (raw_min, raw_max) = range(&trap);
+        assert!(
+            raw_min < -0.01,
+            "the trapezoidal rule overshoots: {raw_min}"
+        );
+        let (true_min, _) = range(&euler);
+        assert!(true_min > 0.0, "{true_min}");
+        let a = analyze_samples(
+            &probe("v(in)", 0.99, 2.31),
+            ProbeKind::Voltage,
+            &time,
+            &trap,
+            &closures,
+        )
+        .unwrap();
+        // The range is the circuit's: its lowest value is where it
+        // settles, VDD·(1/20 S)/(10 kΩ), as backward Euler has it.
+        assert!((a.min - true_min).abs() < 1e-6, "{} vs {true_min}", a.min);
+        assert_eq!(a.max, raw_max);
+        assert_eq!(a.ringing.len(), 1, "{:?}", a.ringing);
+        let r = &a.ringing[0];
+        assert_eq!(r.edge, make);
+        assert_eq!(r.min, raw_min);
+        assert!(r.start > make && r.start < make + 1e-8, "{r:?}");
+        // Said, with both ranges, and the edges are the raw samples'.
+        let warning = a.threshold_warning().unwrap();
+        let shown = |v: f64| crate::report::units::engineering(v, "V");
+        assert!(
+            warning.starts_with("v(in): ") && warning.contains(&shown(raw_min)),
+            "{warning}"
+        );
+        assert!(warning.contains(&shown(a.min)), "{warning}");
+        assert_eq!(a.edges, 1);
+        // Without the contact's edges nothing is left out.
+        let blind = analyze_samples(
+            &probe("v(in)", 0.99, 2.31),
+            ProbeKind::Voltage,
+            &time,
+            &trap,
+            &[],
+        )
+        .unwrap();
+        assert_eq!((blind.min, blind.ringing.len()), (raw_min, 0));
+        assert_eq!(blind.threshold_warning(), None);
+    }
+}
+
+#[test]
+fn a_resolved_oscillation_after_an_edge_is_the_signal() {
+    // A break that rings physically: 1 − e^(−t/τ)·cos(ωt) from the edge,
+    // sampled as ngspice resolves it (steps from T/1000 doubling to T/40),
+    // undershooting and overshooting 1 by a lot. Nothing is left out.
+    let (edge, period, tau) = (1e-3, 1e-6, 3e-6);
+    let omega = 2.0 * std::f64::consts::PI / period;
+    let mut time: Vec<f64> = (0..10).map(|k| k as f64 * 1e-4).collect();
+    let mut h = period / 1000.0;
+    let mut t = edge;
+    while t < edge + 10.0 * period {
+        time.push(t);
+        t += h;
+        h = (2.0 * h).min(period / 40.0);
+    }
+    let values: Vec<f64> = time
+        .iter()
+        .map(|&t| {
+            if t < edge {
+                0.0
+            } else {
+                1.0 - (-(t - edge) / tau).exp() * (omega * (t - edge)).cos()
+            }
+        })
+        .collect();
+    let a = analyze_samples(
+        &probe("v(out)", 0.3, 0.7),
+        ProbeKind::Voltage,
+        &time,
+        &values,
+        &[(0.5e-3, edge)],
+    )
+    .unwrap();
+    assert!(a.ringing.is_empty(), "{:?}", a.ringing);
+    assert_eq!((a.min, a.max), range(&values));
+    assert!(a.max > 1.5, "it rings: {}", a.max);
+}

@@ -12,8 +12,12 @@
 //!   higher (or the user's). An edge is a crossing of the far threshold
 //!   after the near one: an excursion that does not cross both (ringing at
 //!   a make, noise) is no edge.
-//! - **Timing**: the last crossing of the 50 % level before the threshold
-//!   crossing, interpolated between its two samples.
+//! - **Timing**: with the default thresholds, the last crossing of the
+//!   50 % level before the threshold crossing, interpolated between its
+//!   two samples (the contact's own instant, for a sharp edge). With the
+//!   user's thresholds, the crossing of the far threshold itself: the
+//!   instant a Schmitt input with those thresholds switches, so that on a
+//!   slow (RC) edge the times follow the thresholds the user gave.
 //! - **Polarity**: the level the trace ends on is closed (a capture of a
 //!   closing ends closed), unless the user says which.
 
@@ -171,20 +175,40 @@ fn spread(value: &[f64], mid: f64) -> (f64, f64) {
 
 /// The edges of (`time`, `value`): thresholds `low`/`high` (default 30 %
 /// and 70 % between the levels), closed level per `closed` (default: the
-/// one the trace ends nearer to).
+/// one the trace ends nearer to). With the default thresholds each edge
+/// is timed at its 50 % crossing; with given ones, at its crossing of the
+/// far threshold (`low` going down, `high` going up).
 pub fn edges(
     time: &[f64],
     value: &[f64],
     thresholds: Option<(f64, f64)>,
     closed: Option<Closed>,
 ) -> Result<Edges, EdgeError> {
-    let (lower, upper) = levels(value)?;
-    let (low, high) =
-        thresholds.unwrap_or((lower + 0.3 * (upper - lower), lower + 0.7 * (upper - lower)));
-    if !(low.is_finite() && high.is_finite() && low < high) {
+    if let Some((low, high)) = thresholds
+        && !(low.is_finite() && high.is_finite() && low < high)
+    {
         return Err(EdgeError::Thresholds { low, high });
     }
+    let (lower, upper) = match (levels(value), thresholds) {
+        (Ok(levels), _) => levels,
+        // The user's thresholds say where the edges are even when the
+        // trace shows no two clear levels (slow RC edges that never
+        // settle): the levels are then those of the samples beyond them.
+        (Err(e @ EdgeError::OneLevel { .. }), Some((low, high))) => {
+            levels_beyond(value, low, high).ok_or(e)?
+        }
+        (Err(e), _) => return Err(e),
+    };
+    let (low, high) =
+        thresholds.unwrap_or((lower + 0.3 * (upper - lower), lower + 0.7 * (upper - lower)));
+    // Where an edge is timed: the 50 % level, or the far threshold.
+    let given = thresholds.is_some();
     let mid = 0.5 * (low + high);
+    let timing = |up: bool| match (given, up) {
+        (false, _) => mid,
+        (true, true) => high,
+        (true, false) => low,
+    };
     // Schmitt states: Some(true) high, Some(false) low, None not yet known.
     let mut state = if value[0] >= high {
         Some(true)
@@ -206,7 +230,7 @@ pub fn edges(
         };
         let Some(up) = to else { continue };
         if state.is_some() {
-            transitions.push((mid_crossing(time, value, k, mid, up), up));
+            transitions.push((mid_crossing(time, value, k, timing(up), up), up));
         }
         state = Some(up);
     }
@@ -262,6 +286,19 @@ pub fn edges(
         breaks,
         intervals,
     })
+}
+
+/// The means of the samples at or below `low` and at or above `high`, when
+/// there are both: the levels of a trace read with the user's thresholds.
+fn levels_beyond(value: &[f64], low: f64, high: f64) -> Option<(f64, f64)> {
+    let mean = |keep: &dyn Fn(f64) -> bool| {
+        let (sum, n) = value
+            .iter()
+            .filter(|&&v| keep(v))
+            .fold((0.0, 0usize), |(s, n), &v| (s + v, n + 1));
+        (n > 0).then(|| sum / n as f64)
+    };
+    Some((mean(&|v| v <= low)?, mean(&|v| v >= high)?))
 }
 
 /// The time the signal last crossed `mid` (going `up`) at or before sample
@@ -330,6 +367,105 @@ mod tests {
             "{lo} {hi}"
         );
         assert!(levels(&[1.0; 10]).is_err());
+    }
+
+    /// An RC-shaped trace: 5 V open, a make at 100 µs falling toward
+    /// 0.02 V with τ = 5 µs, a break at 200 µs rising back with τ = 20 µs,
+    /// a make at 400 µs; sampled every 20 ns. Returns the trace and the
+    /// closed-form crossing times of `low` (the falls) and `high` (the
+    /// rise).
+    fn rc_trace(low: f64, high: f64) -> (Vec<f64>, Vec<f64>, [f64; 3]) {
+        let (open, closed, tf, tr) = (5.0, 0.02, 5e-6, 20e-6);
+        let (make1, brk, make2) = (100e-6, 200e-6, 400e-6);
+        let fall = |t: f64, from: f64, v0: f64| closed + (v0 - closed) * (-(t - from) / tf).exp();
+        let rise = |t: f64, from: f64, v0: f64| open - (open - v0) * (-(t - from) / tr).exp();
+        let at_break = fall(brk, make1, open);
+        let at_make2 = rise(make2, brk, at_break);
+        let value_at = |t: f64| match t {
+            t if t < make1 => open,
+            t if t < brk => fall(t, make1, open),
+            t if t < make2 => rise(t, brk, at_break),
+            t => fall(t, make2, at_make2),
+        };
+        let time: Vec<f64> = (0..30_000).map(|k| k as f64 * 20e-9).collect();
+        let value = time.iter().map(|&t| value_at(t)).collect();
+        let crossings = [
+            make1 + tf * ((open - closed) / (low - closed)).ln(),
+            brk + tr * ((open - at_break) / (open - high)).ln(),
+            make2 + tf * ((at_make2 - closed) / (low - closed)).ln(),
+        ];
+        (time, value, crossings)
+    }
+
+    #[test]
+    fn given_thresholds_time_an_rc_edge_where_it_crosses_them() {
+        let mut seen = Vec::new();
+        // Pairs sharing a midpoint too: their 50 % times would coincide.
+        for (low, high) in [(1.0, 4.0), (2.0, 3.0), (0.5, 1.0), (4.0, 4.5)] {
+            let (time, value, want) = rc_trace(low, high);
+            let e = edges(&time, &value, Some((low, high)), None).unwrap();
+            assert_eq!((e.low, e.high), (low, high));
+            let got = [e.makes[0], e.breaks[0], e.makes[1]];
+            assert_eq!((e.makes.len(), e.breaks.len()), (2, 1), "{low}/{high}");
+            for (g, w) in got.iter().zip(want) {
+                assert!(
+                    (g - w).abs() < 1e-9,
+                    "{low}/{high}: edge at {g}, crossing at {w}"
+                );
+            }
+            seen.push(got);
+        }
+        // The edges move with the thresholds, (1, 4) and (2, 3) included.
+        for i in 0..seen.len() {
+            for j in 0..i {
+                assert!(
+                    seen[i]
+                        .iter()
+                        .zip(&seen[j])
+                        .all(|(a, b)| (a - b).abs() > 1e-7),
+                    "{seen:?}"
+                );
+            }
+        }
+        // The default thresholds still time each edge at its 50 % level.
+        let (time, value, _) = rc_trace(1.0, 4.0);
+        let e = edges(&time, &value, None, None).unwrap();
+        let mid = 0.5 * (e.low + e.high);
+        let want = 100e-6 + 5e-6 * ((5.0 - 0.02) / (mid - 0.02)).ln();
+        assert!((e.makes[0] - want).abs() < 1e-8, "{} vs {want}", e.makes[0]);
+    }
+
+    /// Edges too slow to settle leave no two clear levels: refused with
+    /// the default thresholds, read with the user's.
+    #[test]
+    fn given_thresholds_read_a_trace_without_two_clear_levels() {
+        let tau = 50e-6;
+        let time: Vec<f64> = (0..4000).map(|k| k as f64 * 0.1e-6).collect();
+        let value: Vec<f64> = time
+            .iter()
+            .map(|&t| {
+                // Open, a make at 50 µs and a break at 250 µs, both slow.
+                if t < 50e-6 {
+                    5.0
+                } else if t < 250e-6 {
+                    5.0 * (-(t - 50e-6) / tau).exp()
+                } else {
+                    let v0 = 5.0 * (-200e-6 / tau).exp();
+                    5.0 - (5.0 - v0) * (-(t - 250e-6) / tau).exp()
+                }
+            })
+            .collect();
+        let auto = edges(&time, &value, None, None);
+        assert!(matches!(auto, Err(EdgeError::OneLevel { .. })), "{auto:?}");
+        let e = edges(&time, &value, Some((1.0, 4.0)), Some(Closed::Low)).unwrap();
+        assert_eq!(
+            (e.makes.len(), e.breaks.len()),
+            (1, 1),
+            "{e:?} (auto: {auto:?})"
+        );
+        let make = 50e-6 + tau * 5.0f64.ln();
+        assert!((e.makes[0] - make).abs() < 1e-9, "{} vs {make}", e.makes[0]);
+        assert!(e.closed < 1.0 && e.open > 4.0, "{e:?}");
     }
 
     #[test]

@@ -126,8 +126,12 @@ impl Capture {
         self.intervals.first().map_or(0.0, |i| i.start)
     }
 
-    /// The intervals from t = 0 at the first sample (what the fit and the
-    /// circuit use: the scope's trigger is not the force step anyway).
+    /// The intervals from t = 0 at the first sample, as
+    /// [`Capture::state_csv`] writes them (a circuit run cannot start
+    /// before 0). The fit does not use them: it reads
+    /// [`Capture::intervals`], on the capture's own axis, so that its time
+    /// offset is measured from the scope's trigger whatever pre-trigger
+    /// samples the record holds.
     pub fn shifted_intervals(&self) -> Vec<Interval> {
         let o = self.csv_origin();
         self.intervals

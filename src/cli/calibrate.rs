@@ -27,7 +27,9 @@ pub struct FitArgs {
     #[arg(value_name = "SCENARIO")]
     pub scenario: PathBuf,
 
-    /// A scope capture of the contact (CSV) to fit the make/break times to.
+    /// A scope capture of the contact (CSV) to fit the make/break times to,
+    /// on its own time axis: the time offset is the model time of its
+    /// t = 0 (the trigger), whatever pre-trigger samples it holds.
     #[arg(long, value_name = "SCOPE.csv", conflicts_with = "measured")]
     pub capture: Option<PathBuf>,
 
@@ -63,18 +65,19 @@ pub struct FitArgs {
     pub force: bool,
 }
 
-/// The record to fit and, for a scope capture, its trace (shifted like the
-/// record), levels and thresholds for the overlay plot.
+/// The record to fit and, for a scope capture, its trace, levels and
+/// thresholds for the overlay plot.
 type Captured = (chatterspice::capture::Trace, chatterspice::capture::Capture);
 
 fn read_record(args: &FitArgs) -> Result<(Option<Record>, Option<Captured>)> {
     if let Some(scope) = &args.capture {
-        let (mut trace, c) = super::capture::analyse(scope, args.channel.as_deref(), None, None)?;
-        let origin = c.csv_origin();
-        trace.time.iter_mut().for_each(|t| *t -= origin);
+        let (trace, c) = super::capture::analyse(scope, args.channel.as_deref(), None, None)?;
+        // On the capture's own time axis: the fit's time offset is the
+        // model time of the record's zero (the scope's trigger), whatever
+        // pre-trigger samples the record holds.
         let record = Record {
             name: c.source.clone(),
-            intervals: c.shifted_intervals(),
+            intervals: c.intervals.clone(),
         };
         return Ok((Some(record), Some((trace, c))));
     }

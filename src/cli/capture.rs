@@ -39,7 +39,10 @@ pub struct CaptureArgs {
     #[arg(long, value_name = "NAME|N")]
     pub channel: Option<String>,
     /// The lower hysteresis threshold, in the trace's unit [default: 30 %
-    /// of the way between the levels]. Give --high too.
+    /// of the way between the levels]. Give --high too. With given
+    /// thresholds each edge is timed where it crosses the far one (a fall
+    /// at --low, a rise at --high), as a Schmitt input switches; with the
+    /// defaults, at its 50 % crossing.
     #[arg(
         long,
         value_name = "V",

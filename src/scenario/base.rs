@@ -7,16 +7,20 @@
 //! an array (`[[probe]]`) replaces the base's whole array, and a surface
 //! section whose `law` changes starts afresh (the keys of one law mean
 //! nothing to another). Relative paths (`circuit.netlist`) keep meaning
-//! what they meant in the file that wrote them. An error about a key
-//! names the file and line the key came from.
+//! what they meant in the file that wrote them. A file's `unset` removes
+//! keys of its bases before its own are merged in, and its `[coil]`
+//! replaces its bases' step force (`unset.rs`). An error about a key
+//! names the file and line the key came from, and two keys that exclude
+//! each other, given by two files, are named with the file of each.
 
 use std::path::{Path, PathBuf};
 
 use toml::de::DeTable;
 
 use super::builtin::{DEFAULT_SCENARIO_ORIGIN, DEFAULT_SCENARIO_TOML};
-use super::error::{Location, ScenarioError};
+use super::error::{InheritedConflict, Location, ScenarioError};
 use super::keys::{KeyIndex, line_column};
+use super::unset::{self, Removed};
 
 /// How deep a chain of bases may go before it is taken for a loop.
 const MAX_DEPTH: usize = 16;
@@ -27,6 +31,12 @@ pub(super) struct Layer {
     pub(super) origin: PathBuf,
     /// Its text.
     pub(super) text: String,
+    /// The `base` value that named it, as the file above wrote it
+    /// (`default`, `part:NAME`, `../lib/relay.toml`); `None` for the
+    /// scenario itself.
+    pub(super) named: Option<String>,
+    /// The keys of its bases its `unset` removed.
+    pub(super) removed: Vec<Removed>,
 }
 
 /// A scenario with its bases merged in: the merged TOML text and the
@@ -40,13 +50,14 @@ pub(super) struct Expanded {
 /// when it has no `base`.
 pub(super) fn expand(text: &str, origin: &Path) -> Result<Option<Expanded>, ScenarioError> {
     let table = table_of(text, origin)?;
-    if !table.contains_key("base") {
+    if !table.contains_key("base") && !table.contains_key("unset") {
         return Ok(None);
     }
     let mut layers = Vec::new();
     let merged = resolve(
         text.to_owned(),
         origin.to_owned(),
+        None,
         table,
         &mut layers,
         &mut Vec::new(),
@@ -62,18 +73,34 @@ pub(super) fn expand(text: &str, origin: &Path) -> Result<Option<Expanded>, Scen
     Ok(Some(Expanded { text, layers }))
 }
 
-/// The layers of `origin`'s scenario merged into one table, its bases
-/// pushed on `layers` before it.
+/// The layers of `origin`'s scenario (named `named` by the file above
+/// it) merged into one table, its bases pushed on `layers` before it.
 fn resolve(
     text: String,
     origin: PathBuf,
+    named: Option<String>,
     mut table: toml::Table,
     layers: &mut Vec<Layer>,
     chain: &mut Vec<PathBuf>,
 ) -> Result<toml::Table, ScenarioError> {
     absolute_paths(&mut table, &origin);
+    let mut removed = Vec::new();
     let merged = match table.remove("base") {
-        None => table,
+        None => {
+            if table.contains_key("unset") {
+                return Err(ScenarioError::Unset {
+                    at: Location {
+                        path: origin.clone(),
+                        line: line_of(&text, "unset"),
+                    },
+                    path: String::new(),
+                    problem: "`unset` removes keys of a base, and this file has no `base`; \
+                              remove the key from the file itself instead"
+                        .into(),
+                });
+            }
+            table
+        }
         Some(value) => {
             let at = Location {
                 path: origin.clone(),
@@ -105,14 +132,30 @@ fn resolve(
             }
             let base_table = table_of(&base_text, &base_origin)?;
             chain.push(origin.clone());
-            let below = resolve(base_text, base_origin, base_table, layers, chain);
+            let below = resolve(
+                base_text,
+                base_origin,
+                Some(base.clone()),
+                base_table,
+                layers,
+                chain,
+            );
             chain.pop();
             let mut below = below?;
+            if let Some(entries) = table.remove("unset") {
+                removed = unset::apply(entries, &mut below, &origin, &text)?;
+            }
+            unset::coil_displaces_force(&table, &mut below);
             merge(&mut below, table);
             below
         }
     };
-    layers.push(Layer { origin, text });
+    layers.push(Layer {
+        origin,
+        text,
+        named,
+        removed,
+    });
     Ok(merged)
 }
 
@@ -306,20 +349,44 @@ fn law_changes(below: &toml::Table, above: &toml::Table) -> bool {
 }
 
 /// The 1-based line of top-level or dotted `key` in `text`, if it is there.
-fn line_of(text: &str, key: &str) -> Option<usize> {
+pub(super) fn line_of(text: &str, key: &str) -> Option<usize> {
     let tree = DeTable::parse(text).ok()?;
     KeyIndex::new(&tree, text).line_of_key(key)
+}
+
+/// Where a key of the merged scenario comes from.
+struct Source {
+    /// The index of the layer that gives it (or removed it).
+    layer: usize,
+    /// Its line in that layer.
+    line: usize,
+    /// Whether that layer gives the key itself, not only a table around
+    /// it or an `unset` entry that removed it.
+    exact: bool,
 }
 
 impl Expanded {
     /// `error`, found in the merged text, made to point at the file (and
     /// line) its key came from: the topmost layer that gives the key or,
-    /// failing that, the closest enclosing table.
+    /// failing that, the closest enclosing table, or the `unset` entry
+    /// that removed it. Two keys that exclude each other, given by two
+    /// different files, become a [`ScenarioError::BaseConflict`] that
+    /// names both files and says how to keep either.
     pub(super) fn relocate(&self, mut error: ScenarioError) -> ScenarioError {
         // The parser quotes the merged document, lines and all: keep its
         // words only, the location below is the file's own.
         if self.layers.len() > 1 {
             error.forget_merged_text();
+        }
+        if let ScenarioError::Conflict {
+            key, other, why, ..
+        } = &error
+            && let (Some(mine), Some(theirs)) = (self.source(key), self.source(other))
+            && mine.exact
+            && theirs.exact
+            && mine.layer != theirs.layer
+        {
+            return self.base_conflict(key, mine, other, theirs, why);
         }
         let key = error.key().map(str::to_owned);
         let Some(at) = error.location_mut() else {
@@ -330,36 +397,148 @@ impl Expanded {
             path: top.unwrap_or_default(),
             line: None,
         };
-        let Some(key) = key else { return error };
-        let mut best: Option<(usize, &Layer, usize)> = None;
-        for layer in self.layers.iter().rev() {
-            let Ok(tree) = DeTable::parse(&layer.text) else {
-                continue;
-            };
-            let index = KeyIndex::new(&tree, &layer.text);
-            let mut probe = key.as_str();
-            loop {
-                if let Some(e) = index.entries.iter().find(|e| e.path == probe) {
-                    let depth = probe.len();
-                    if best.is_none_or(|(d, ..)| depth > d) {
-                        let line = line_column(&layer.text, e.key_span.start).0;
-                        best = Some((depth, layer, line));
-                    }
-                    break;
-                }
-                match probe.rfind(['.', '[']) {
-                    Some(cut) => probe = &probe[..cut],
-                    None => break,
-                }
-            }
-        }
-        if let Some((_, layer, line)) = best {
-            *at = Location {
-                path: layer.origin.clone(),
-                line: Some(line),
-            };
+        if let Some(found) = key.and_then(|key| self.source(&key)) {
+            *at = self.location(&found);
         }
         error
+    }
+
+    /// Where `key` comes from: the topmost layer that gives it or the
+    /// deepest table around it, an `unset` entry standing for the key it
+    /// removed from the layers below.
+    fn source(&self, key: &str) -> Option<Source> {
+        let mut best: Option<(usize, Source)> = None;
+        for (i, layer) in self.layers.iter().enumerate().rev() {
+            if let Ok(tree) = DeTable::parse(&layer.text) {
+                let index = KeyIndex::new(&tree, &layer.text);
+                let mut probe = key;
+                loop {
+                    if let Some(e) = index.entries.iter().find(|e| e.path == probe) {
+                        let depth = probe.len();
+                        if best.as_ref().is_none_or(|(d, _)| depth > *d) {
+                            let line = line_column(&layer.text, e.key_span.start).0;
+                            let exact = depth == key.len();
+                            best = Some((
+                                depth,
+                                Source {
+                                    layer: i,
+                                    line,
+                                    exact,
+                                },
+                            ));
+                        }
+                        break;
+                    }
+                    match probe.rfind(['.', '[']) {
+                        Some(cut) => probe = &probe[..cut],
+                        None => break,
+                    }
+                }
+            }
+            // What this layer unset, no layer below it gives any more.
+            let covering = layer.removed.iter().find(|r| {
+                key == r.path
+                    || key
+                        .strip_prefix(r.path.as_str())
+                        .is_some_and(|rest| rest.starts_with(['.', '[']))
+            });
+            if let Some(r) = covering {
+                if let Some(line) = r.line
+                    && best.as_ref().is_none_or(|(d, _)| *d < r.path.len())
+                {
+                    let source = Source {
+                        layer: i,
+                        line,
+                        exact: false,
+                    };
+                    best = Some((r.path.len(), source));
+                }
+                break;
+            }
+        }
+        best.map(|(_, source)| source)
+    }
+
+    fn location(&self, source: &Source) -> Location {
+        Location {
+            path: self.layers[source.layer].origin.clone(),
+            line: Some(source.line),
+        }
+    }
+
+    /// The scenario's own file: the top layer.
+    fn own(&self) -> &Layer {
+        self.layers.last().expect("a scenario has a layer")
+    }
+
+    /// Which file gives a key, in a reader's words: the scenario's own
+    /// file and line, or its base as the scenario wrote it (never the
+    /// checkout the binary was built in) and the line in it.
+    fn describe(&self, source: &Source) -> String {
+        let top = self.layers.len() - 1;
+        let layer = &self.layers[source.layer];
+        let line = source.line;
+        if source.layer == top {
+            return format!("set in {} line {line}", layer.origin.display());
+        }
+        let named = layer.named.as_deref().unwrap_or_default();
+        if source.layer + 1 == top {
+            format!("set by its base \"{named}\", line {line}")
+        } else {
+            let above = &self.layers[source.layer + 1];
+            format!(
+                "set by \"{named}\", line {line}, the base of {}",
+                above.origin.display()
+            )
+        }
+    }
+
+    /// The conflict of `key` (from `mine`) and `other` (from `theirs`),
+    /// given by different files, with what to do in the scenario's own
+    /// file to keep either.
+    fn base_conflict(
+        &self,
+        key: &str,
+        mine: Source,
+        other: &str,
+        theirs: Source,
+        why: &'static str,
+    ) -> ScenarioError {
+        let top = self.layers.len() - 1;
+        let own = self.own().origin.display().to_string();
+        let drop = |name: &str, source: &Source| {
+            let written =
+                unset::quoted_path(&name.split('.').map(str::to_owned).collect::<Vec<_>>());
+            if source.layer == top {
+                format!("remove `{name}` from {own}")
+            } else {
+                format!(
+                    "add `unset = [\"{}\"]` to {own}",
+                    written.replace('"', "\\\"")
+                )
+            }
+        };
+        let advice = format!(
+            "to keep `{other}`, {}; to keep `{key}`, {}",
+            drop(key, &mine),
+            drop(other, &theirs)
+        );
+        let upper = if mine.layer >= theirs.layer {
+            &mine
+        } else {
+            &theirs
+        };
+        ScenarioError::BaseConflict {
+            at: self.location(upper),
+            conflict: Box::new(InheritedConflict {
+                key: key.to_owned(),
+                key_from: self.describe(&mine),
+                other: other.to_owned(),
+                other_from: self.describe(&theirs),
+                why,
+                advice,
+            }),
+        }
     }
 }
 

@@ -167,3 +167,213 @@ fn an_envelope_range_written_in_full_replaces_the_bases() {
     let r = range(&partial);
     assert_eq!((r.min, r.max, r.log), (range(&base).min, 3.0e6, true));
 }
+
+/// The coil of `examples/scenarios/relay-driver.toml`, with a DC step so
+/// that it closes without its driver circuit.
+const RELAY_DRIVER_COIL: &str = "[coil]\nresistance = 70.0\nturns = 3000\npole_area = 2.0e-5\n\
+     air_gap = 6.0e-4\niron_gap = 5.0e-5\ndrive_voltage = 5.0\n";
+
+#[test]
+fn a_coil_over_the_defaults_step_force_replaces_it() {
+    let default = Scenario::builtin_default();
+    assert!(default.mechanics.force.is_some());
+    let s = Scenario::parse(
+        &format!("base = \"default\"\n\n{RELAY_DRIVER_COIL}"),
+        Path::new("mine.toml"),
+    )
+    .unwrap();
+    assert_eq!(
+        s.mechanics.force, None,
+        "a coil-driven relay has no step force"
+    );
+    assert_eq!(s.coil.as_ref().unwrap().turns, 3000);
+    // The rest of the base's mechanics stays.
+    assert_eq!(s.mechanics.mass, default.mechanics.mass);
+    assert_eq!(s.mechanics.gap, default.mechanics.gap);
+    assert_eq!(s.dc_step_voltage(), Some(5.0));
+}
+
+#[test]
+fn a_file_that_gives_both_a_force_and_a_coil_is_told_to_remove_one() {
+    let err = Scenario::parse(
+        &format!("base = \"default\"\n\n[mechanics]\nforce = 0.8\n\n{RELAY_DRIVER_COIL}"),
+        Path::new("mine.toml"),
+    )
+    .unwrap_err();
+    assert!(matches!(err, ScenarioError::Conflict { .. }), "{err:?}");
+    let text = err.to_string();
+    assert!(text.starts_with("mine.toml:4:"), "{text}");
+    assert!(
+        text.contains("remove `mechanics.force` or the [coil] section"),
+        "{text}"
+    );
+}
+
+#[test]
+fn a_force_over_a_parts_coil_names_both_files_and_the_way_out() {
+    let name = "te-axicom-im-5v";
+    let part_line = bundled_part(name)
+        .unwrap()
+        .lines()
+        .position(|l| l == "[coil]")
+        .unwrap()
+        + 1;
+    let mine = format!("base = \"part:{name}\"\n\n[mechanics]\nforce = 0.5\n");
+    let err = Scenario::parse(&mine, Path::new("mine.toml")).unwrap_err();
+    let text = err.to_string();
+    assert!(matches!(err, ScenarioError::BaseConflict { .. }), "{text}");
+    // The user's key at the user's line, the part's by the name the user
+    // gave it, and what to write.
+    assert!(text.starts_with("mine.toml:4:"), "{text}");
+    assert!(text.contains("set in mine.toml line 4"), "{text}");
+    assert!(
+        text.contains(&format!("\"part:{name}\", line {part_line}")),
+        "{text}"
+    );
+    assert!(
+        text.contains("add `unset = [\"coil\"]` to mine.toml"),
+        "{text}"
+    );
+    assert!(!text.contains("/parts/"), "no build-machine path: {text}");
+    // The advice works: the part's mechanics on the step force.
+    let s = Scenario::parse(
+        &mine.replacen('\n', "\nunset = [\"coil\"]\n", 1),
+        Path::new("mine.toml"),
+    )
+    .unwrap();
+    assert_eq!((s.coil.is_none(), s.mechanics.force), (true, Some(0.5)));
+}
+
+#[test]
+fn a_conflict_between_two_bases_names_the_chain() {
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "lib/a.toml",
+        "base = \"default\"\n[limits]\nmax_release_time = 0.01\n",
+    );
+    let top = write(
+        dir.path(),
+        "top.toml",
+        "base = \"lib/a.toml\"\n[simulation]\nt_end = 0.02\n",
+    );
+    let text = Scenario::load(&top).unwrap_err().to_string();
+    let force_line = DEFAULT_SCENARIO_TOML
+        .lines()
+        .position(|l| l.starts_with("force"))
+        .unwrap()
+        + 1;
+    assert!(text.contains("a.toml:3:"), "{text}");
+    assert!(text.contains("base \"lib/a.toml\", line 3"), "{text}");
+    assert!(
+        text.contains(&format!("\"default\", line {force_line}, the base of")),
+        "{text}"
+    );
+    assert!(
+        text.contains("add `unset = [\"limits.max_release_time\"]` to")
+            && text.contains("top.toml"),
+        "{text}"
+    );
+}
+
+#[test]
+fn unset_removes_a_key_of_the_base() {
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "base.toml",
+        "base = \"default\"\n[limits]\nmax_bounces = 1\nmax_settle_time = 0.01\n",
+    );
+    let top = write(
+        dir.path(),
+        "top.toml",
+        "base = \"base.toml\"\nunset = [\"limits.max_bounces\"]\n",
+    );
+    let inherited = Scenario::load(&dir.path().join("base.toml")).unwrap();
+    assert_eq!(inherited.limits.as_ref().unwrap().max_bounces, Some(1));
+    let s = Scenario::load(&top).unwrap();
+    let limits = s.limits.as_ref().unwrap();
+    assert_eq!(limits.max_bounces, None);
+    assert_eq!(limits.max_settle_time, Some(0.01));
+    // Removing the last key removes the section.
+    let s = Scenario::parse(
+        "base = \"base.toml\"\nunset = [\"limits.max_bounces\", \"limits.max_settle_time\"]\n",
+        &dir.path().join("top.toml"),
+    )
+    .unwrap();
+    assert!(s.limits.is_none());
+}
+
+#[test]
+fn unset_removes_an_envelope_range_and_a_section_starts_afresh() {
+    let part = "base = \"part:te-axicom-im-5v\"\n";
+    let base = Scenario::parse(part, Path::new("x.toml")).unwrap();
+    let ranges = |s: &Scenario| s.envelope.as_ref().unwrap().ranges.clone();
+    assert!(ranges(&base).contains_key("surface.stiffness"));
+    let s = Scenario::parse(
+        &format!("{part}unset = ['envelope.\"surface.stiffness\"']\n"),
+        Path::new("x.toml"),
+    )
+    .unwrap();
+    let left = ranges(&s);
+    assert!(!left.contains_key("surface.stiffness"), "{left:?}");
+    assert_eq!(left.len() + 1, ranges(&base).len());
+    assert_eq!(left["surface.damping"], ranges(&base)["surface.damping"]);
+    // A whole section removed and written again is this file's alone.
+    let s = Scenario::parse(
+        &format!(
+            "{part}unset = [\"envelope\"]\n[envelope]\nsource = \"mine\"\n\
+             [envelope.\"surface.stiffness\"]\nmax = 3.0e6\nmin = 1.0e6\n"
+        ),
+        Path::new("x.toml"),
+    )
+    .unwrap();
+    let mine = ranges(&s);
+    assert_eq!(mine.keys().collect::<Vec<_>>(), ["surface.stiffness"]);
+}
+
+#[test]
+fn a_bad_unset_entry_names_the_file_and_its_line() {
+    let case = |text: &str| {
+        Scenario::parse(text, Path::new("mine.toml"))
+            .unwrap_err()
+            .to_string()
+    };
+    // Not set by the base: the entry's own line, and what the base sets.
+    let text = case("base = \"default\"\nunset = [\n  \"limits\",\n  \"mechanics.forse\",\n]\n");
+    assert!(text.starts_with("mine.toml:3:"), "{text}");
+    assert!(
+        text.contains("\"limits\"") && text.contains("does not set"),
+        "{text}"
+    );
+    let text = case("base = \"default\"\nunset = [\n  \"mechanics.forse\",\n]\n");
+    assert!(text.starts_with("mine.toml:3:"), "{text}");
+    assert!(text.contains("force, gap"), "{text}");
+    // No such section.
+    let text = case("base = \"default\"\nunset = [\"mechanic.force\"]\n");
+    assert!(
+        text.starts_with("mine.toml:2:") && text.contains("not a section"),
+        "{text}"
+    );
+    // Not a key path, or an element of an array.
+    for entry in ["\"mechanics..force\"", "\"probe[0]\"", "\"\"", "3"] {
+        let text = case(&format!("base = \"default\"\n\nunset = [{entry}]\n"));
+        assert!(text.starts_with("mine.toml:3:"), "{entry}: {text}");
+    }
+    // Into a value.
+    let text = case("base = \"default\"\nunset = [\"mechanics.force.x\"]\n");
+    assert!(text.contains("not a table"), "{text}");
+    // Without a base.
+    let text = case("\nunset = [\"probe\"]\n[simulation]\nt_end = 0.02\n");
+    assert!(
+        text.starts_with("mine.toml:2:") && text.contains("no `base`"),
+        "{text}"
+    );
+    // A required key removed is missing at the entry that removed it.
+    let text =
+        case("base = \"default\"\nunset = [\"mechanics.mass\"]\n[mechanics]\nstiffness = 4000.0\n");
+    assert!(
+        text.starts_with("mine.toml:2:") && text.contains("`mechanics.mass` is missing"),
+        "{text}"
+    );
+}

@@ -76,8 +76,8 @@ impl Check<'_> {
                     at: self.at("circuit.nc_subckt"),
                     key: "circuit.nc_subckt".to_owned(),
                     other: "circuit.subckt".to_owned(),
-                    advice: "the normally-closed contact needs a subcircuit name of its own, \
-                             e.g. CONTACT_NC",
+                    why: "the normally-closed contact needs a subcircuit name of its own",
+                    advice: "rename it, e.g. CONTACT_NC",
                 });
             }
         }

@@ -99,9 +99,9 @@ impl Check<'_> {
                     at: self.at("circuit.nc_subckt"),
                     key: "circuit.nc_subckt".to_owned(),
                     other: "mechanics.force".to_owned(),
-                    advice: "the normally-closed contact follows the armature back to its \
-                             rest stop on release, which needs a [coil]; give one or remove \
-                             the key",
+                    why: "the normally-closed contact follows the armature back to its \
+                          rest stop on release, which needs a [coil]",
+                    advice: "give one or remove the key",
                 });
             }
         }

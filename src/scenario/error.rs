@@ -118,7 +118,7 @@ pub enum ScenarioError {
         help: &'static str,
     },
     /// Two keys or sections that cannot be used together are both given.
-    #[error("{at}: `{key}` and `{other}` cannot both be given: {advice}")]
+    #[error("{at}: `{key}` and `{other}` cannot both be given: {why}; {advice}")]
     Conflict {
         /// Where `key` is.
         at: Location,
@@ -126,8 +126,31 @@ pub enum ScenarioError {
         key: String,
         /// The key or section it cannot be used with.
         other: String,
-        /// Which to keep, and why.
+        /// Why the two exclude each other.
+        why: &'static str,
+        /// Which to keep, in the file that gives both.
         advice: &'static str,
+    },
+    /// Two keys or sections that cannot be used together, given by two
+    /// different files of a chain of bases (one of them usually the
+    /// scenario itself, the other its base).
+    #[error("{at}: {conflict}")]
+    BaseConflict {
+        /// Where the one of the two given higher up the chain is.
+        at: Location,
+        /// The two keys, the file of each, and how to keep either.
+        conflict: Box<InheritedConflict>,
+    },
+    /// An entry of `unset` that cannot be applied: not a key path, a path
+    /// no base sets, or `unset` in a file without a `base`.
+    #[error("{at}: `unset`{}: {problem}", entry(path))]
+    Unset {
+        /// Where the entry is.
+        at: Location,
+        /// The entry as written (empty when `unset` itself is malformed).
+        path: String,
+        /// What is wrong, and what to write instead.
+        problem: String,
     },
     /// A key of `[surface]` or `[back_stop]` that the section's `law` does
     /// not read.
@@ -219,6 +242,45 @@ pub enum ScenarioError {
     },
 }
 
+/// Two keys that exclude each other, each given by a different file of a
+/// chain of bases: the body of [`ScenarioError::BaseConflict`].
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct InheritedConflict {
+    /// The dotted key reported.
+    pub key: String,
+    /// Which file, and which line of it, gives `key`.
+    pub key_from: String,
+    /// The key or section it cannot be used with.
+    pub other: String,
+    /// Which file, and which line of it, gives `other`.
+    pub other_from: String,
+    /// Why the two exclude each other.
+    pub why: &'static str,
+    /// How to keep either: which key to remove from the scenario, or to
+    /// `unset` from its base.
+    pub advice: String,
+}
+
+impl fmt::Display for InheritedConflict {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "`{}` ({}) and `{}` ({}) cannot both be given: {}; {}",
+            self.key, self.key_from, self.other, self.other_from, self.why, self.advice
+        )
+    }
+}
+
+/// " entry \"PATH\"" for an `unset` error about one entry, "" for one
+/// about `unset` itself.
+fn entry(path: &str) -> String {
+    if path.is_empty() {
+        String::new()
+    } else {
+        format!(" entry {path:?}")
+    }
+}
+
 /// `Some(f(at))` for the variants that point at a place in the file, by
 /// reference or by mutable reference as `$error` is borrowed.
 macro_rules! located {
@@ -230,6 +292,8 @@ macro_rules! located {
             | ScenarioError::Invalid { $at, .. }
             | ScenarioError::Empty { $at, .. }
             | ScenarioError::Conflict { $at, .. }
+            | ScenarioError::BaseConflict { $at, .. }
+            | ScenarioError::Unset { $at, .. }
             | ScenarioError::NotForLaw { $at, .. }
             | ScenarioError::UnknownNumber { $at, .. }
             | ScenarioError::Sweep { $at, .. }
@@ -284,7 +348,9 @@ impl ScenarioError {
             | ScenarioError::NotForLaw { key, .. }
             | ScenarioError::UnknownNumber { key, .. }
             | ScenarioError::Sweep { key, .. } => Some(key),
+            ScenarioError::BaseConflict { conflict, .. } => Some(&conflict.key),
             ScenarioError::Base { .. } => Some("base"),
+            ScenarioError::Unset { .. } => Some("unset"),
             ScenarioError::Read { .. }
             | ScenarioError::Syntax { .. }
             | ScenarioError::CoilDriveUnsupported { .. } => None,

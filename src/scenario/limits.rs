@@ -163,8 +163,9 @@ impl Check<'_> {
                 at: self.at(key),
                 key: (*key).to_owned(),
                 other: "mechanics.force".to_owned(),
-                advice: "a release needs a coil that is switched off: with a step force the \
-                         contact never releases; give a [coil] or remove the limit",
+                why: "a release needs a coil that is switched off: with a step force the \
+                      contact never releases",
+                advice: "give a [coil] or remove the limit",
             }),
             _ => Ok(()),
         }

@@ -34,7 +34,8 @@ impl Scenario {
     /// `origin`'s directory.
     pub fn parse(text: &str, origin: &Path) -> Result<Scenario, ScenarioError> {
         let tree = syntax(text, origin)?;
-        if tree.get_ref().get("base").is_none() {
+        let own = tree.get_ref();
+        if own.get("base").is_none() && own.get("unset").is_none() {
             return Scenario::parse_tree(tree, text, origin);
         }
         let Some(expanded) = base::expand(text, origin)? else {

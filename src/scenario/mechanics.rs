@@ -100,8 +100,10 @@ impl Check<'_> {
                 at: self.at("mechanics.force"),
                 key: "mechanics.force".to_owned(),
                 other: "coil".to_owned(),
-                advice: "with [coil] the closing force comes from the coil current; \
-                         remove `mechanics.force` or the [coil] section",
+                why: "with [coil] the closing force comes from the coil current, and a \
+                      coil-driven relay has no step force",
+                advice: "remove `mechanics.force` or the [coil] section (a [coil] written \
+                         over a base's step force replaces it by itself)",
             }),
             (None, None) => Err(self.missing(
                 "mechanics.force",

@@ -44,6 +44,7 @@ mod sweep;
 #[cfg(test)]
 mod tests;
 mod two_stage;
+mod unset;
 
 pub use base::{BUNDLED_PARTS, bundled_part, bundled_part_text};
 pub use builder::ScenarioBuilder;
@@ -55,7 +56,7 @@ pub use circuit::CircuitSection;
 pub use coil::CoilSection;
 pub use contact::{ContactSection, HolmSection};
 pub use envelope::{EnvelopeRange, EnvelopeSection};
-pub use error::{Location, ScenarioError};
+pub use error::{InheritedConflict, Location, ScenarioError};
 pub use figure::{FigureKind, PRINTED_PRECISION, PrintedFigure, TYPICAL_BAND};
 pub use law::{ReleaseRule, SurfaceLaw};
 pub use limits::LimitsSection;

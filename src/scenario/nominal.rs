@@ -79,8 +79,9 @@ impl Check<'_> {
                     at: self.at("sweep.grid"),
                     key: "sweep.grid".to_owned(),
                     other: "sweep.vary".to_owned(),
-                    advice: "a grid steps its keys instead of drawing random samples; \
-                             keep [sweep.grid] or [sweep.vary], and sweep the other in a second run",
+                    why: "a grid steps its keys instead of drawing random samples",
+                    advice: "keep [sweep.grid] or [sweep.vary], and sweep the other in a \
+                             second run",
                 });
             }
             if sweep.samples.is_some() {
@@ -88,8 +89,9 @@ impl Check<'_> {
                     at: self.at("sweep.samples"),
                     key: "sweep.samples".to_owned(),
                     other: "sweep.grid".to_owned(),
-                    advice: "a grid runs each of its points once; remove `samples` \
-                             (the number of points is the product of the `steps`)",
+                    why: "a grid runs each of its points once",
+                    advice: "remove `samples` (the number of points is the product of the \
+                             `steps`)",
                 });
             }
             if sweep.grid.len() > 2 {

@@ -49,9 +49,9 @@ impl Check<'_> {
                 at: self.at("back_stop"),
                 key: "back_stop".to_owned(),
                 other: "mechanics.force".to_owned(),
-                advice: "the armature comes back to its rest stop only on release, and a \
-                         step force never releases: give a [coil] (the release follows its \
-                         driver) or remove [back_stop]",
+                why: "the armature comes back to its rest stop only on release, and a \
+                      step force never releases",
+                advice: "give a [coil] (the release follows its driver) or remove [back_stop]",
             });
         }
         if s.release.is_some() {
@@ -59,8 +59,9 @@ impl Check<'_> {
                 at: self.at("back_stop.release"),
                 key: "back_stop.release".to_owned(),
                 other: "back_stop.law".to_owned(),
-                advice: "the rest stop lets go of the armature by position (back at the stop, \
-                         moving away); remove the key",
+                why: "the rest stop lets go of the armature by position (back at the stop, \
+                      moving away)",
+                advice: "remove the key",
             });
         }
         self.surface("back_stop", s).map(Some)
@@ -201,7 +202,8 @@ impl Check<'_> {
                     at: self.at(&format!("{section}.chi")),
                     key: format!("{section}.chi"),
                     other,
-                    advice: "give χ directly, or as `restitution` at `reference_velocity`, not both",
+                    why: "χ is given directly, or as `restitution` at `reference_velocity`",
+                    advice: "keep one of the two",
                 });
             }
             (None, Some(e), Some(v)) => {

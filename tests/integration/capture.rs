@@ -44,7 +44,11 @@ fn noise(k: usize) -> f64 {
 /// 80 % and recovers to the open level with τ = 20 µs; ±40 mV of noise;
 /// 8 bits over −1…7 V. `closed_high` flips the polarity.
 fn trace(intervals: &[Interval], closed_high: bool) -> (Vec<f64>, Vec<f64>) {
-    let t0 = intervals[0].start - 2e-4; // pre-trigger
+    trace_from(intervals, closed_high, intervals[0].start - 2e-4) // pre-trigger
+}
+
+/// [`trace`] from the first sample at `t0`, on the scope's axis.
+fn trace_from(intervals: &[Interval], closed_high: bool, t0: f64) -> (Vec<f64>, Vec<f64>) {
     let t1 = intervals.last().unwrap().end;
     let n = ((t1 - t0) / DT) as usize;
     let (mut time, mut value) = (Vec::with_capacity(n), Vec::with_capacity(n));
@@ -533,4 +537,129 @@ fn fit_capture_recovers_a_known_relay() {
         let got = p["value"].as_f64().unwrap();
         assert!((got / want - 1.0).abs() < tol, "{key}: {got} vs {want}");
     }
+}
+
+/// `fit --capture` gives its time offset from the scope's trigger (t = 0
+/// of the file's time axis), not from the capture's first sample: the
+/// same chatter recorded from 1 ms or from 50 µs before the trigger gives
+/// the same offset, the model time of the trigger.
+#[test]
+fn fit_capture_offset_is_from_the_trigger_not_the_first_sample() {
+    let truth_text = "[mechanics]\nmass = 2.0e-4\nstiffness = 800.0\ndamping = 0.02\nforce = 0.5\n\
+                      gap = 5.0e-4\n\n[surface]\nlaw = \"kelvin-voigt\"\nstiffness = 8.0e4\n\
+                      damping = 0.5\n\n[simulation]\nt_end = 0.02\n";
+    let truth = Scenario::parse(truth_text, Path::new("truth.toml")).unwrap();
+    let c = chatterspice::simulate(
+        &truth.mechanics().unwrap(),
+        &truth.surface(),
+        &truth.settings(),
+    )
+    .unwrap();
+    let settle = c.settle_time.unwrap();
+    // Scope time = model time + OFFSET: the force came on -OFFSET before
+    // the trigger.
+    let intervals: Vec<Interval> = c
+        .intervals
+        .iter()
+        .map(|i| Interval {
+            state: i.state,
+            start: i.start + OFFSET,
+            end: i.end.min(settle + 1e-3) + OFFSET,
+        })
+        .filter(|i| i.end > i.start)
+        .collect();
+    let dir = tempfile::tempdir().unwrap();
+    let prior = dir.path().join("prior.toml");
+    std::fs::write(&prior, truth_text).unwrap();
+    let mut offsets = Vec::new();
+    for (name, first_sample) in [("long.csv", -1.0e-3), ("short.csv", -0.05e-3)] {
+        let (t, v) = trace_from(&intervals, false, first_sample);
+        assert!((t[0] - first_sample).abs() < 1e-12);
+        let scope = dir.path().join(name);
+        std::fs::write(&scope, plain(&t, &v)).unwrap();
+        let out = Command::cargo_bin("chatterspice")
+            .unwrap()
+            .arg("fit")
+            .arg(&prior)
+            .arg("--capture")
+            .arg(&scope)
+            .args(["--free", "surface.damping", "--format", "json"])
+            .assert()
+            .success();
+        let report: Value = serde_json::from_slice(&out.get_output().stdout).unwrap();
+        let offset = report["time_offset"].as_f64().unwrap();
+        assert!(
+            (offset + OFFSET).abs() < 2e-6,
+            "{name}: offset {offset}, the trigger is at model time {}",
+            -OFFSET
+        );
+        // The events are reported on the scope's own axis.
+        let first = report["events"][0]["measured"].as_f64().unwrap();
+        let want = intervals[1].start;
+        assert!((first - want).abs() < 1e-6, "{name}: {first} vs {want}");
+        offsets.push(offset);
+    }
+    assert!(
+        (offsets[0] - offsets[1]).abs() < 1e-6,
+        "pre-trigger samples moved the offset: {offsets:?}"
+    );
+}
+
+/// `capture --low/--high` on an RC-shaped trace (exponential edges, no
+/// sharp step): each edge is where the trace crosses the far threshold,
+/// in closed form τ·ln(ΔV₀/ΔV), so two pairs sharing a midpoint give
+/// different edges.
+#[test]
+fn given_thresholds_move_the_edges_of_an_rc_trace() {
+    let (open, closed, tau_fall, tau_rise): (f64, f64, f64, f64) = (3.3, 0.0, 8e-6, 30e-6);
+    let (make, brk): (f64, f64) = (50e-6, 150e-6);
+    let dt = 50e-9;
+    let at_break = closed + (open - closed) * (-(brk - make) / tau_fall).exp();
+    let v = |t: f64| {
+        if t < make {
+            open
+        } else if t < brk {
+            closed + (open - closed) * (-(t - make) / tau_fall).exp()
+        } else {
+            open - (open - at_break) * (-(t - brk) / tau_rise).exp()
+        }
+    };
+    let t: Vec<f64> = (0..8000).map(|k| -20e-6 + k as f64 * dt).collect();
+    let values: Vec<f64> = t.iter().map(|&t| v(t)).collect();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("rc.csv");
+    std::fs::write(&path, plain(&t, &values)).unwrap();
+    let mut seen = Vec::new();
+    for (low, high) in [(0.8, 2.5), (1.2, 2.1)] {
+        let json = capture_json(
+            &path,
+            &[
+                "--low",
+                &low.to_string(),
+                "--high",
+                &high.to_string(),
+                "--closed",
+                "low",
+            ],
+        );
+        let makes = json["makes"].as_array().unwrap();
+        let breaks = json["breaks"].as_array().unwrap();
+        assert_eq!((makes.len(), breaks.len()), (1, 1), "{json}");
+        let want_make = make + tau_fall * ((open - closed) / (low - closed)).ln();
+        let want_break = brk + tau_rise * ((open - at_break) / (open - high)).ln();
+        let (m, b) = (makes[0].as_f64().unwrap(), breaks[0].as_f64().unwrap());
+        assert!(
+            (m - want_make).abs() < 1e-8,
+            "{low}: make {m} vs {want_make}"
+        );
+        assert!(
+            (b - want_break).abs() < 1e-8,
+            "{high}: break {b} vs {want_break}"
+        );
+        seen.push((m, b));
+    }
+    assert!(
+        (seen[0].0 - seen[1].0).abs() > 1e-6 && (seen[0].1 - seen[1].1).abs() > 1e-6,
+        "{seen:?}"
+    );
 }
