@@ -682,8 +682,8 @@ pub fn making_checks(scenario: &Scenario, makes: &[crate::arc::making::Make]) ->
                 if makes.is_empty() {
                     no_make()
                 } else {
-                    "not evaluated: the contact force at the makes is known for a step-force \
-                     relay only (a coil-driven or measured relay's force is not modelled here)"
+                    "not evaluated: the run has no contact force at its makes (a measured \
+                     record has none, nor a rigid contact closed on its coil's DC step)"
                         .to_owned()
                 }
             }),

@@ -99,7 +99,7 @@ pub struct OwnLife {
     pub energy_per_operation: f64,
 }
 
-/// `life`'s report.
+/// `life`'s report, also the `life` object of `run` and `check`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LifeReport {
     /// The figure B was calibrated on (0-based).
@@ -110,6 +110,54 @@ pub struct LifeReport {
     pub figures: Vec<FigureLife>,
     /// At the scenario's own circuit, when it has one.
     pub life: Option<OwnLife>,
+    /// The Weibull shape β the B10 life was computed with
+    /// (`[datasheet] weibull_shape`; `null` without one: no B10).
+    pub weibull_shape: Option<f64>,
+}
+
+/// Whether `scenario` prints electrical endurance figures, so that a life
+/// can be estimated for it.
+pub fn has_figures(scenario: &Scenario) -> bool {
+    scenario
+        .datasheet
+        .as_ref()
+        .is_some_and(|d| !d.electrical_endurance.is_empty())
+}
+
+/// `[limits] min_electrical_life` (operations) held against the life at
+/// the scenario's own circuit in `report`. A circuit whose operation puts
+/// no arc energy into the contacts has no electrical wear: the limit holds
+/// (with the largest finite number as its life, and a note saying why).
+pub fn limit_check(limit: f64, report: &LifeReport) -> crate::check::LimitCheck {
+    let (actual, note) = match &report.life {
+        Some(OwnLife {
+            operations: Some(n),
+            ..
+        }) => (Ok(*n), None),
+        Some(_) => (
+            Ok(f64::MAX),
+            Some(
+                "unlimited by arcs: the circuit's operation puts no arc energy into the contacts"
+                    .to_owned(),
+            ),
+        ),
+        None => (
+            Err("the scenario has no [circuit] to estimate the life at".to_owned()),
+            None,
+        ),
+    };
+    let mut check = crate::check::LimitCheck::new(
+        "limits.min_electrical_life".into(),
+        "electrical life at this circuit (operations)".into(),
+        "",
+        crate::check::Bound::Min,
+        limit,
+        actual,
+    );
+    if note.is_some() {
+        check.note = note;
+    }
+    check
 }
 
 /// Why the life cannot be estimated.
@@ -165,13 +213,28 @@ pub enum LifeError {
 }
 
 /// The life estimate of `scenario` with `phases` switching phases per AC
-/// figure, its ngspice runs through `runner`, `jobs` at a time.
+/// figure, its ngspice runs through `runner`, `jobs` at a time. The
+/// scenario's own circuit, when it has one, is run too.
 pub fn estimate(
     scenario: &Scenario,
     runner: &dyn Runner,
     options: &RunOptions,
     phases: usize,
     jobs: usize,
+) -> Result<LifeReport, LifeError> {
+    estimate_at(scenario, runner, options, phases, jobs, None)
+}
+
+/// [`estimate`] with the scenario's own circuit already run (`own`, the
+/// result of `run` or `check`): its operation energy is read from that
+/// run instead of running the circuit again.
+pub fn estimate_at(
+    scenario: &Scenario,
+    runner: &dyn Runner,
+    options: &RunOptions,
+    phases: usize,
+    jobs: usize,
+    own: Option<&pipeline::RunResult>,
 ) -> Result<LifeReport, LifeError> {
     let path = scenario.origin.clone();
     let figures = scenario
@@ -242,29 +305,35 @@ pub fn estimate(
             }
         })
         .collect();
-    let life = match &scenario.circuit {
-        Some(_) => {
+    let shape = scenario.datasheet.as_ref().and_then(|d| d.weibull_shape);
+    let own_energy = |run: &pipeline::RunResult| {
+        run.arcs
+            .as_ref()
+            .map_or(0.0, |a| a.totals.max_operation_energy)
+    };
+    let energy = match (&scenario.circuit, own) {
+        (None, _) => None,
+        (Some(_), Some(run)) => Some(own_energy(run)),
+        (Some(_), None) => {
             let run = pipeline::run(scenario, runner, options)
                 .map_err(|e| LifeError::Own(Box::new(e)))?;
-            let e = run
-                .arcs
-                .as_ref()
-                .map_or(0.0, |a| a.totals.max_operation_energy);
-            let operations = (e > 0.0).then(|| b / e);
-            let shape = scenario.datasheet.as_ref().and_then(|d| d.weibull_shape);
-            Some(OwnLife {
-                operations,
-                b10: operations.zip(shape).map(|(n, beta)| b10(n, beta)),
-                energy_per_operation: e,
-            })
+            Some(own_energy(&run))
         }
-        None => None,
     };
+    let life = energy.map(|e| {
+        let operations = (e > 0.0).then(|| b / e);
+        OwnLife {
+            operations,
+            b10: operations.zip(shape).map(|(n, beta)| b10(n, beta)),
+            energy_per_operation: e,
+        }
+    });
     Ok(LifeReport {
         calibrated_on: 0,
         constant_j: b,
         figures: rows,
         life,
+        weibull_shape: shape,
     })
 }
 
@@ -305,7 +374,11 @@ pub fn render(report: &LifeReport) -> String {
                         "{n:.4e}"
                     )),
                 l.energy_per_operation,
-                l.b10.map_or(String::new(), |b| format!(", B10 {b:.4e}"))
+                l.b10
+                    .zip(report.weibull_shape)
+                    .map_or(String::new(), |(b, beta)| format!(
+                        ", B10 {b:.4e} (Weibull shape {beta})"
+                    ))
             );
         }
         None => out.push_str("the scenario has no [circuit]: no life at its own load\n"),
@@ -418,8 +491,13 @@ fn figure_energy(
         });
         test.probes.clear();
         test.arc = Some(scenario.arc.unwrap_or_default());
+        // Only the arcs are read: no ideal-contact run to compare with.
+        let options = RunOptions {
+            compare_ideal: false,
+            ..options.clone()
+        };
         let run =
-            pipeline::run_measured(&test, intervals.clone(), runner, options).map_err(|e| {
+            pipeline::run_measured(&test, intervals.clone(), runner, &options).map_err(|e| {
                 LifeError::Run {
                     index: index + 1,
                     phase,

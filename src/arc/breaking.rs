@@ -16,8 +16,14 @@
 //! The arc also goes out when its steady current falls below I_min, which
 //! caps what the model can show at high voltages: there the breakable
 //! current is V·I_min²/((V − a)·I_min − K), however small the printed
-//! figure ([`ArcModel::breaking_current`]). The fit uses the tangent
-//! relation; the rows show the whole model beside each printed figure.
+//! figure ([`ArcModel::breaking_current`]). At the tangent the arc burns
+//! at i_t = 2·K/(V − a), which falls with the voltage; a printed curve
+//! that follows the tangent up to V therefore says the arc still burns at
+//! i_t(V). With `arc.i_min` free the fit lowers I_min to the largest value
+//! that lets every printed figure be set by its tangent, min over the
+//! figures of i_t (and never raises it); any smaller I_min gives the same
+//! breaking currents, so the fitted value is an upper bound. The rows show
+//! the whole model beside each printed figure.
 
 use serde::Serialize;
 
@@ -59,6 +65,13 @@ pub struct BreakingFit {
     pub low_current: f64,
     /// Whether E was fitted (two figures or more) or held.
     pub field_fitted: bool,
+    /// A, the minimum arc current: the prior's, or (when fitted) the
+    /// largest that lets the tangent set every figure.
+    pub i_min: f64,
+    /// Whether I_min was lowered to the figures (it is held when the
+    /// prior already lets the tangent set every figure, or when it was
+    /// not free).
+    pub i_min_fitted: bool,
     /// m, the full contact gap the figures were fitted at.
     pub gap: f64,
     /// The figures beside the fitted model.
@@ -92,15 +105,25 @@ pub enum BreakingFitError {
     },
 }
 
-/// Fits C, and E when `fit_field` and there are two figures or more, of
-/// `model` to `figures` at the full gap `gap` (m), holding V_min, I_min
-/// and D (and E otherwise).
+/// What a breaking fit may move besides C.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct FreeArcKeys {
+    /// E, the column gradient (with two figures or more).
+    pub field: bool,
+    /// I_min, lowered where the figures call for it.
+    pub i_min: bool,
+}
+
+/// Fits C, E when `free.field` and there are two figures or more, and
+/// I_min when `free.i_min`, of `model` to `figures` at the full gap `gap`
+/// (m), holding V_min and D (and E, I_min otherwise).
 pub fn fit(
     model: &ArcModel,
     gap: f64,
     figures: &[BreakingFigure],
-    fit_field: bool,
+    free: FreeArcKeys,
 ) -> Result<BreakingFit, BreakingFitError> {
+    let fit_field = free.field;
     if figures.is_empty() {
         return Err(BreakingFitError::NoFigures);
     }
@@ -145,6 +168,16 @@ pub fn fit(
             k,
         });
     }
+    // The tangent current of each figure: the arc burns there when the
+    // load line touches its characteristic. I_min above the smallest of
+    // them puts the arc out first, and the model then breaks more than
+    // printed at that voltage.
+    let tangent_floor = figures
+        .iter()
+        .filter(|f| f.voltage > a)
+        .map(|f| 2.0 * k / (f.voltage - a))
+        .fold(f64::INFINITY, f64::min);
+    let i_min_fitted = free.i_min && tangent_floor < model.i_min;
     let fitted = ArcModel {
         field: if field_fitted {
             (a - model.v_min) / gap
@@ -152,6 +185,11 @@ pub fn fit(
             model.field
         },
         low_current,
+        i_min: if i_min_fitted {
+            tangent_floor
+        } else {
+            model.i_min
+        },
         ..*model
     };
     let rows = rows(&fitted, gap, figures);
@@ -168,6 +206,8 @@ pub fn fit(
         field: fitted.field,
         low_current,
         field_fitted,
+        i_min: fitted.i_min,
+        i_min_fitted,
         gap,
         rows,
         rms_log_error,
@@ -178,6 +218,12 @@ pub fn fit(
 mod tests {
     use super::*;
     use crate::arc::ArcSection;
+
+    /// E and C free, I_min held.
+    const FIELD: FreeArcKeys = FreeArcKeys {
+        field: true,
+        i_min: false,
+    };
 
     /// The largest current whose load line still meets the arc's
     /// characteristic at a current of at least I_min, found by brute
@@ -259,7 +305,7 @@ mod tests {
         }
         .model();
         assert!((start.field / truth.field - 1.0).abs() > 0.5);
-        let fit = fit(&start, gap, &figures, true).unwrap();
+        let fit = fit(&start, gap, &figures, FIELD).unwrap();
         assert!(fit.field_fitted);
         assert!(
             (fit.field / truth.field - 1.0).abs() < 1e-9,
@@ -269,7 +315,7 @@ mod tests {
         assert!((fit.low_current / truth.low_current - 1.0).abs() < 1e-9);
         assert!(fit.rms_log_error < 1e-9);
         // One figure: E held, C through it.
-        let one = super::fit(&start, gap, &figures[..1], true).unwrap();
+        let one = super::fit(&start, gap, &figures[..1], FIELD).unwrap();
         assert!(!one.field_fitted);
         assert_eq!(one.field, start.field);
         let row = &one.rows[0];
@@ -286,40 +332,96 @@ mod tests {
             },
         ];
         assert!(matches!(
-            super::fit(&start, gap, &wrong, true),
+            super::fit(&start, gap, &wrong, FIELD),
             Err(BreakingFitError::Unphysical { .. })
         ));
         assert_eq!(
-            super::fit(&start, gap, &[], true),
+            super::fit(&start, gap, &[], FIELD),
             Err(BreakingFitError::NoFigures)
         );
         // E held over several figures: C alone, by least squares.
-        let held = super::fit(&start, gap, &figures, false).unwrap();
+        let held = super::fit(&start, gap, &figures, FreeArcKeys::default()).unwrap();
         assert!(!held.field_fitted);
         assert_eq!(held.field, start.field);
         assert!(held.low_current > 0.0 && held.low_current != start.low_current);
     }
 
-    #[test]
-    fn the_finder_curve_at_30_v_and_the_i_min_floor_above() {
-        // Finder 40.52, DC1 curve (resistive): 8 A at 30 V, 0.3 A at
-        // 110 V, 0.12 A at 220 V.
-        let printed = [(30.0, 8.0), (110.0, 0.3), (220.0, 0.12)]
-            .map(|(voltage, current)| BreakingFigure { voltage, current });
-        let model = ArcSection {
+    /// Finder 40.52, DC1 curve (resistive): 8 A at 30 V, 0.3 A at 110 V,
+    /// 0.12 A at 220 V (40 Series datasheet, "Breaking capacity DC1").
+    fn finder() -> [BreakingFigure; 3] {
+        [(30.0, 8.0), (110.0, 0.3), (220.0, 0.12)]
+            .map(|(voltage, current)| BreakingFigure { voltage, current })
+    }
+
+    fn agni() -> ArcModel {
+        ArcSection {
             material: Some(crate::arc::Material::AgNi),
             ..ArcSection::default()
         }
-        .model();
-        let fit = fit(&model, 0.3e-3, &printed, true).unwrap();
+        .model()
+    }
+
+    #[test]
+    fn the_finder_curve_at_30_v_and_the_i_min_floor_above() {
+        let printed = finder();
+        let fit = fit(&agni(), 0.3e-3, &printed, FIELD).unwrap();
         // The three points lie on one tangent curve: E of tens of kV/m.
         assert!(fit.field > 1e4 && fit.field < 1e5, "{}", fit.field);
+        assert!(!fit.i_min_fitted && fit.i_min == 0.4);
         let at_30 = &fit.rows[0];
         assert!((at_30.model.unwrap() / 8.0 - 1.0).abs() < 0.05, "{at_30:?}");
         // Above, the steady arc current drops below silver's 0.4 A first:
-        // the model breaks more than printed, and says so.
+        // with I_min held the model breaks more than printed.
         for row in &fit.rows[1..] {
-            assert!(row.model.unwrap() > row.printed, "{row:?}");
+            assert!(row.model.unwrap() > 1.5 * row.printed, "{row:?}");
         }
+    }
+
+    #[test]
+    fn with_i_min_free_the_finder_curve_is_met_at_every_voltage() {
+        let all = FreeArcKeys {
+            field: true,
+            i_min: true,
+        };
+        let fit = fit(&agni(), 0.3e-3, &finder(), all).unwrap();
+        assert!(fit.i_min_fitted);
+        // I_min is the tangent current at 220 V: 2K/(V − a).
+        let a = agni().v_min + fit.field * 0.3e-3;
+        let expected = 2.0 * fit.low_current / (220.0 - a);
+        assert!((fit.i_min / expected - 1.0).abs() < 1e-12, "{}", fit.i_min);
+        assert!(fit.i_min > 0.04 && fit.i_min < 0.07, "{}", fit.i_min);
+        for row in &fit.rows {
+            assert!(
+                (row.model.unwrap() / row.printed - 1.0).abs() < 0.01,
+                "{row:?}"
+            );
+        }
+        // Fitted on two of the three, the third within 10 %: the two
+        // ends predict the middle, and the upper two the rated 30 V.
+        for (fitted, left_out) in [([0, 2], 1), ([1, 2], 0)] {
+            let two = fitted.map(|k| finder()[k]);
+            let fit = super::fit(&agni(), 0.3e-3, &two, all).unwrap();
+            let model = ArcModel {
+                field: fit.field,
+                low_current: fit.low_current,
+                i_min: fit.i_min,
+                ..agni()
+            };
+            let third = finder()[left_out];
+            let predicted = model.breaking_current(third.voltage, 0.3e-3).unwrap();
+            assert!(
+                (predicted / third.current - 1.0).abs() < 0.10,
+                "{fitted:?} → {} V: {predicted} A against {} A",
+                third.voltage,
+                third.current
+            );
+        }
+        // A curve the prior's I_min already lets the tangent set: held.
+        let low = [BreakingFigure {
+            voltage: 30.0,
+            current: 8.0,
+        }];
+        let held = super::fit(&agni(), 0.3e-3, &low, all).unwrap();
+        assert!(!held.i_min_fitted && held.i_min == 0.4);
     }
 }

@@ -72,9 +72,17 @@ impl Material {
 pub struct Make {
     /// s, when the contact closed.
     pub time: f64,
-    /// s, when the current peaked during that closure.
+    /// The operation it belongs to (0-based; each break, a release after
+    /// the coil was switched off, starts the next), as the arcs count them.
+    pub operation: usize,
+    /// 0 for the operation's first make; N for the re-make after its N-th
+    /// bounce opening.
+    pub bounce: usize,
+    /// s, when the current peaked during that closure (while the contacts
+    /// press, where the force is known; the first instant within 0.1 % of
+    /// the largest |i|).
     pub peak_time: f64,
-    /// A, the largest |i| through the contact during that closure.
+    /// A, |i| through the contact then: the closure's largest, to 0.1 %.
     pub peak_current: f64,
     /// N, the contact force at the peak (`null` where the run has no
     /// force: a coil-driven or measured relay).
@@ -104,6 +112,8 @@ pub fn make(
     });
     Make {
         time,
+        operation: 0,
+        bounce: 0,
         peak_time,
         peak_current: peak_current.abs(),
         force,
@@ -119,32 +129,88 @@ pub fn make(
     }
 }
 
-/// Every make of the closures `closures` ((start, end) pairs, s) in a run
-/// sampled at `time` with contact current `current` (A).
+/// Relative tolerance of a closure's peak: the first sample within it of
+/// the largest |i| is the peak (on a flat current, the make itself).
+const PEAK_TOLERANCE: f64 = 1e-3;
+
+/// (s, A, N): the peak of one closure sampled at `time` with current
+/// `current`, starting at `start`, and the contact force then. Where the
+/// force is known the peak is sought among the instants the contacts
+/// press (force > 0): a Kelvin–Voigt contact pulls for a moment before it
+/// releases, and a held contact's force fades to nothing at the break,
+/// where no spot remains to speak of. Of the samples within
+/// [`PEAK_TOLERANCE`] of the largest |i|, the first is the peak, so that
+/// a load whose current is flat over the closure has its peak at the
+/// make, not at whichever sample the rounding of ngspice's values favours.
+fn closure_peak(
+    time: &[f64],
+    current: &[f64],
+    start: f64,
+    force_at: Option<&dyn Fn(f64) -> f64>,
+) -> (f64, f64, Option<f64>) {
+    let forces: Option<Vec<f64>> = force_at.map(|f| time.iter().map(|&t| f(t)).collect());
+    let pressing = |k: usize| forces.as_ref().is_none_or(|f| f[k] > 0.0);
+    // Without a pressing sample (a closure shorter than a sample, or a
+    // contact that never presses), every sample.
+    let candidates: Vec<usize> = if (0..time.len()).any(pressing) {
+        (0..time.len()).filter(|&k| pressing(k)).collect()
+    } else {
+        (0..time.len()).collect()
+    };
+    let largest = candidates
+        .iter()
+        .map(|&k| current[k].abs())
+        .fold(0.0f64, f64::max);
+    match candidates
+        .iter()
+        .find(|&&k| current[k].abs() >= largest * (1.0 - PEAK_TOLERANCE))
+    {
+        Some(&k) => (time[k], current[k].abs(), forces.as_ref().map(|f| f[k])),
+        None => (start, 0.0, force_at.map(|f| f(start))),
+    }
+}
+
+/// Every make of the closures `closures` ((start, end) pairs, s, in
+/// order) in a run sampled at `time` with contact current `current` (A),
+/// with the contact force `force_at` (N at s) where the run knows it;
+/// each closure's peak is sought while the contacts press (force > 0,
+/// where the force is known), at the first instant within 0.1 % of the
+/// largest |i| (on a flat current, the make itself).
+/// `coil_offs` (s) are when the coil was switched off: a closure during
+/// which the coil went off ends in a break, and the next make starts a new
+/// operation (without a coil every make belongs to operation 0).
 pub fn makes(
     time: &[f64],
     current: &[f64],
     closures: &[(f64, f64)],
     force_at: Option<&dyn Fn(f64) -> f64>,
     material: &SpotMaterial,
+    coil_offs: &[f64],
 ) -> Vec<Make> {
     let n = time.len().min(current.len());
+    let (mut operation, mut bounce) = (0, 0);
+    let mut previous: Option<(f64, f64)> = None;
     closures
         .iter()
         .map(|&(start, end)| {
+            if let Some((since, until)) = previous {
+                if coil_offs.iter().any(|&t| t >= since && t <= until) {
+                    operation += 1;
+                    bounce = 0;
+                } else {
+                    bounce += 1;
+                }
+            }
+            previous = Some((start, end));
             let first = time[..n].partition_point(|&t| t < start);
             let last = time[..n].partition_point(|&t| t <= end);
-            let (peak_time, peak) = (first..last).map(|k| (time[k], current[k].abs())).fold(
-                (start, 0.0f64),
-                |best, x| if x.1 > best.1 { x } else { best },
-            );
-            make(
-                start,
-                peak_time,
-                peak,
-                force_at.map(|f| f(peak_time)),
-                material,
-            )
+            let (peak_time, peak, force) =
+                closure_peak(&time[first..last], &current[first..last], start, force_at);
+            Make {
+                operation,
+                bounce,
+                ..make(start, peak_time, peak, force, material)
+            }
         })
         .collect()
 }
@@ -206,10 +272,85 @@ mod tests {
             &[(0.0, 4e-3), (6e-3, 9.9e-3)],
             Some(&|t: f64| 0.5 + t),
             &Material::Cu.spot(),
+            &[],
         );
         assert_eq!(found.len(), 2);
         assert_eq!((found[0].peak_time, found[0].peak_current), (0.0, 10.0));
         assert_eq!(found[1].peak_current, 3.0);
         assert_eq!(found[1].force, Some(0.5 + found[1].peak_time));
+        // Without a coil: one operation, the second closure a re-make.
+        assert_eq!((found[0].operation, found[0].bounce), (0, 0));
+        assert_eq!((found[1].operation, found[1].bounce), (0, 1));
+    }
+
+    #[test]
+    fn a_coil_off_during_a_closure_starts_the_next_operation() {
+        let time: Vec<f64> = (0..1000).map(|k| k as f64 * 1e-4).collect();
+        let current = vec![1.0; time.len()];
+        // Operation 0: a make and two re-makes; the coil goes off at 50 ms
+        // in the third closure; operation 1: a make and one re-make.
+        let closures = [
+            (1e-3, 2e-3),
+            (3e-3, 4e-3),
+            (5e-3, 60e-3),
+            (70e-3, 71e-3),
+            (72e-3, 90e-3),
+        ];
+        let found = makes(
+            &time,
+            &current,
+            &closures,
+            None,
+            &Material::Ag.spot(),
+            &[50e-3],
+        );
+        // A flat current peaks at the make itself.
+        assert!(
+            found
+                .iter()
+                .all(|m| m.peak_time == time[time.partition_point(|&t| t < m.time)])
+        );
+        let tags: Vec<(usize, usize)> = found.iter().map(|m| (m.operation, m.bounce)).collect();
+        assert_eq!(tags, [(0, 0), (0, 1), (0, 2), (1, 0), (1, 1)]);
+        // No force known: no spot figures, however large the current.
+        assert!(
+            found
+                .iter()
+                .all(|m| m.force.is_none() && m.weld_margin.is_none())
+        );
+    }
+
+    #[test]
+    fn the_peak_is_sought_while_the_contacts_press() {
+        // The current rises over the closure; the force is positive for
+        // its first 80 % and pulls after (a Kelvin–Voigt contact about to
+        // release).
+        let time: Vec<f64> = (0..=100).map(|k| k as f64 * 1e-5).collect();
+        let current: Vec<f64> = time.iter().map(|&t| 1.0 + 1e4 * t).collect();
+        let force = |t: f64| 1.0 - t / 0.8e-3;
+        let found = makes(
+            &time,
+            &current,
+            &[(0.0, 1e-3)],
+            Some(&force),
+            &Material::Ag.spot(),
+            &[],
+        );
+        let m = &found[0];
+        let f = m.force.unwrap();
+        assert!(f > 0.0, "{m:?}");
+        // The last pressing sample carries the largest current.
+        assert!((m.peak_time - 0.79e-3).abs() < 1e-12, "{m:?}");
+        assert!(m.weld_margin.is_some());
+        // Without the force, the closure's own peak at its end.
+        let plain = makes(
+            &time,
+            &current,
+            &[(0.0, 1e-3)],
+            None,
+            &Material::Ag.spot(),
+            &[],
+        );
+        assert_eq!(plain[0].peak_time, 1e-3);
     }
 }

@@ -926,13 +926,13 @@ fn fit_breaking(
 ) -> Result<(), FitError> {
     let path = scenario.origin.display().to_string();
     for key in keys {
-        if !matches!(key.as_str(), "arc.low_current" | "arc.field") {
+        if !matches!(key.as_str(), "arc.low_current" | "arc.field" | "arc.i_min") {
             return Err(FitError::Breaking {
                 path,
                 problem: format!(
-                    "free key `{key}`: of the arc, only arc.low_current and arc.field are \
-                     fitted (to [datasheet] dc_breaking); arc.low_current_gap is held, as one \
-                     gap cannot tell it from arc.low_current"
+                    "free key `{key}`: of the arc, only arc.low_current, arc.field and \
+                     arc.i_min are fitted (to [datasheet] dc_breaking); arc.low_current_gap is \
+                     held, as one gap cannot tell it from arc.low_current"
                 ),
             });
         }
@@ -954,13 +954,18 @@ fn fit_breaking(
     let model = section.model();
     let gap = report.fitted.mechanics.gap;
     let fit_field = keys.iter().any(|k| k == "arc.field");
-    let fitted = crate::arc::breaking::fit(&model, gap, &figures, fit_field).map_err(|e| {
-        FitError::Breaking {
+    let free = crate::arc::breaking::FreeArcKeys {
+        field: fit_field,
+        i_min: keys.iter().any(|k| k == "arc.i_min"),
+    };
+    let fitted =
+        crate::arc::breaking::fit(&model, gap, &figures, free).map_err(|e| FitError::Breaking {
             path: path.clone(),
             problem: e.to_string(),
-        }
-    })?;
-    let determined = if figures.len() == keys.len() {
+        })?;
+    // I_min is bounded by the figures, not fitted through them.
+    let through = keys.iter().filter(|k| *k != "arc.i_min").count();
+    let determined = if figures.len() == through {
         Determined::Exactly
     } else {
         Determined::Yes
@@ -989,10 +994,41 @@ fn fit_breaking(
                 .to_owned(),
         );
     }
+    if free.i_min {
+        rows.push(ParameterRow {
+            key: "arc.i_min".to_owned(),
+            prior: model.i_min,
+            value: fitted.i_min,
+            sigma: None,
+            determined: if fitted.i_min_fitted {
+                Determined::Yes
+            } else {
+                Determined::No
+            },
+        });
+        report.notes.push(if fitted.i_min_fitted {
+            format!(
+                "arc.i_min lowered to {:.4} A, the arc's current at the tangent of the highest \
+                 printed voltage: the largest minimum arc current that lets every printed figure \
+                 be set by the tangent (an upper bound; any smaller value breaks the same \
+                 currents)",
+                fitted.i_min
+            )
+        } else {
+            "arc.i_min held at its value: the arc burns above it at every printed figure's \
+             tangent"
+                .to_owned()
+        });
+    }
     report.parameters.extend(rows);
     report.fitted.arc = Some(crate::arc::ArcSection {
         field: Some(fitted.field),
         low_current: Some(fitted.low_current),
+        i_min: if fitted.i_min_fitted {
+            Some(fitted.i_min)
+        } else {
+            section.i_min
+        },
         ..section
     });
     if report.fitted_to.is_empty() {

@@ -90,7 +90,7 @@ const PARTS: &[Part] = &[
     Part {
         name: "finder-40.52-12vdc",
         class: "industrial PCB/plug-in relay",
-        source: "Finder 40.52.9.012.0000; Finder datasheet \"40 Series - Miniature PCB/Plug-in relays 8 - 10 - 12 - 16 A\" (DC coil 0.65 W, operating range 0.73…1.5 U_N, must drop-out 0.1 U_N, operate/release time 7/3 ms); coil resistance 220 Ω as listed for 40.52.9.012.0000; contact specification, \"Breaking capacity DC1: 30/110/220 V\" 8/0.3/0.12 A and \"Rated current/Maximum peak current\" 8/15 A for 40.52, AgNi contacts (the arc's field and low-current term fitted to those three figures at the part's 0.3 mm gap)",
+        source: "Finder 40.52.9.012.0000; Finder datasheet \"40 Series - Miniature PCB/Plug-in relays 8 - 10 - 12 - 16 A\" (DC coil 0.65 W, operating range 0.73…1.5 U_N, must drop-out 0.1 U_N, operate/release time 7/3 ms); coil resistance 220 Ω as listed for 40.52.9.012.0000; contact specification, \"Breaking capacity DC1: 30/110/220 V\" 8/0.3/0.12 A and \"Rated current/Maximum peak current\" 8/15 A for 40.52, AgNi contacts (the arc's field, low-current term and minimum arc current fitted to those three figures at the part's 0.3 mm gap); electrical endurance (edition VI-2014): page 3, \"Electrical life at rated load AC1 100·10³ cycles\" (AC1 2000 VA at 250 V: 8 A), page 7, H 40, \"an electrical life of 100·10³ can be expected\" on the DC1 curve",
         contact_rating: "2 CO 8 A 250 VAC",
         remark: "pick-up 8.76 V = 0.73 × 12 V (the lower end of the operating range)",
         scenario: bundled_part_text("finder-40.52-12vdc"),
@@ -106,7 +106,7 @@ const PARTS: &[Part] = &[
     Part {
         name: "te-v23145-12v",
         class: "automotive plug-in Micro ISO relay",
-        source: "TE Connectivity Micro Relay Low Noise V23145 (coil code *01-402); TE datasheet \"Automotive Relays, Plug-in Micro ISO Relays, Micro Relay Low Noise\" (12 VDC, operate 7.2 V, release 1.4 V, 181 Ω ±10 %, 796 mW; limiting breaking current 30 A at 13.5 VDC, the most for a 12 VDC load, the arc's low-current term fitted to it; silver-based contacts)",
+        source: "TE Connectivity Micro Relay Low Noise V23145 (coil code *01-402); TE datasheet \"Automotive Relays, Plug-in Micro ISO Relays, Micro Relay Low Noise\" (12 VDC, operate 7.2 V, release 1.4 V, 181 Ω ±10 %, 796 mW; limiting breaking current 30 A at 13.5 VDC, the most for a 12 VDC load, the arc's low-current term fitted to it; silver-based contacts; page 1, 1 form A: \"Limiting making current\" 100 A, \"Electrical endurance, resistive load at 14VDC 15A >1x10⁵ ops.\")",
         contact_rating: "20 A NO at 23 °C, 12 VDC",
         remark: "no operate, bounce or release time printed in the coil data: the mass is the prior's",
         scenario: bundled_part_text("te-v23145-12v"),
@@ -122,7 +122,7 @@ const PARTS: &[Part] = &[
     Part {
         name: "te-rt1-rt314012",
         class: "power PCB relay 16 A (industrial)",
-        source: "TE Connectivity Schrack RT1 RT314012 (12 VDC); TE datasheet \"Power PCB Relay RT1\" F0144-C Rev. HK1 (operate/release time max. 8/6 ms, bounce time NO/NC max. 4/6 ms) and coil table F0144-B (12 V: pull-in 8.4 V, release 1.2 V, 360 Ω ±10 %)",
+        source: "TE Connectivity Schrack RT1 RT314012 (12 VDC); TE datasheet \"Power PCB Relay RT1\" F0144-C Rev. HK1 (operate/release time max. 8/6 ms, bounce time NO/NC max. 4/6 ms) and coil table F0144-B (12 V: pull-in 8.4 V, release 1.2 V, 360 Ω ±10 %); F0144-C page 1: \"Limiting making current, max. 4s, duty factor 10%\" 30 A, NO-contact ratings (IEC 61810) 30x10³ at 16 A 250 VAC and 150x10³ at 10 A 400 VAC, resistive",
         contact_rating: "1 CO 12 A / 16 A, 250 VAC (AgNi 90/10)",
         remark: "every figure is a bound and the prior (blade and pole face included) meets them all, so the fit held every key: the nominal relay is an assumption inside the datasheet, and the envelope is the honest answer; the NO contact's bounce time is the one held",
         scenario: bundled_part_text("te-rt1-rt314012"),
@@ -130,7 +130,7 @@ const PARTS: &[Part] = &[
     Part {
         name: "omron-g8h-1c4t-r-12v",
         class: "automotive Micro ISO plug-in relay",
-        source: "Omron G8H-1C4T-R (12 VDC); Omron datasheet \"Micro ISO Automotive Relay G8H\" (coil 100 Ω ±10 %, 1440 mW, pull-in < 7.0 V, drop-out > 0.7 V; operate time 20 ms max., release time 10 ms max., bounce time at operate 5 ms max.)",
+        source: "Omron G8H-1C4T-R (12 VDC); Omron datasheet \"Micro ISO Automotive Relay G8H\" (coil 100 Ω ±10 %, 1440 mW, pull-in < 7.0 V, drop-out > 0.7 V; operate time 20 ms max., release time 10 ms max., bounce time at operate 5 ms max.; page 2: inrush 60 A (NO), the making current held; its electrical durability prints no test voltage and is left out)",
         contact_rating: "20 A (NO) / 10 A (NC) steady, 60 A inrush, 16 V max. (AgSnO2)",
         remark: "every figure is a bound and the prior meets them all, so the fit held every key: the nominal relay is an assumption inside the datasheet, and the envelope is the honest answer",
         scenario: bundled_part_text("omron-g8h-1c4t-r-12v"),
@@ -138,7 +138,7 @@ const PARTS: &[Part] = &[
     Part {
         name: "te-card-e-v23057-12v",
         class: "industrial I/O relay (Card E)",
-        source: "TE Connectivity Schrack Card E V23057, coil code 002 (12 VDC); TE datasheet \"Power PCB Relay Card E\" F0151-B Rev. 0411 (operate 8.0 V, release 1.2 V, 330 Ω ±10 %; operate/release time typ. 7/3 ms; bounce time typ. form A/form B 0.5/3 ms)",
+        source: "TE Connectivity Schrack Card E V23057, coil code 002 (12 VDC); TE datasheet \"Power PCB Relay Card E\" F0151-B Rev. 0411 (operate 8.0 V, release 1.2 V, 330 Ω ±10 %; operate/release time typ. 7/3 ms; bounce time typ. form A/form B 0.5/3 ms; page 1: \"Limiting making current, max 4 s, duty factor 10%\" 15 A, AgNi20 NO contact 30x10³ at 8 A 250 VAC resistive)",
         contact_rating: "1 CO 8 A, 250 VAC (AgCdO / AgNi20)",
         remark: "fitted to the typical operate time and the form A (closing) contact's typical bounce time",
         scenario: bundled_part_text("te-card-e-v23057-12v"),
@@ -146,7 +146,7 @@ const PARTS: &[Part] = &[
     Part {
         name: "te-rel-5v",
         class: "miniature PCB relay (white goods, industrial)",
-        source: "TE Connectivity Schrack REL, 5 VDC; TE datasheet \"Miniature PCB Relay REL\" Rev. 0511 (5 V: operate 3.75 V, release 0.5 V, 70 Ω ±10 %, 357 mW; operate/release time max. 10/5 ms; bounce time max. 4 ms)",
+        source: "TE Connectivity Schrack REL, 5 VDC; TE datasheet \"Miniature PCB Relay REL\" Rev. 0511 (5 V: operate 3.75 V, release 0.5 V, 70 Ω ±10 %, 357 mW; operate/release time max. 10/5 ms; bounce time max. 4 ms; page 1: \"Limiting making current, max 4s, duty factor 10%\" 15 A, REL30 NO contact 100x10³ at 5 A 250 VAC and 400x10³ at 3 A 400 VAC, resistive)",
         contact_rating: "1 form A 5 A, 250 VAC (AgNi 90/10, AgCdO)",
         remark: "every time is a maximum: the nominal relay is the prior inside them, with the preload moved to the printed operate voltage",
         scenario: bundled_part_text("te-rel-5v"),
@@ -204,6 +204,10 @@ pub struct Listing {
     /// the full contact gap (`model`; `null`: breaks any current).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub dc_breaking: Vec<crate::arc::breaking::BreakingRow>,
+    /// The printed electrical endurance figures (operations at a
+    /// resistive test load), for `life`.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub electrical_endurance: Vec<crate::life::EnduranceFigure>,
 }
 
 /// The listing of `part`: its datasheet figures against its scenario's.
@@ -246,6 +250,7 @@ pub fn listing(part: &Part) -> Listing {
             scenario.mechanics.gap,
             &d.dc_breaking,
         ),
+        electrical_endurance: d.electrical_endurance.clone(),
     }
 }
 
@@ -285,6 +290,9 @@ pub fn table() -> String {
             let unit = unit_of(name);
             let model = match l.model.get(name).copied().flatten() {
                 Some(m) => format!("model {}", engineering(m, unit)),
+                None if *name == "making_current" => {
+                    "a rating: `check` holds every make of a run to it".to_owned()
+                }
                 None => "not modelled".to_owned(),
             };
             let verdict = match l.met.get(name) {
@@ -299,6 +307,9 @@ pub fn table() -> String {
             );
         }
         out.push_str(&super::render::breaking_rows(&l.dc_breaking));
+        for f in &l.electrical_endurance {
+            let _ = writeln!(out, "  endurance         {}", endurance_text(f));
+        }
         if let Some(binds) = &l.pick_up_binds {
             let _ = writeln!(out, "  pick-up binds     {binds}");
         }
@@ -307,6 +318,26 @@ pub fn table() -> String {
         let _ = writeln!(out, "  note              {}\n", l.remark);
     }
     out
+}
+
+/// A printed endurance figure: `1e5 operations at 8 A, 250 V AC 50 Hz
+/// (resistive)`.
+fn endurance_text(f: &crate::life::EnduranceFigure) -> String {
+    let supply = match f.supply {
+        crate::life::Supply::Dc => "DC".to_owned(),
+        crate::life::Supply::Ac => match f.frequency {
+            Some(hz) => format!("AC {hz} Hz"),
+            None => "AC (no frequency printed: 50 Hz)".to_owned(),
+        },
+    };
+    format!(
+        "{:.3e} operations at {}, {} {} ({})",
+        f.operations,
+        engineering(f.current, "A"),
+        engineering(f.voltage, "V"),
+        supply,
+        f.load
+    )
 }
 
 /// The unit of a datasheet figure.

@@ -161,6 +161,10 @@ pub struct RunJson<'a> {
     arc_model: Option<&'a ArcModel>,
     /// Every make: its peak current, the force then and the spot.
     makes: &'a [crate::arc::making::Make],
+    /// With `[datasheet] electrical_endurance`: the electrical life at
+    /// this circuit (the `life` document).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    life: Option<&'a crate::life::LifeReport>,
 }
 
 /// One probe: the contract's fields (flattened from the analysis), then
@@ -244,6 +248,7 @@ impl<'a> RunJson<'a> {
             breakdowns: run.arcs.as_ref().map(|a| a.breakdowns.as_slice()),
             arc_model: run.arcs.as_ref().map(|a| &a.model),
             makes: &run.makes,
+            life: run.life.as_ref(),
         }
     }
 }
@@ -259,6 +264,10 @@ pub struct CheckJson<'a> {
     /// The first closing's times, from the coil being energized.
     timing: Closing,
     run: Option<RunJson<'a>>,
+    /// With `[datasheet] electrical_endurance`: the electrical life at the
+    /// circuit (the `life` document; the nested run leaves it out).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    life: Option<&'a crate::life::LifeReport>,
 }
 
 /// The `check` result as pretty-printed JSON with a trailing newline.
@@ -267,10 +276,26 @@ pub fn render_check(
     evidence: &Evidence,
     dimensionless: Option<&Dimensionless>,
 ) -> String {
+    render_check_with_life(verdict, evidence, dimensionless, None)
+}
+
+/// [`render_check`] with the electrical life `life` estimated for the
+/// check (else the run's own, when the evidence carries one), at the top
+/// level of the document.
+pub fn render_check_with_life(
+    verdict: &Verdict,
+    evidence: &Evidence,
+    dimensionless: Option<&Dimensionless>,
+    life: Option<&crate::life::LifeReport>,
+) -> String {
     let bounce = BounceJson::new(evidence.chatter(), dimensionless);
     let pole_face = match evidence {
         Evidence::Run(run) => run.pole_face.as_deref(),
         Evidence::Mechanics(_, pole_face) => pole_face.as_deref(),
+    };
+    let run_life = match evidence {
+        Evidence::Run(run) => run.life.as_ref(),
+        Evidence::Mechanics(..) => None,
     };
     let doc = CheckJson {
         verdict,
@@ -280,9 +305,13 @@ pub fn render_check(
         },
         timing: Closing::first(evidence.chatter(), evidence.operations()),
         run: match evidence {
-            Evidence::Run(run) => Some(RunJson::new(run, dimensionless)),
+            Evidence::Run(run) => Some(RunJson {
+                life: None,
+                ..RunJson::new(run, dimensionless)
+            }),
             Evidence::Mechanics(..) => None,
         },
+        life: life.or(run_life),
     };
     let mut text = serde_json::to_string_pretty(&doc).expect("a check result always serializes");
     text.push('\n');
