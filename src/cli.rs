@@ -191,6 +191,60 @@ pub struct RunArgs {
 
     #[command(flatten)]
     pub envelope: EnvelopeArgs,
+
+    #[command(flatten)]
+    pub life: LifeInRunArgs,
+}
+
+/// The electrical life `run` and `check` estimate for a scenario with
+/// `[datasheet] electrical_endurance` (docs/arcs.md, "Electrical life").
+#[derive(Debug, Args)]
+pub struct LifeInRunArgs {
+    /// Switching phases averaged over the period of each AC endurance
+    /// figure (each phase is one ngspice run of the figure's test load).
+    #[arg(long, value_name = "N", default_value_t = chatterspice::life::DEFAULT_PHASES,
+          value_parser = parse_phases)]
+    pub life_phases: usize,
+
+    /// Do not estimate the electrical life (`check` still does when
+    /// [limits] min_electrical_life asks for it).
+    #[arg(long)]
+    pub no_life: bool,
+}
+
+impl LifeInRunArgs {
+    /// The life of `scenario` at its circuit's run `own` (`None`: run the
+    /// circuit), or `None` when the scenario prints no endurance figures
+    /// or `--no-life` was given and `needed` is false. A life that is not
+    /// `needed` (for a limit) and cannot be estimated is a warning, not a
+    /// failure of the run.
+    fn estimate(
+        &self,
+        scenario: &Scenario,
+        runner: &dyn chatterspice::spice::Runner,
+        options: &RunOptions,
+        own: Option<&pipeline::RunResult>,
+        needed: bool,
+    ) -> Result<Option<chatterspice::life::LifeReport>> {
+        if !(needed || (!self.no_life && chatterspice::life::has_figures(scenario))) {
+            return Ok(None);
+        }
+        match chatterspice::life::estimate_at(
+            scenario,
+            runner,
+            options,
+            self.life_phases,
+            cpus(),
+            own,
+        ) {
+            Ok(report) => Ok(Some(report)),
+            Err(e) if !needed && chatterspice::interrupt::stopping().is_none() => {
+                eprintln!("warning: the electrical life was not estimated: {e}");
+                Ok(None)
+            }
+            Err(e) => Err(e.into()),
+        }
+    }
 }
 
 /// `--envelope` and its sampling: the options `run` and `check` share.
@@ -261,6 +315,15 @@ pub struct SimulatorArgs {
           value_parser = parse_tolerance)]
     pub coupling_tolerance: f64,
 
+    /// With a [coil]: how the coil and the armature are coupled.
+    /// `lock-step`: one ngspice run through its shared library
+    /// (libngspice.so.0), the mechanics advanced with every time step;
+    /// `passes`: whole ngspice runs repeated until the events stop moving
+    /// [default: lock-step when the library is installed and the contact
+    /// has no [arc], else passes].
+    #[arg(long, value_name = "SCHEME", value_parser = parse_coupling)]
+    pub coupling: Option<chatterspice::pipeline::Coupling>,
+
     /// Start ngspice without the user's own start-up file
     /// (`~/.spiceinit`), as `ngspice -n` does; the system `spinit`, which
     /// loads the XSPICE code models, is read either way.
@@ -291,6 +354,7 @@ impl SimulatorArgs {
             coupling: CouplingOptions {
                 tolerance: self.coupling_tolerance,
                 max_iterations: self.max_iterations,
+                coupling: self.coupling,
                 ..CouplingOptions::default()
             },
             ..RunOptions::default()
@@ -305,6 +369,10 @@ fn parse_iterations(text: &str) -> Result<usize, String> {
             "`{text}` is not a number of passes: give a whole number ≥ 1, e.g. 20"
         )),
     }
+}
+
+fn parse_coupling(text: &str) -> Result<chatterspice::pipeline::Coupling, String> {
+    text.parse()
 }
 
 fn parse_tolerance(text: &str) -> Result<f64, String> {
@@ -337,6 +405,9 @@ pub struct CheckArgs {
 
     #[command(flatten)]
     pub envelope: EnvelopeArgs,
+
+    #[command(flatten)]
+    pub life: LifeInRunArgs,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -503,6 +574,10 @@ fn run(args: &RunArgs) -> Result<()> {
         Some(csv) => pipeline::run_measured(&scenario, read_measured(csv)?, &ngspice, &options)?,
         None => pipeline::run(&scenario, &ngspice, &options)?,
     };
+    // The electrical life at this circuit, from this run's arcs.
+    result.life = args
+        .life
+        .estimate(&scenario, &ngspice, &options, Some(&result), false)?;
     // Shown relative to where the user is, when it is below it.
     if let Some(relative) = std::env::current_dir()
         .ok()
@@ -565,50 +640,49 @@ fn check(args: &CheckArgs) -> Result<Status> {
         // The relay's limits alone: no circuit, no ngspice needed.
         check::relay_only(&scenario)?
     };
-    let verdict = match scenario.limits.and_then(|l| l.min_electrical_life) {
-        Some(limit) => {
-            let ngspice = args.simulator.ngspice()?;
-            let life = chatterspice::life::estimate(
-                &scenario,
-                &ngspice,
-                &options,
-                chatterspice::life::DEFAULT_PHASES,
-                cpus(),
-            )?;
-            let operations = match &life.life {
-                Some(own) => own.operations.ok_or_else(|| {
-                    "unlimited by arcs: the circuit's operation puts no arc energy into the \
-                     contacts"
-                        .to_owned()
-                }),
-                None => Err("the scenario has no [circuit] to estimate the life at".to_owned()),
-            };
-            // No arc energy means no electrical wear: the limit holds.
-            let operations = match operations {
-                Err(e) if life.life.is_some() => {
-                    eprintln!("note: min_electrical_life: {e}");
-                    Ok(f64::MAX)
-                }
-                other => other,
-            };
+    // The electrical life: with [limits] min_electrical_life always, else
+    // for a scenario with endurance figures whose circuit the check ran
+    // (from that run's arcs, not a second run).
+    let limit = scenario.limits.and_then(|l| l.min_electrical_life);
+    let own = match &evidence {
+        check::Evidence::Run(run) => Some(run.as_ref()),
+        check::Evidence::Mechanics(..) => None,
+    };
+    let life = if limit.is_some() || own.is_some() {
+        let ngspice = args.simulator.ngspice()?;
+        args.life
+            .estimate(&scenario, &ngspice, &options, own, limit.is_some())?
+    } else {
+        None
+    };
+    let verdict = match (limit, &life) {
+        (Some(limit), Some(life)) => {
+            let row = chatterspice::life::limit_check(limit, life);
+            if let Some(note) = &row.note {
+                eprintln!("note: min_electrical_life: {note}");
+            }
             let mut checks = verdict.checks;
-            checks.push(check::LimitCheck::new(
-                "limits.min_electrical_life".into(),
-                "electrical life at this circuit (operations)".into(),
-                "",
-                check::Bound::Min,
-                limit,
-                operations,
-            ));
+            checks.push(row);
             check::Verdict::new(checks)
         }
-        None => verdict,
+        _ => verdict,
     };
     let dimensionless = chatterspice::commands::dimensionless(&scenario);
     let text = match args.format {
-        RunFormat::Json => report::json::render_check(&verdict, &evidence, dimensionless.as_ref()),
+        RunFormat::Json => report::json::render_check_with_life(
+            &verdict,
+            &evidence,
+            dimensionless.as_ref(),
+            life.as_ref(),
+        ),
         RunFormat::Table => {
-            report::table::render_check(&verdict, evidence.chatter(), evidence.operations())
+            let mut text =
+                report::table::render_check(&verdict, evidence.chatter(), evidence.operations());
+            if let Some(life) = &life {
+                text.push_str("\nelectrical life\n");
+                text.push_str(&chatterspice::life::render(life));
+            }
+            text
         }
     };
     if let check::Evidence::Run(run) = &evidence {

@@ -574,7 +574,7 @@ fn py_fit(
             let (_, c) = analyse(&scope, channel.as_deref(), None, None)?;
             Some(Record {
                 name: c.source.clone(),
-                intervals: c.shifted_intervals(),
+                intervals: c.intervals.clone(),
             })
         }
         (None, Some(csv)) => Some(Record {

@@ -85,9 +85,31 @@ pub const STATE_HYSTERESIS: f64 = 4e-3;
 /// `include` with the arc added (see the module overview), the hold
 /// voltages sampled at the gap profile's times.
 pub fn with_arc(
-    mut include: ContactInclude,
+    include: ContactInclude,
     model: &ArcModel,
     gap: &GapProfile,
+) -> Result<ContactInclude, NetlistError> {
+    arc_into(include, model, Some(gap), gap.at(0.0))
+}
+
+/// [`with_arc`] for a lock-step run: the gap's voltages are external
+/// sources (`Vvarc`, `Vvbd`, and `Vlow` when the low-current term grows
+/// with the gap) that the caller of ngspice's shared library answers at
+/// every time point from the armature's position, the gap being
+/// `initial_gap` (m) at t = 0.
+pub fn with_arc_external(
+    include: ContactInclude,
+    model: &ArcModel,
+    initial_gap: f64,
+) -> Result<ContactInclude, NetlistError> {
+    arc_into(include, model, None, initial_gap)
+}
+
+fn arc_into(
+    mut include: ContactInclude,
+    model: &ArcModel,
+    gap: Option<&GapProfile>,
+    initial_gap: f64,
 ) -> Result<ContactInclude, NetlistError> {
     let subckt = include.subckt.clone();
     let header = format!(".subckt {subckt} a b\n");
@@ -115,17 +137,23 @@ pub fn with_arc(
     line(&mut arc, "Vsense a ai 0");
     line(&mut arc, &format!("Xcore ai b {subckt}_core"));
     line(&mut arc, "Vclamp ai ac 0");
-    let samples = gap.samples();
-    line(&mut arc, "Vvarc varc 0 PWL(");
-    pairs(
-        &mut arc,
-        samples.iter().map(|&(t, g)| (t, model.arc_voltage(g))),
-    );
-    line(&mut arc, "Vvbd vbd 0 PWL(");
-    pairs(
-        &mut arc,
-        samples.iter().map(|&(t, g)| (t, model.hold_voltage(g))),
-    );
+    let samples = gap.map_or(&[][..], GapProfile::samples);
+    if gap.is_some() {
+        line(&mut arc, "Vvarc varc 0 PWL(");
+        pairs(
+            &mut arc,
+            samples.iter().map(|&(t, g)| (t, model.arc_voltage(g))),
+        );
+        line(&mut arc, "Vvbd vbd 0 PWL(");
+        pairs(
+            &mut arc,
+            samples.iter().map(|&(t, g)| (t, model.hold_voltage(g))),
+        );
+    } else {
+        // ngspice 39 takes `external` as the whole value.
+        line(&mut arc, "Vvarc varc 0 external");
+        line(&mut arc, "Vvbd vbd 0 external");
+    }
     line(&mut arc, "Bia iar 0 V = abs(i(Vsense))");
     line(
         &mut arc,
@@ -144,12 +172,14 @@ pub fn with_arc(
                 &mut arc,
                 &format!("Vlow lowc 0 DC {}", format_time(model.low_current)),
             );
-        } else {
+        } else if gap.is_some() {
             line(&mut arc, "Vlow lowc 0 PWL(");
             pairs(
                 &mut arc,
                 samples.iter().map(|&(t, g)| (t, model.low_current_term(g))),
             );
+        } else {
+            line(&mut arc, "Vlow lowc 0 external");
         }
         line(
             &mut arc,
@@ -187,7 +217,7 @@ pub fn with_arc(
         &format!(
             "Cth th 0 {} IC={}",
             format_time(THRESHOLD_LAG / LAG_RESISTANCE),
-            format_time(model.hold_voltage(gap.at(0.0)))
+            format_time(model.hold_voltage(initial_gap))
         ),
     );
     let s = format_time(CLAMP_SOFTNESS);

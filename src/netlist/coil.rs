@@ -38,7 +38,25 @@ pub fn coil_include(
     subckt: &str,
     trajectory: &[(f64, f64)],
 ) -> Result<String, NetlistError> {
+    coil_text(coil, subckt, Some(trajectory))
+}
+
+/// The include for `coil` as subcircuit `subckt`, its armature's position
+/// (mm, on node `xmm`) an external source `V_X` that the caller of
+/// ngspice's shared library answers at every time point (the lock-step
+/// coupling).
+pub fn coil_include_external(coil: &CoilSection, subckt: &str) -> Result<String, NetlistError> {
+    coil_text(coil, subckt, None)
+}
+
+fn coil_text(
+    coil: &CoilSection,
+    subckt: &str,
+    trajectory: Option<&[(f64, f64)]>,
+) -> Result<String, NetlistError> {
     check_subckt_name(subckt)?;
+    let points = trajectory.map_or(0, <[_]>::len);
+    let trajectory = trajectory.unwrap_or(&[(0.0, 0.0)]);
     if trajectory.is_empty() {
         return Err(NetlistError::EmptyTrajectory);
     }
@@ -60,7 +78,7 @@ pub fn coil_include(
         &format!(
             "chatterspice coil subcircuit: R_c = {} ohm, N = {}, A = {} m^2, g_a = {} m, \
              l_eq = {} m; L(x) = mu0 N^2 A / (g_a - x + l_eq), from {} H at rest. \
-             The armature follows {} points. Instantiate it as: X2 a b {subckt}; \
+             {}. Instantiate it as: X2 a b {subckt}; \
              its current is i(v.x2.vi).",
             format_time(coil.resistance),
             coil.turns,
@@ -68,7 +86,11 @@ pub fn coil_include(
             format_time(coil.air_gap),
             format_time(coil.iron_gap),
             format_time(n2a / (coil.air_gap + coil.iron_gap)),
-            trajectory.len()
+            if points == 0 {
+                "The armature's position is asked of the mechanics at every time point".to_owned()
+            } else {
+                format!("The armature follows {points} points")
+            }
         ),
     );
     line(&mut out, &format!(".subckt {subckt} a b"));
@@ -98,8 +120,14 @@ pub fn coil_include(
             format_time(n2a)
         ),
     );
-    line(&mut out, "V_X xmm 0 PWL(");
-    pairs(&mut out, trajectory.iter().map(|&(t, x)| (t, x * 1e3)));
+    if points == 0 {
+        // ngspice 39 takes `external` as the whole value: `dc 0 external`
+        // crashes it.
+        line(&mut out, "V_X xmm 0 external");
+    } else {
+        line(&mut out, "V_X xmm 0 PWL(");
+        pairs(&mut out, trajectory.iter().map(|&(t, x)| (t, x * 1e3)));
+    }
     line(&mut out, ".ends");
     Ok(out)
 }

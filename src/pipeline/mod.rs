@@ -18,11 +18,14 @@
 //! reports to write wherever the caller wants.
 
 pub mod coupled;
+pub mod lockstep;
 pub mod pass;
 
 pub use pass::{Pass, PassError, Simulation, circuit_pass};
 
-pub use coupled::{Coupled, CouplingError, CouplingOptions, Iteration, nc_include, run_coupled};
+pub use coupled::{
+    Coupled, Coupling, CouplingError, CouplingOptions, Iteration, nc_include, run_coupled,
+};
 
 use std::path::PathBuf;
 use std::time::Duration;
@@ -270,6 +273,10 @@ pub struct RunResult {
     /// bounce): its peak current and, where the run knows the contact
     /// force, the spot's voltage, temperature and weld margin.
     pub makes: Vec<crate::arc::making::Make>,
+    /// The electrical life at this circuit, when the caller estimated it
+    /// (`run` and `check` do for a scenario with `[datasheet]
+    /// electrical_endurance`; the pipeline itself leaves it `None`).
+    pub life: Option<crate::life::LifeReport>,
 }
 
 /// Run the whole pipeline on `scenario` with `runner`. A scenario with a
@@ -328,13 +335,15 @@ pub fn run_plan(
         &result.waveform,
         &result.chatter,
         Some(&|t| trajectory.contact_force(t)),
+        &[],
     );
     Ok(result)
 }
 
 /// Every make of `chatter` in `plot`: the contact current is the voltage
 /// across the contact instance's nodes times the waveform's conductance;
-/// `force_at` (N at s) where the run knows the contact force.
+/// `force_at` (N at s) where the run knows the contact force; `coil_offs`
+/// (s) where the coil was switched off, which ends an operation.
 fn contact_makes(
     scenario: &Scenario,
     netlist_text: Option<&str>,
@@ -342,6 +351,7 @@ fn contact_makes(
     waveform: &Waveform,
     chatter: &Chatter,
     force_at: Option<&dyn Fn(f64) -> f64>,
+    coil_offs: &[f64],
 ) -> Vec<crate::arc::making::Make> {
     let (Some(circuit), Some(text)) = (&scenario.circuit, netlist_text) else {
         return Vec::new();
@@ -380,6 +390,7 @@ fn contact_makes(
         &analysis::closures(chatter),
         force_at,
         &material,
+        coil_offs,
     )
 }
 
@@ -427,11 +438,23 @@ fn run_dc_step(
     // the arc's opening speed, as for a measured record.
     let gap = record_gap(scenario, &chatter.intervals);
     let pole_face = two_stage
-        .filter(|_| plan.two_stage().pole_face.is_some())
-        .map(|run| run.pole_face);
+        .clone()
+        .filter(|_| plan.two_stage().pole_face.is_some());
+    // The contact force at each make, from the closing's own motion.
+    let force = crate::arc::make_force::dc_step(plan, &coil, &source, two_stage.clone());
+    let pole_face = pole_face.map(|run| run.pole_face);
     let (waveform, model) = contact_waveform_of(scenario, plan.surface(), &chatter)?;
     let mut result = run_chatter(plan, chatter, waveform, &model, gap, runner, options)?;
     result.pole_face = pole_face;
+    result.makes = contact_makes(
+        scenario,
+        plan.netlist().map(|n| n.text.as_str()),
+        &result.simulation.plot,
+        &result.waveform,
+        &result.chatter,
+        force.as_deref(),
+        &[],
+    );
     Ok(result)
 }
 
@@ -626,12 +649,14 @@ fn run_chatter(
         &waveform,
         &chatter,
         None,
+        &[],
     );
     Ok(RunResult {
         coupling: None,
         operations: Vec::new(),
         pole_face: None,
         makes,
+        life: None,
         arcs,
         netlist: netlist_path,
         chatter,
@@ -763,6 +788,7 @@ fn run_coil(plan: &Plan, runner: &dyn Runner, options: &RunOptions) -> Result<Ru
         .iter()
         .map(ToString::to_string)
         .collect();
+    warnings.extend(coupled.fallback.clone());
     if let Some(text) = netlist_text {
         warnings.extend(arc_warnings(
             scenario,
@@ -774,16 +800,28 @@ fn run_coil(plan: &Plan, runner: &dyn Runner, options: &RunOptions) -> Result<Ru
             &gap,
         ));
     }
+    // The contact force at each make, from the armature moved again under
+    // the converged pass's flux.
+    let force = crate::arc::make_force::coupled(plan, &coupled);
+    if force.is_none() && !coupled.chatter.impacts.is_empty() {
+        warnings.push(
+            "the contact force at the makes could not be rebuilt from the coupled run, so \
+             the makes have no spot figures or weld margin"
+                .to_owned(),
+        );
+    }
     let makes = contact_makes(
         scenario,
         netlist_text,
         &coupled.plot,
         &waveform,
         &coupled.chatter,
-        None,
+        force.as_deref(),
+        &coil_offs,
     );
     Ok(RunResult {
         makes,
+        life: None,
         netlist: netlist_path,
         chatter: coupled.chatter,
         waveform,

@@ -154,6 +154,10 @@ pub fn render_run(run: &RunResult) -> String {
         out.push('\n');
         out.push_str(&render_arcs(report));
     }
+    if let Some(life) = &run.life {
+        out.push_str("\nelectrical life\n");
+        out.push_str(&crate::life::render(life));
+    }
     // Warnings are not part of the table: the CLI prints them on stderr.
     out
 }
@@ -171,14 +175,19 @@ fn run_lines(run: &RunResult) -> Vec<(&'static str, String)> {
     ]);
     if let Some(passes) = &run.coupling {
         let last = passes.last().map_or(f64::NAN, |p| p.change);
-        lines.push((
-            "coil",
-            format!(
-                "coupled to the circuit in {} iterations, last change {}",
+        let text = match passes.as_slice() {
+            [one] if one.scheme == crate::pipeline::Coupling::LockStep => format!(
+                "coupled to the circuit in lock-step, one ngspice run; its events and the \
+                 mechanics under its flux differ by {}",
+                engineering(last, "s")
+            ),
+            _ => format!(
+                "coupled to the circuit in {} passes, last change {}",
                 passes.len(),
                 engineering(last, "s")
             ),
-        ));
+        };
+        lines.push(("coil", text));
     }
     for (k, op) in run.operations.iter().enumerate() {
         lines.push(("", operation_line(k + 1, op)));
@@ -332,6 +341,8 @@ pub fn render_makes(makes: &[crate::arc::making::Make]) -> String {
     let mut rows = vec![
         [
             "make",
+            "operation",
+            "which",
             "at",
             "peak",
             "force",
@@ -345,6 +356,12 @@ pub fn render_makes(makes: &[crate::arc::making::Make]) -> String {
         let or_dash = |v: Option<String>| v.unwrap_or_else(|| "-".to_owned());
         rows.push([
             (k + 1).to_string(),
+            (m.operation + 1).to_string(),
+            if m.bounce == 0 {
+                "first".to_owned()
+            } else {
+                format!("after bounce {}", m.bounce)
+            },
             engineering(m.time, "s"),
             engineering(m.peak_current, "A"),
             or_dash(m.force.map(|f| engineering(f, "N"))),

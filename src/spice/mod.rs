@@ -25,6 +25,7 @@ mod error;
 pub mod fake;
 pub mod ngspice;
 mod run;
+pub mod shared;
 
 pub use classify::{Exit, Failure};
 pub use error::{LOG_TAIL_LINES, RunContext, SpiceError, log_tail};

@@ -179,6 +179,10 @@ pub fn parse_version(banner: &str) -> Option<String> {
 }
 
 impl Runner for Ngspice {
+    fn lock_step(&self) -> bool {
+        true
+    }
+
     fn run(&self, req: &RunRequest) -> Result<RunOutput, SpiceError> {
         for (name, _) in &req.includes {
             if !is_plain_name(name) {
@@ -223,70 +227,13 @@ impl Runner for Ngspice {
             source,
             context: context(""),
         })?;
-        let log = finished.log;
-        if log.contains("rawfile write error") {
-            return Err(SpiceError::RawWrite {
-                dir: workdir.clone(),
-                context: context(&log),
-            });
-        }
-        let Some(status) = finished.status else {
-            return Err(SpiceError::Timeout {
-                limit: req.timeout,
-                context: context(&log),
-            });
-        };
-        if let Some(failure) = classify::classify(exit_of(status), &log) {
-            return Err(SpiceError::Failed {
-                failure,
-                context: context(&log),
-            });
-        }
-        let raw_path = workdir.join(RAW_NAME);
-        let bytes = match std::fs::read(&raw_path) {
-            Ok(b) => b,
-            Err(e) if e.kind() == io::ErrorKind::NotFound => {
-                return Err(SpiceError::MissingRaw {
-                    context: context(&log),
-                });
-            }
-            Err(source) => {
-                return Err(SpiceError::BadRaw {
-                    source: crate::rawfile::RawError::Io {
-                        path: raw_path,
-                        source,
-                    },
-                    context: context(&log),
-                });
-            }
-        };
-        let raw = RawFile::parse(&bytes).map_err(|source| SpiceError::BadRaw {
-            source,
-            context: context(&log),
-        })?;
-        drop(bytes);
-        if let Some(warning) = raw
-            .warnings
-            .iter()
-            .find(|w| matches!(w, RawWarning::Truncated { .. }))
-        {
-            // ngspice exited cleanly, so a cut file means a write failure
-            // (disk full?), not a result to analyse.
-            return Err(SpiceError::TruncatedRaw {
-                warning: warning.clone(),
-                context: context(&log),
-            });
-        }
-        let mut warnings = classify::warnings(&log);
-        warnings.extend(raw.warnings.iter().map(ToString::to_string));
+        let exit = finished.status.map(exit_of);
+        let out = read_run(&workdir, kept, finished.log, exit, req.timeout)?;
         drop(dir_guard);
         Ok(RunOutput {
-            raw,
-            log,
             version: self.version.clone(),
             elapsed,
-            workdir: kept.then_some(workdir),
-            warnings,
+            ..out
         })
     }
 
@@ -467,6 +414,89 @@ impl Ngspice {
         }
         Ok(done)
     }
+}
+
+/// What a finished run in `workdir` gave: its raw file read and checked,
+/// or the failure its log (`log`) and its exit (`None`: stopped at the
+/// time limit `timeout`) tell. The output's version and elapsed time are
+/// the caller's to fill in.
+pub(crate) fn read_run(
+    workdir: &Path,
+    kept: bool,
+    log: String,
+    exit: Option<Exit>,
+    timeout: Duration,
+) -> Result<RunOutput, SpiceError> {
+    let context = |log: &str| {
+        Box::new(RunContext {
+            workdir: workdir.to_path_buf(),
+            kept,
+            log_tail: log_tail(log),
+        })
+    };
+    if log.contains("rawfile write error") {
+        return Err(SpiceError::RawWrite {
+            dir: workdir.to_path_buf(),
+            context: context(&log),
+        });
+    }
+    let Some(exit) = exit else {
+        return Err(SpiceError::Timeout {
+            limit: timeout,
+            context: context(&log),
+        });
+    };
+    if let Some(failure) = classify::classify(exit, &log) {
+        return Err(SpiceError::Failed {
+            failure,
+            context: context(&log),
+        });
+    }
+    let raw_path = workdir.join(RAW_NAME);
+    let bytes = match std::fs::read(&raw_path) {
+        Ok(b) => b,
+        Err(e) if e.kind() == io::ErrorKind::NotFound => {
+            return Err(SpiceError::MissingRaw {
+                context: context(&log),
+            });
+        }
+        Err(source) => {
+            return Err(SpiceError::BadRaw {
+                source: crate::rawfile::RawError::Io {
+                    path: raw_path,
+                    source,
+                },
+                context: context(&log),
+            });
+        }
+    };
+    let raw = RawFile::parse(&bytes).map_err(|source| SpiceError::BadRaw {
+        source,
+        context: context(&log),
+    })?;
+    drop(bytes);
+    if let Some(warning) = raw
+        .warnings
+        .iter()
+        .find(|w| matches!(w, RawWarning::Truncated { .. }))
+    {
+        // ngspice exited cleanly, so a cut file means a write failure
+        // (disk full?), not a result to analyse.
+        return Err(SpiceError::TruncatedRaw {
+            warning: warning.clone(),
+            context: context(&log),
+        });
+    }
+    let mut warnings = classify::warnings(&log);
+    warnings.extend(raw.warnings.iter().map(ToString::to_string));
+    Ok(RunOutput {
+        raw,
+        log,
+        version: None,
+        elapsed: Duration::ZERO,
+        workdir: kept.then_some(workdir.to_path_buf()),
+        warnings,
+    })
 }
 
 /// One deck's part of a batch's log.

@@ -21,6 +21,13 @@ pub trait Runner: Send + Sync {
     fn run_many(&self, reqs: &[RunRequest]) -> Vec<Result<RunOutput, SpiceError>> {
         reqs.iter().map(|req| self.run(req)).collect()
     }
+
+    /// Whether a coil-driven run through this runner may instead run in
+    /// lock-step through ngspice's shared library (the real simulator:
+    /// yes; a runner that serves recorded results: no).
+    fn lock_step(&self) -> bool {
+        false
+    }
 }
 
 /// One simulation to run.

@@ -383,9 +383,9 @@ fn run_couples_a_coil_driven_relay_in_its_transistor_driver() {
     let release = op["release_time"].as_f64().unwrap();
     let off = op["coil_off"].as_f64().unwrap();
     assert!((off + release - break_time).abs() < 1e-12);
-    let passes = v["coupling"].as_array().unwrap();
-    assert!(passes.len() >= 2);
-    assert!(passes.last().unwrap()["change"].as_f64().unwrap() <= 1e-7);
+    let runs = v["coupling"].as_array().unwrap();
+    assert!(!runs.is_empty());
+    assert!(runs.last().unwrap()["change"].as_f64().unwrap() <= 1e-7);
     // The coil current is integrated over the closures the coupling found.
     let make = v["bounce"]["first_impact"].as_f64().unwrap();
     let first_closure = &v["probes"][1]["current"]["per_closure"][0];
@@ -400,7 +400,7 @@ fn a_coupling_that_does_not_converge_in_the_passes_allowed_is_exit_2() {
     chatterspice()
         .arg("run")
         .arg(&scenario)
-        .args(["--max-iterations", "2"])
+        .args(["--max-iterations", "2", "--coupling", "passes"])
         .assert()
         .code(2)
         .stderr(predicate::str::contains("did not converge in 2 iterations"))

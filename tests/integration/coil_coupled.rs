@@ -11,7 +11,7 @@ use std::path::Path;
 
 use chatterspice::coil::{Coil, Source, simulate_direct};
 use chatterspice::mechanics::Mechanics;
-use chatterspice::pipeline::{CouplingOptions, run_coupled};
+use chatterspice::pipeline::{Coupling, CouplingOptions, run_coupled};
 use chatterspice::scenario::Scenario;
 
 fn reference() -> Scenario {
@@ -96,6 +96,7 @@ fn a_coupling_that_cannot_converge_says_so_with_its_last_change() {
     let options = CouplingOptions {
         tolerance: 0.0,
         max_iterations: 2,
+        coupling: Some(Coupling::Passes),
         ..CouplingOptions::default()
     };
     let err = run_coupled(&reference(), &ng, &options).unwrap_err();
@@ -114,7 +115,11 @@ fn a_coupling_that_cannot_converge_says_so_with_its_last_change() {
 #[test]
 fn the_iterations_are_reported_and_shrink() {
     let ng = ngspice_or_skip!();
-    let coupled = run_coupled(&reference(), &ng, &CouplingOptions::default()).unwrap();
+    let passes = CouplingOptions {
+        coupling: Some(Coupling::Passes),
+        ..CouplingOptions::default()
+    };
+    let coupled = run_coupled(&reference(), &ng, &passes).unwrap();
     let changes: Vec<f64> = coupled.iterations.iter().map(|i| i.change).collect();
     assert!(changes.len() >= 2);
     // Once the events are the same in number, each pass moves them less.

@@ -12,7 +12,7 @@ use crate::common;
 use std::path::Path;
 
 use chatterspice::chatter::Chatter;
-use chatterspice::pipeline::{Coupled, CouplingOptions, run_coupled};
+use chatterspice::pipeline::{Coupled, Coupling, CouplingOptions, run_coupled};
 use chatterspice::scenario::Scenario;
 
 fn load(name: &str) -> Scenario {
@@ -41,7 +41,11 @@ fn assert_same_events(fast: &Coupled, plain: &Coupled, tolerance: f64) {
 fn compare(name: &str) {
     let ng = ngspice_or_skip!();
     let scenario = load(name);
-    let defaults = CouplingOptions::default();
+    // The passes, which this compares with themselves.
+    let defaults = CouplingOptions {
+        coupling: Some(Coupling::Passes),
+        ..CouplingOptions::default()
+    };
     assert!(defaults.accelerate);
     let fast =
         run_coupled(&scenario, &ng, &defaults).unwrap_or_else(|e| panic!("{}", common::chain(&e)));

@@ -168,7 +168,7 @@ fn broken<D: DriveModel>(model: &RelayModel<'_, D>, p: &Propagation) -> Option<(
 }
 
 /// The relay's keys and values, for an error that must name them.
-fn describe<D: DriveModel>(model: &RelayModel<'_, D>) -> String {
+pub(super) fn describe<D: DriveModel>(model: &RelayModel<'_, D>) -> String {
     let m = model.m;
     let mut out = format!(
         "mechanics.mass = {:e} kg, mechanics.stiffness = {:e} N/m, mechanics.damping = {:e} N·s/m, \
@@ -193,7 +193,7 @@ fn describe<D: DriveModel>(model: &RelayModel<'_, D>) -> String {
 
 /// Propagate `p` to the horizon: exactly when every mode is linear, else
 /// by DOP853.
-fn advance<D: DriveModel>(
+pub(super) fn advance<D: DriveModel>(
     model: &RelayModel<'_, D>,
     settings: &Settings,
     horizon: Horizon,

@@ -47,6 +47,7 @@ mod propagation;
 mod relay;
 pub(crate) mod run;
 pub(crate) mod span;
+pub(crate) mod stepper;
 
 pub use engine::{driven_run, simulate_two_stage, step_closing};
 pub(crate) use relay::validate_all;

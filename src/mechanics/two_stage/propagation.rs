@@ -44,6 +44,32 @@ impl Tally {
             .filter_map(|i| Some((i.release_time?, i.max_gap_after?)))
     }
 
+    /// The contact's states so far, in time order (the last one open-ended).
+    pub(crate) fn intervals(&self) -> &[Interval] {
+        &self.intervals
+    }
+
+    /// The rest stop's (the normally-closed contact's) states so far.
+    pub(crate) fn back_intervals(&self) -> &[Interval] {
+        &self.back_intervals
+    }
+
+    /// s, the first event recorded after `t`: a change of the contact's
+    /// or the rest stop's state, or an impact on or a release from the
+    /// pole face.
+    pub(crate) fn first_event_after(&self, t: f64) -> Option<f64> {
+        let changes = self
+            .intervals
+            .iter()
+            .chain(&self.back_intervals)
+            .map(|iv| iv.start);
+        let pole = self
+            .pole
+            .iter()
+            .flat_map(|i| std::iter::once(i.impact_time).chain(i.release_time));
+        changes.chain(pole).filter(|&e| e > t).reduce(f64::min)
+    }
+
     /// Impacts on the contact so far.
     pub(crate) fn contact_count(&self) -> usize {
         self.contact.len()
