@@ -275,10 +275,13 @@ impl Flux {
             0 => 0.0,
             1 => p[0].1,
             n => {
-                let k = if t >= p[n - 1].0 {
+                // The mechanics asks at or near the newest points (a
+                // commit within the last step, a plan beyond it): try the
+                // last segment before searching.
+                let k = if t >= p[n - 2].0 {
                     n - 1
                 } else {
-                    p.partition_point(|&(s, _)| s <= t).max(1)
+                    p.partition_point(|&(s, _)| s <= t).clamp(1, n - 1)
                 };
                 let (a, b) = (p[k - 1], p[k]);
                 if b.0 <= a.0 {
@@ -327,6 +330,9 @@ fn child(library: &'static Library, relay: &Relay, dir: &Path) -> Vec<u8> {
             let finished = library.run_circuit(
                 &mut session,
                 &[
+                    // As the batch runs: no progress reports, and no
+                    // clock read at every time point to time them.
+                    "set norefvalue",
                     &format!("source {DECK_NAME}"),
                     "run",
                     &format!("write {RAW_NAME}"),

@@ -143,3 +143,123 @@ impl<'a, F: Fn(f64, f64) -> f64> Stepper<'a, F> {
         self.p.rec.first_event_after(t)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mechanics::Surface;
+    use crate::mechanics::two_stage::{Blade, driven_run};
+
+    /// A relay with a blade pulled by a force that rises, holds and falls
+    /// (a coil pulse): closing, bounces, release and the return onto the
+    /// rest stop.
+    fn relay() -> (Mechanics, TwoStage, Stops, Settings) {
+        let m = Mechanics {
+            mass: 2e-4,
+            stiffness: 800.0,
+            damping: 0.04,
+            force: 0.0,
+            gap: 4.5e-4,
+            initial_position: 0.0,
+            initial_velocity: 0.0,
+            preload: 0.1,
+        };
+        let build = TwoStage {
+            blade: Some(Blade {
+                mass: 3e-5,
+                stiffness: 3000.0,
+                damping: 0.01,
+            }),
+            ..TwoStage::default()
+        };
+        let stops = Stops {
+            make: Surface::KelvinVoigt {
+                stiffness: 8e4,
+                damping: 0.2,
+            },
+            back: Some(Surface::KelvinVoigt {
+                stiffness: 5e4,
+                damping: 0.2,
+            }),
+        };
+        let settings = Settings {
+            t_end: 0.03,
+            ..Settings::default()
+        };
+        (m, build, stops, settings)
+    }
+
+    fn pull(t: f64, _x: f64) -> f64 {
+        let rise = 1.0 - (-t / 2e-3).exp();
+        if t < 0.012 {
+            0.9 * rise
+        } else {
+            0.9 * (1.0 - (-0.012 / 2e-3_f64).exp()) * (-(t - 0.012) / 1e-3).exp()
+        }
+    }
+
+    /// Advanced in uneven pieces, as ngspice's steps would, the stepper
+    /// finds the events of the whole run to the integrator's precision.
+    #[test]
+    fn advancing_piece_by_piece_finds_the_whole_run_s_events() {
+        let (m, build, stops, settings) = relay();
+        let whole = driven_run(&m, &build, &stops, &settings, &pull).unwrap();
+        let whole_changes: Vec<f64> = whole
+            .chatter()
+            .intervals
+            .iter()
+            .skip(1)
+            .map(|iv| iv.start)
+            .collect();
+        assert!(whole_changes.len() >= 4, "{whole_changes:?}");
+        let pieces = with_stepper(&m, &build, &stops, &settings, pull, |stepper| {
+            // Steps from 0.1 µs to 40 µs, in a fixed irregular pattern.
+            let mut t = 0.0;
+            let mut k = 0u32;
+            while t < settings.t_end {
+                k = k.wrapping_mul(1_103_515_245).wrapping_add(12_345);
+                t = (t + 1e-7 + 4e-5 * f64::from(k % 1000) / 1000.0).min(settings.t_end);
+                stepper.advance_to(t).unwrap();
+                assert_eq!(stepper.time(), t);
+            }
+            stepper
+                .intervals()
+                .iter()
+                .skip(1)
+                .map(|iv| iv.start)
+                .collect::<Vec<f64>>()
+        })
+        .unwrap();
+        assert_eq!(
+            pieces.len(),
+            whole_changes.len(),
+            "{pieces:?} vs {whole_changes:?}"
+        );
+        for (a, b) in pieces.iter().zip(&whole_changes) {
+            assert!((a - b).abs() < 1e-9, "{a} vs {b}");
+        }
+    }
+
+    /// A speculation runs ahead and leaves the stepper where it was.
+    #[test]
+    fn a_speculation_leaves_the_stepper_alone() {
+        let (m, build, stops, settings) = relay();
+        with_stepper(&m, &build, &stops, &settings, pull, |stepper| {
+            stepper.advance_to(2e-3).unwrap();
+            let x = stepper.armature(2e-3);
+            let mut plan = stepper.speculate();
+            plan.advance_to(8e-3).unwrap();
+            let first = plan.first_event_after(2e-3).expect("the contact makes");
+            assert!(first > 2e-3 && first < 8e-3, "{first}");
+            assert_eq!(stepper.time(), 2e-3);
+            assert_eq!(stepper.armature(2e-3), x);
+            // The stepper itself then finds the same event.
+            stepper.advance_to(8e-3).unwrap();
+            let found = stepper.first_event_after(2e-3).unwrap();
+            assert!((found - first).abs() < 1e-12, "{found} vs {first}");
+            assert_eq!(stepper.armature(8e-3), plan.armature(8e-3));
+            assert_eq!(stepper.intervals(), plan.intervals());
+        })
+        .unwrap();
+    }
+}
