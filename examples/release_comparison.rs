@@ -34,7 +34,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     }
 
     println!(
-        "| driver | operate | closed for good | bounces | release | NC make | NC bounces | NC bounce time | iterations |"
+        "| driver | operate | closed for good | bounces | release | NC make | NC bounces | NC bounce time | ngspice runs |"
     );
     println!("|---|---|---|---|---|---|---|---|---|");
     let ms = |t: Option<f64>| t.map_or_else(|| "-".to_owned(), |t| format!("{:.3} ms", t * 1e3));
