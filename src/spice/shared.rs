@@ -163,6 +163,18 @@ fn load() -> Result<Library, String> {
             "ngspice's shared library is switched off ({LIBRARY_ENV} is empty)"
         ));
     }
+    // ngSpice_Init looks for `~/.spiceinit` through the password database
+    // and dereferences what it gets: a user without an entry (a container
+    // run under an arbitrary uid) would crash this process, not a child.
+    // SAFETY: getpwuid reads the database; the pointer is only tested.
+    if unsafe { libc::getpwuid(libc::getuid()) }.is_null() {
+        return Err(format!(
+            "ngspice's shared library is not loaded: user {} has no entry in the password \
+             database, and the library's initialisation would crash on that",
+            // SAFETY: a plain system call.
+            unsafe { libc::getuid() }
+        ));
+    }
     // SAFETY: loading runs the library's initialisers, which set up its
     // own state only.
     let dl = unsafe { Dl::new(&name) }.map_err(|e| {
