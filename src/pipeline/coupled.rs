@@ -552,19 +552,7 @@ pub fn run_coupled_plan(
                 }];
                 let thinning = options.path_tolerance * (coil.air_gap + coil.iron_gap);
                 let (chatter, back, path, strokes, pole_face) = records(cycle, thinning);
-                let vector = |name: &str| {
-                    plot.real(name).ok_or_else(|| CouplingError::MissingVector {
-                        iteration: 1,
-                        vector: name.to_owned(),
-                    })
-                };
-                let Some(Vector::Real(time)) = plot.scale() else {
-                    return Err(CouplingError::MissingVector {
-                        iteration: 1,
-                        vector: "time".to_owned(),
-                    });
-                };
-                let switching = Switching::from_coil(time, vector(&volts)?, vector(&current)?);
+                let switching = switching_of(&plot, &volts, &current, 1)?;
                 return Ok(Coupled {
                     operations: operations(&strokes, &switching),
                     switching,
@@ -746,19 +734,7 @@ pub fn run_coupled_plan(
             continue;
         };
         if converged {
-            let vector = |name: &str| {
-                plot.real(name).ok_or_else(|| CouplingError::MissingVector {
-                    iteration,
-                    vector: name.to_owned(),
-                })
-            };
-            let Some(Vector::Real(time)) = plot.scale() else {
-                return Err(CouplingError::MissingVector {
-                    iteration,
-                    vector: "time".to_owned(),
-                });
-            };
-            let switching = Switching::from_coil(time, vector(&volts)?, vector(&current)?);
+            let switching = switching_of(&plot, &volts, &current, iteration)?;
             return Ok(Coupled {
                 operations: operations(&strokes, &switching),
                 switching,
@@ -781,6 +757,29 @@ pub fn run_coupled_plan(
         change: iterations.last().map_or(f64::INFINITY, |i| i.change),
         tolerance: options.tolerance,
     })
+}
+
+/// The coil's switching in `plot`, read from the voltage across it
+/// (`volts`) and its current (`current`), of ngspice run `iteration`.
+fn switching_of(
+    plot: &Plot,
+    volts: &str,
+    current: &str,
+    iteration: usize,
+) -> Result<Switching, CouplingError> {
+    let vector = |name: &str| {
+        plot.real(name).ok_or_else(|| CouplingError::MissingVector {
+            iteration,
+            vector: name.to_owned(),
+        })
+    };
+    let Some(Vector::Real(time)) = plot.scale() else {
+        return Err(CouplingError::MissingVector {
+            iteration,
+            vector: "time".to_owned(),
+        });
+    };
+    Ok(Switching::from_coil(time, vector(volts)?, vector(current)?))
 }
 
 /// The shared library to run a lock-step coupling with, or why not (a
