@@ -4,6 +4,7 @@
 
 pub mod fit;
 pub mod parts;
+mod printed;
 pub mod render;
 
 /// The scenario sections calibration reads and writes (`[datasheet]`,

@@ -22,6 +22,7 @@ use serde::Serialize;
 use thiserror::Error;
 
 use super::fit::{datasheet_figures, pick_up_of};
+use super::printed::{printed_text, unit_of};
 use crate::report::units::engineering;
 use crate::scenario::{PrintedFigure, Scenario, ScenarioError, bundled_part_text};
 
@@ -338,40 +339,4 @@ fn endurance_text(f: &crate::life::EnduranceFigure) -> String {
         supply,
         f.load
     )
-}
-
-/// The unit of a datasheet figure.
-pub(super) fn unit_of(name: &str) -> &'static str {
-    if name.ends_with("_voltage") {
-        "V"
-    } else if name.ends_with("_resistance") {
-        "Ω"
-    } else if name.ends_with("_current") {
-        "A"
-    } else {
-        "s"
-    }
-}
-
-/// A printed figure in engineering units: `≤ 10 ms`, `63 Ω ±10 %`,
-/// `1 ms typ., ≤ 5 ms`.
-pub(super) fn printed_text(f: &PrintedFigure, unit: &str) -> String {
-    let mut parts = Vec::new();
-    if let Some(t) = f.typ {
-        let mut text = engineering(t, unit);
-        if let Some(tol) = f.tolerance {
-            text.push_str(&format!(" ±{} %", (tol * 1e5).round() / 1e3));
-        }
-        if f.min.is_some() || f.max.is_some() {
-            text.push_str(" typ.");
-        }
-        parts.push(text);
-    }
-    if let Some(v) = f.min {
-        parts.push(format!("≥ {}", engineering(v, unit)));
-    }
-    if let Some(v) = f.max {
-        parts.push(format!("≤ {}", engineering(v, unit)));
-    }
-    parts.join(", ")
 }

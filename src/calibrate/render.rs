@@ -86,12 +86,12 @@ pub fn table(report: &FitReport) -> String {
             "figure", "datasheet", "model", "misfit"
         );
         for f in &report.datasheet {
-            let unit = super::parts::unit_of(f.figure);
+            let unit = super::printed::unit_of(f.figure);
             let _ = writeln!(
                 out,
                 "{:<18} {:>22} {:>10} {:>10}{}",
                 f.figure,
-                super::parts::printed_text(&f.printed, unit),
+                super::printed::printed_text(&f.printed, unit),
                 number(f.model, unit),
                 match (f.role, f.model) {
                     (_, None) => "-".to_owned(),

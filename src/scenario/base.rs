@@ -19,7 +19,7 @@ use toml::de::DeTable;
 
 use super::builtin::{DEFAULT_SCENARIO_ORIGIN, DEFAULT_SCENARIO_TOML};
 use super::error::{InheritedConflict, Location, ScenarioError};
-use super::keys::{KeyIndex, line_column};
+use super::keys::{KeyIndex, line_column, line_of};
 use super::unset::{self, Removed};
 
 /// How deep a chain of bases may go before it is taken for a loop.
@@ -346,12 +346,6 @@ fn law_changes(below: &toml::Table, above: &toml::Table) -> bool {
     above
         .get("law")
         .is_some_and(|law| below.get("law") != Some(law))
-}
-
-/// The 1-based line of top-level or dotted `key` in `text`, if it is there.
-pub(super) fn line_of(text: &str, key: &str) -> Option<usize> {
-    let tree = DeTable::parse(text).ok()?;
-    KeyIndex::new(&tree, text).line_of_key(key)
 }
 
 /// Where a key of the merged scenario comes from.

@@ -23,6 +23,12 @@ pub(super) fn line_column(text: &str, at: usize) -> (usize, usize) {
     (line, column)
 }
 
+/// The 1-based line of top-level or dotted `key` in `text`, if it is there.
+pub(super) fn line_of(text: &str, key: &str) -> Option<usize> {
+    let tree = DeTable::parse(text).ok()?;
+    KeyIndex::new(&tree, text).line_of_key(key)
+}
+
 /// Every key of the parsed file with its dotted path and where it is, so
 /// that errors from serde (which know a byte span) and from validation
 /// (which know a key) can both name the key and the line.

@@ -109,7 +109,7 @@ pub(super) fn apply(
 ) -> Result<Vec<Removed>, ScenarioError> {
     let at = |key: &str| Location {
         path: origin.to_owned(),
-        line: super::base::line_of(text, key),
+        line: super::keys::line_of(text, key),
     };
     let toml::Value::Array(entries) = value else {
         return Err(ScenarioError::Unset {
