@@ -49,18 +49,20 @@
 //! an input that discharges from 3.3 V to 16 µV. Such samples are the
 //! integrator's, not the circuit's. After each contact edge (the starts
 //! and ends of the closures given), [`integration_ringing`] looks, within
-//! [`RINGING_LOOKAHEAD`] samples of the edge, for a local extremum that
-//! is either the first of at least [`RINGING_EXTREMA`] extrema in a row
-//! (one per sample, the last swing smaller than the first) or a sharp
-//! turn (left by a step at most [`SHARP_TURN`] of the one that reached
-//! it). Those samples, and the samples that then move monotonically back
-//! up to the next reversal or the next edge, are left out of `min` and
-//! `max` (so out of the `min_value`, `max_value` and `max_peak` limits)
-//! and listed in [`ProbeAnalysis::ringing`]. A physical oscillation,
-//! which ngspice resolves with several points per period, is reached and
-//! left by comparable steps and never alternates point to point; a
-//! monotone stretch has its extremes at its ends, and the end it settles
-//! at is kept. Edges and currents use every sample.
+//! [`RINGING_LOOKAHEAD`] samples of the edge, for at least
+//! [`RINGING_EXTREMA`] local extrema in a row, one per sample, swinging
+//! less and less: samples that alternate about a smooth curve. Those
+//! samples, and the samples that then move monotonically back to the next
+//! reversal or the next edge, are listed in [`ProbeAnalysis::ringing`],
+//! and the range without them is [`ProbeAnalysis::min_without_ringing`]
+//! and [`ProbeAnalysis::max_without_ringing`]. Nothing else is ever left
+//! out: a peak that rises in one step and falls smoothly (the inrush of a
+//! capacitor through a small resistance) is the circuit's, and so is a
+//! physical oscillation, which ngspice resolves with several points per
+//! period and which never alternates point to point. `min` and `max` are
+//! always the extremes of every sample, and the limits hold them unless
+//! the probe sets `ignore_ringing = true`. Edges and currents use every
+//! sample.
 //!
 //! # Comparison with an ideal contact
 //! [`compare`] sets a probe's analysis beside the same circuit's with a
@@ -356,10 +358,19 @@ pub struct ProbeAnalysis {
     pub first_edge: Option<f64>,
     /// s, time of the last edge: where the signal settled.
     pub last_edge: Option<f64>,
-    /// Smallest sample (V, A, ...).
+    /// Smallest sample (V, A, ...): every sample, the integrator's
+    /// ringing after a contact edge included.
     pub min: f64,
-    /// Largest sample.
+    /// Largest sample, every sample included.
     pub max: f64,
+    /// The smallest sample without the integrator's ringing after contact
+    /// edges (see the module overview), when that differs from `min`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub min_without_ringing: Option<f64>,
+    /// The largest sample without the integrator's ringing, when that
+    /// differs from `max`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_without_ringing: Option<f64>,
     /// Voltage, current or other: decides the unit and the current analysis.
     pub kind: ProbeKind,
     /// The `low` threshold used, in the signal's unit.
@@ -426,13 +437,6 @@ pub const RINGING_LOOKAHEAD: usize = 6;
 /// several samples apart.
 pub const RINGING_EXTREMA: usize = 3;
 
-/// A local extremum right after a contact edge that the signal leaves
-/// with a step at most this fraction of the one that reached it is an
-/// overshoot of the integrator: it went past where the signal was going
-/// in one step and is pulled back by a smaller one. A resolved extremum
-/// of a smooth signal is reached and left by comparable steps.
-pub const SHARP_TURN: f64 = 0.5;
-
 /// The integrator's overshoots of (`time`, `values`) after each contact
 /// edge at `edges` (s), and for each sample whether it is left out of the
 /// range (see the module overview). After the overshooting samples, the
@@ -476,8 +480,7 @@ pub fn integration_ringing(
             }
             let into = step(k - 1).abs();
             let ringing = last + 1 - k >= RINGING_EXTREMA && step(last).abs() < into;
-            let overshoot = step(k).abs() <= SHARP_TURN * into;
-            if !(ringing || overshoot) {
+            if !ringing {
                 k = last + 1;
                 continue;
             }
@@ -547,54 +550,58 @@ impl ProbeAnalysis {
         (!parts.is_empty()).then(|| parts.join("; "))
     }
 
-    /// When samples left out as the integrator's overshoot lie beyond the
-    /// range of the others (so that they would have been the minimum or
-    /// the maximum): a sentence saying where, how far, and how to avoid
-    /// it.
+    /// When the integrator's ringing after a contact edge reaches beyond
+    /// the range of the other samples (so that it sets the minimum or the
+    /// maximum): a sentence saying where, how far, what the limits hold
+    /// and how to avoid it.
     pub fn ringing_warning(&self) -> Option<String> {
-        let lowest = self
-            .ringing
-            .iter()
-            .map(|r| r.min)
-            .fold(f64::INFINITY, f64::min);
-        let highest = self
-            .ringing
-            .iter()
-            .map(|r| r.max)
-            .fold(f64::NEG_INFINITY, f64::max);
-        if !(lowest < self.min || highest > self.max) {
+        if self.min_without_ringing.is_none() && self.max_without_ringing.is_none() {
             return None;
         }
+        let (lo, hi) = self.range_without_ringing();
         let unit = self.kind.unit();
         let e = |v: f64| crate::report::units::engineering(v, unit);
-        let beyond = |r: &Ringing| (self.min - r.min).max(r.max - self.max);
+        let beyond = |r: &Ringing| (lo - r.min).max(r.max - hi);
         let worst = self
             .ringing
             .iter()
-            .max_by(|a, b| beyond(a).total_cmp(&beyond(b)))
-            .expect("a ringing lies beyond the range");
+            .max_by(|a, b| beyond(a).total_cmp(&beyond(b)))?;
         let edges = self.ringing.iter().filter(|r| beyond(r) > 0.0).count();
-        let far = if worst.min < self.min {
-            worst.min
-        } else {
-            worst.max
-        };
+        let far = if worst.min < lo { worst.min } else { worst.max };
         Some(format!(
-            "{}: right after {edges} contact edge{} ngspice's samples overshoot where the signal \
-             is going, some ringing up and down from one time point to the next (out to {}, \
-             after the edge at {:.4} ms): the integration of the contact's sharp edge, not the \
-             signal; those samples are left out of min and max, which are {} to {} without them \
-             ({} to {} with them). `.options method=gear trtol=1` in the netlist avoids the \
-             overshoot",
+            "{}: right after {edges} contact edge{} ngspice's samples ring up and down from one \
+             time point to the next (out to {}, after the edge at {:.4} ms): the integration of \
+             the contact's sharp edge, not the signal. The range is {} to {} with them and {} to \
+             {} without them; limits hold the range with them unless the probe sets \
+             `ignore_ringing = true`. `.options method=gear trtol=1` in the netlist avoids the \
+             ringing",
             self.signal,
             if edges == 1 { "" } else { "s" },
             e(far),
             worst.edge * 1e3,
             e(self.min),
             e(self.max),
-            e(lowest.min(self.min)),
-            e(highest.max(self.max)),
+            e(lo),
+            e(hi),
         ))
+    }
+
+    /// (min, max) without the integrator's ringing after contact edges.
+    pub fn range_without_ringing(&self) -> (f64, f64) {
+        (
+            self.min_without_ringing.unwrap_or(self.min),
+            self.max_without_ringing.unwrap_or(self.max),
+        )
+    }
+
+    /// (min, max) as a probe's limits hold them: every sample, or without
+    /// the integrator's ringing when `ignore_ringing`.
+    pub fn range_for_limits(&self, ignore_ringing: bool) -> (f64, f64) {
+        if ignore_ringing {
+            self.range_without_ringing()
+        } else {
+            (self.min, self.max)
+        }
     }
 
     /// When the signal crossed neither threshold it would have to: the
@@ -765,14 +772,19 @@ pub fn analyze_samples(
     let schmitt = schmitt(&probe.signal, time, values, probe.low, probe.high)?;
     let contact_edges: Vec<f64> = closures.iter().flat_map(|&(a, b)| [a, b]).collect();
     let (ringing, left_out) = integration_ringing(time, values, &contact_edges);
+    let range = |keep: &dyn Fn(usize) -> bool| {
+        values
+            .iter()
+            .enumerate()
+            .filter(|&(k, _)| keep(k))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), (_, &v)| {
+                (lo.min(v), hi.max(v))
+            })
+    };
+    let (min, max) = range(&|_| true);
     // The first and last samples are never left out: the range has one.
-    let (min, max) = values
-        .iter()
-        .zip(&left_out)
-        .filter(|(_, out)| !**out)
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), (&v, _)| {
-            (lo.min(v), hi.max(v))
-        });
+    let (lo, hi) = range(&|k| !left_out.get(k).copied().unwrap_or(false));
+    let differs = |a: f64, b: f64| (a != b).then_some(b);
     let current = match kind {
         ProbeKind::Current => Some(current(&probe.signal, time, values, closures)?),
         _ => None,
@@ -793,6 +805,8 @@ pub fn analyze_samples(
         last_edge: edges.last().map(|e| e.time),
         min,
         max,
+        min_without_ringing: differs(min, lo),
+        max_without_ringing: differs(max, hi),
         kind,
         low: probe.low,
         high: probe.high,

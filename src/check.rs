@@ -463,6 +463,7 @@ pub fn probe_checks(index: usize, probe: &Probe, a: &ProbeAnalysis) -> Vec<Limit
             Ok(a.glitches as f64),
         ));
     }
+    let (lo, hi) = a.range_for_limits(probe.ignore_ringing);
     if let Some(limit) = probe.max_peak {
         out.push(LimitCheck::new(
             key("max_peak"),
@@ -470,7 +471,7 @@ pub fn probe_checks(index: usize, probe: &Probe, a: &ProbeAnalysis) -> Vec<Limit
             unit,
             Bound::Max,
             limit,
-            Ok(a.max.abs().max(a.min.abs())),
+            Ok(hi.abs().max(lo.abs())),
         ));
     }
     if let Some(limit) = probe.max_value {
@@ -480,7 +481,7 @@ pub fn probe_checks(index: usize, probe: &Probe, a: &ProbeAnalysis) -> Vec<Limit
             unit,
             Bound::Max,
             limit,
-            Ok(a.max),
+            Ok(hi),
         ));
     }
     if let Some(limit) = probe.min_value {
@@ -490,7 +491,7 @@ pub fn probe_checks(index: usize, probe: &Probe, a: &ProbeAnalysis) -> Vec<Limit
             unit,
             Bound::Min,
             limit,
-            Ok(a.min),
+            Ok(lo),
         ));
     }
     if let Some(limit) = probe.max_last_edge {

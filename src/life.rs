@@ -64,18 +64,32 @@ pub enum Supply {
 /// s, how long the contact stays closed after it settled before it breaks.
 pub const HOLD: f64 = 5e-3;
 
+/// How far above the model's breaking capacity a DC figure's current may
+/// lie and still be simulated rather than refused outright: a printed
+/// endurance figure at the printed capacity (which the model was fitted
+/// to) sits on it, within rounding.
+pub const CAPACITY_TOLERANCE: f64 = 0.02;
+
 /// The default number of switching phases of an AC figure.
 pub const DEFAULT_PHASES: usize = 16;
 
 /// One figure's result.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FigureLife {
+    /// The figure's test load in words, e.g. `5 A 30 VDC resistive`.
+    pub load: String,
     /// As printed.
     pub operations: f64,
     /// The operations the calibrated model predicts at this load (`null`:
     /// the load puts no arc energy into the contacts, so the model
-    /// predicts no electrical wear).
+    /// predicts no electrical wear, or the figure is `refused`).
     pub predicted: Option<f64>,
+    /// Why the model cannot price this figure (`null` when it can): its
+    /// contact does not break the test load (beyond the breaking capacity
+    /// at its voltage, or the break arc still burning when the test run
+    /// ends). Such a figure has no finite life in the model and is never
+    /// calibrated on.
+    pub refused: Option<String>,
     /// predicted / printed.
     pub ratio: Option<f64>,
     /// J, the mean arc energy of one operation at this load.
@@ -91,8 +105,12 @@ pub struct FigureLife {
 /// The life at the scenario's own circuit.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct OwnLife {
-    /// Operations: B / E_op (`null`: no arc energy, no electrical wear).
+    /// Operations: B / E_op (`null`: no arc energy, no electrical wear, or
+    /// `refused`).
     pub operations: Option<f64>,
+    /// Why the circuit's life cannot be priced (`null` when it can): the
+    /// contact does not break the circuit's load within the run.
+    pub refused: Option<String>,
     /// The B10 life with the printed Weibull shape (`null` without one).
     pub b10: Option<f64>,
     /// J, the arc energy of the circuit's operation.
@@ -113,6 +131,24 @@ pub struct LifeReport {
     /// The Weibull shape β the B10 life was computed with
     /// (`[datasheet] weibull_shape`; `null` without one: no B10).
     pub weibull_shape: Option<f64>,
+    /// What the reader must know: every figure the model cannot price,
+    /// with its reason.
+    pub warnings: Vec<String>,
+}
+
+impl EnduranceFigure {
+    /// The test load in words: `5 A 30 VDC resistive`, `10 A 125 VAC
+    /// 60 Hz resistive`.
+    pub fn label(&self) -> String {
+        let supply = match self.supply {
+            Supply::Dc => "VDC".to_owned(),
+            Supply::Ac => match self.frequency {
+                Some(h) => format!("VAC {h} Hz"),
+                None => "VAC".to_owned(),
+            },
+        };
+        format!("{} A {} {supply} {}", self.current, self.voltage, self.load)
+    }
 }
 
 /// Whether `scenario` prints electrical endurance figures, so that a life
@@ -130,6 +166,9 @@ pub fn has_figures(scenario: &Scenario) -> bool {
 /// (with the largest finite number as its life, and a note saying why).
 pub fn limit_check(limit: f64, report: &LifeReport) -> crate::check::LimitCheck {
     let (actual, note) = match &report.life {
+        Some(OwnLife {
+            refused: Some(why), ..
+        }) => (Err(format!("the life cannot be priced: {why}")), None),
         Some(OwnLife {
             operations: Some(n),
             ..
@@ -179,16 +218,16 @@ pub enum LifeError {
         /// What is wrong.
         problem: String,
     },
-    /// The calibration figure's load does not arc.
+    /// No figure's load arcs and is broken, so none fixes B.
     #[error(
-        "{path}: figure {index}'s test load puts no arc energy into the contacts, so it cannot \
-         fix the erosion constant: calibrate on a figure whose load arcs"
+        "{path}: no printed endurance figure can fix the erosion constant: {reasons}. Give a \
+         figure whose test load the contact breaks with an arc"
     )]
     NoArcEnergy {
         /// The scenario file.
         path: PathBuf,
-        /// 1-based.
-        index: usize,
+        /// Why each figure cannot, joined.
+        reasons: String,
     },
     /// The relay's closing.
     #[error(transparent)]
@@ -267,49 +306,101 @@ pub fn estimate_at(
         }
     }
     let (closing, _) = crate::check::relay_closing(scenario)?;
+    let arc = scenario.arc.unwrap_or_default().model();
+    let gap = scenario.mechanics.gap;
     let dir = tempfile::Builder::new()
         .prefix("chatterspice-life-")
         .tempdir()?;
     let _remove = crate::interrupt::remove_at_stop(dir.path());
     let mut energies = Vec::with_capacity(figures.len());
     for (k, figure) in figures.iter().enumerate() {
-        energies.push(figure_energy(
-            scenario,
-            &closing,
-            figure,
-            k,
-            phases,
-            dir.path(),
-            runner,
-            options,
-            jobs,
-        )?);
+        // A load beyond the breaking capacity at its voltage is never
+        // broken: nothing to simulate.
+        let beyond = (figure.supply == Supply::Dc)
+            .then(|| arc.breaking_current(figure.voltage, gap))
+            .flatten()
+            .filter(|&most| figure.current > most * (1.0 + CAPACITY_TOLERANCE))
+            .map(|most| {
+                format!(
+                    "beyond the breaking capacity: at {} V DC the contact breaks at most {:.3} A \
+                     at its full gap",
+                    figure.voltage, most
+                )
+            });
+        energies.push(match beyond {
+            Some(why) => FigureEnergy::refused(why),
+            None => figure_energy(
+                scenario,
+                &closing,
+                figure,
+                k,
+                phases,
+                dir.path(),
+                runner,
+                options,
+                jobs,
+            )?,
+        });
     }
-    let (e0, _, _) = energies[0];
-    if e0.is_nan() || e0 <= 0.0 {
-        return Err(LifeError::NoArcEnergy { path, index: 1 });
-    }
-    let b = figures[0].operations * e0;
+    let Some(calibrated_on) = energies
+        .iter()
+        .position(|e| e.refused.is_none() && e.mean > 0.0)
+    else {
+        let reasons = figures
+            .iter()
+            .zip(&energies)
+            .map(|(f, e)| {
+                format!(
+                    "{}: {}",
+                    f.label(),
+                    e.refused
+                        .as_deref()
+                        .unwrap_or("its load puts no arc energy into the contacts")
+                )
+            })
+            .collect::<Vec<_>>()
+            .join("; ");
+        return Err(LifeError::NoArcEnergy { path, reasons });
+    };
+    let b = figures[calibrated_on].operations * energies[calibrated_on].mean;
+    let mut warnings = Vec::new();
     let rows = figures
         .iter()
         .zip(&energies)
-        .map(|(f, &(e, n, convergence))| {
-            let predicted = (e > 0.0).then(|| b / e);
+        .map(|(f, e)| {
+            if let Some(why) = &e.refused {
+                warnings.push(format!(
+                    "the endurance figure at {} ({} operations) has no finite life in the \
+                     model: {why}",
+                    f.label(),
+                    f.operations
+                ));
+            }
+            let predicted = (e.refused.is_none() && e.mean > 0.0).then(|| b / e.mean);
             FigureLife {
+                load: f.label(),
                 operations: f.operations,
                 predicted,
+                refused: e.refused.clone(),
                 ratio: predicted.map(|p| p / f.operations),
-                energy_per_operation: e,
-                phases: n,
-                convergence,
+                energy_per_operation: e.mean,
+                phases: e.phases,
+                convergence: e.convergence,
             }
         })
         .collect();
     let shape = scenario.datasheet.as_ref().and_then(|d| d.weibull_shape);
     let own_energy = |run: &pipeline::RunResult| {
-        run.arcs
-            .as_ref()
-            .map_or(0.0, |a| a.totals.max_operation_energy)
+        let totals = run.arcs.as_ref().map(|a| &a.totals);
+        let refused = totals.and_then(|t| t.still_burning.as_ref()).map(|b| {
+            format!(
+                "the contact does not break the circuit's load: its arc still burns when the run \
+                 ends, {:.3} ms after it struck, at a gap of {:.3} mm",
+                b.duration * 1e3,
+                b.gap * 1e3
+            )
+        });
+        (totals.map_or(0.0, |t| t.max_operation_energy), refused)
     };
     let energy = match (&scenario.circuit, own) {
         (None, _) => None,
@@ -320,20 +411,25 @@ pub fn estimate_at(
             Some(own_energy(&run))
         }
     };
-    let life = energy.map(|e| {
-        let operations = (e > 0.0).then(|| b / e);
+    let life = energy.map(|(e, refused)| {
+        if let Some(why) = &refused {
+            warnings.push(format!("no life at the scenario's circuit: {why}"));
+        }
+        let operations = (e > 0.0 && refused.is_none()).then(|| b / e);
         OwnLife {
             operations,
+            refused,
             b10: operations.zip(shape).map(|(n, beta)| b10(n, beta)),
             energy_per_operation: e,
         }
     });
     Ok(LifeReport {
-        calibrated_on: 0,
+        calibrated_on,
         constant_j: b,
         figures: rows,
         life,
         weibull_shape: shape,
+        warnings,
     })
 }
 
@@ -345,19 +441,30 @@ pub fn render(report: &LifeReport) -> String {
         report.constant_j,
         report.calibrated_on + 1
     );
+    let width = report
+        .figures
+        .iter()
+        .map(|f| f.load.chars().count())
+        .max()
+        .unwrap_or(0)
+        .max(4);
     let _ = writeln!(
         out,
-        "{:>6} {:>12} {:>12} {:>8} {:>14} {:>7} {:>12}",
-        "figure", "printed", "predicted", "ratio", "J/operation", "phases", "convergence"
+        "{:>6}  {:<width$} {:>12} {:>12} {:>8} {:>14} {:>7} {:>12}",
+        "figure", "load", "printed", "predicted", "ratio", "J/operation", "phases", "convergence"
     );
     for (k, f) in report.figures.iter().enumerate() {
         let _ = writeln!(
             out,
-            "{:>6} {:>12.4e} {:>12} {:>8} {:>14.4e} {:>7} {:>+11.2}%",
+            "{:>6}  {:<width$} {:>12.4e} {:>12} {:>8} {:>14.4e} {:>7} {:>+11.2}%",
             k + 1,
+            f.load,
             f.operations,
-            f.predicted
-                .map_or("no wear".to_owned(), |p| format!("{p:.4e}")),
+            match (&f.refused, f.predicted) {
+                (Some(_), _) => "not priced".to_owned(),
+                (None, Some(p)) => format!("{p:.4e}"),
+                (None, None) => "no wear".to_owned(),
+            },
             f.ratio.map_or("-".to_owned(), |r| format!("{r:.3}")),
             f.energy_per_operation,
             f.phases,
@@ -369,10 +476,11 @@ pub fn render(report: &LifeReport) -> String {
             let _ = writeln!(
                 out,
                 "life at the scenario's circuit: {} operations ({:.4e} J per operation){}",
-                l.operations
-                    .map_or("unlimited by arcs (no arc energy)".to_owned(), |n| format!(
-                        "{n:.4e}"
-                    )),
+                match (&l.refused, l.operations) {
+                    (Some(_), _) => "not priced (see the warning)".to_owned(),
+                    (None, Some(n)) => format!("{n:.4e}"),
+                    (None, None) => "unlimited by arcs (no arc energy)".to_owned(),
+                },
                 l.energy_per_operation,
                 l.b10
                     .zip(report.weibull_shape)
@@ -382,6 +490,9 @@ pub fn render(report: &LifeReport) -> String {
             );
         }
         None => out.push_str("the scenario has no [circuit]: no life at its own load\n"),
+    }
+    for w in &report.warnings {
+        let _ = writeln!(out, "warning: {w}");
     }
     out
 }
@@ -415,7 +526,34 @@ fn gamma(x: f64) -> f64 {
     (2.0 * std::f64::consts::PI).sqrt() * t.powf(x + 0.5) * (-t).exp() * a
 }
 
-/// (mean E_op, phases, convergence) of one figure.
+/// One phase's arc energy (J) and, when its break arc still burned when
+/// the test run ended, how long it had burned (s).
+type PhaseResult = Result<(f64, Option<f64>), LifeError>;
+
+/// One figure's simulated test load.
+struct FigureEnergy {
+    /// J, the mean arc energy of an operation.
+    mean: f64,
+    /// Switching phases averaged.
+    phases: usize,
+    /// How far the mean still moves (see [`FigureLife::convergence`]).
+    convergence: f64,
+    /// Why the figure cannot be priced.
+    refused: Option<String>,
+}
+
+impl FigureEnergy {
+    fn refused(why: String) -> FigureEnergy {
+        FigureEnergy {
+            mean: 0.0,
+            phases: 0,
+            convergence: 0.0,
+            refused: Some(why),
+        }
+    }
+}
+
+/// One figure's test load run over its switching phases.
 #[allow(clippy::too_many_arguments)]
 fn figure_energy(
     scenario: &Scenario,
@@ -427,7 +565,7 @@ fn figure_energy(
     runner: &dyn Runner,
     options: &RunOptions,
     jobs: usize,
-) -> Result<(f64, usize, f64), LifeError> {
+) -> Result<FigureEnergy, LifeError> {
     let settle = closing
         .intervals
         .iter()
@@ -463,7 +601,8 @@ fn figure_energy(
         start: t_break,
         end: t_stop,
     });
-    let run_phase = |phase: usize| -> Result<f64, LifeError> {
+    // (energy, the arc still burning at the run's end: how long it had burned)
+    let run_phase = |phase: usize| -> PhaseResult {
         let source = match figure.supply {
             Supply::Dc => format!("DC {}", figure.voltage),
             Supply::Ac => format!(
@@ -504,12 +643,17 @@ fn figure_energy(
                     source: Box::new(e),
                 }
             })?;
-        Ok(run.arcs.as_ref().map_or(0.0, |a| a.totals.energy))
+        Ok(run.arcs.as_ref().map_or((0.0, None), |a| {
+            (
+                a.totals.energy,
+                a.totals.still_burning.as_ref().map(|b| b.duration),
+            )
+        }))
     };
     // The phases in parallel, `jobs` ngspice runs at a time; the first
     // error (in phase order) is the answer.
     let next = std::sync::atomic::AtomicUsize::new(0);
-    let results: std::sync::Mutex<Vec<Option<Result<f64, LifeError>>>> =
+    let results: std::sync::Mutex<Vec<Option<PhaseResult>>> =
         std::sync::Mutex::new((0..n).map(|_| None).collect());
     std::thread::scope(|scope| {
         for _ in 0..jobs.clamp(1, n) {
@@ -530,9 +674,15 @@ fn figure_energy(
         }
     });
     let mut energies = Vec::with_capacity(n);
+    let mut burning: Option<f64> = None;
     for result in results.into_inner().unwrap_or_else(|e| e.into_inner()) {
         match result {
-            Some(Ok(e)) => energies.push(e),
+            Some(Ok((e, still))) => {
+                energies.push(e);
+                if let Some(d) = still {
+                    burning = Some(burning.map_or(d, |b: f64| b.max(d)));
+                }
+            }
             Some(Err(e)) => return Err(e),
             // A phase not run: an earlier error stopped the others.
             None => continue,
@@ -553,7 +703,21 @@ fn figure_energy(
     } else {
         0.0
     };
-    Ok((mean, n, convergence))
+    // An arc that outlasts the test run would price the figure by how
+    // long the run was: the contact does not break this load.
+    let refused = burning.map(|d| {
+        format!(
+            "the contact does not break its test load: the break arc still burns when the test \
+             run ends, {:.1} ms after it struck",
+            d * 1e3
+        )
+    });
+    Ok(FigureEnergy {
+        mean,
+        phases: n,
+        convergence,
+        refused,
+    })
 }
 
 #[cfg(test)]

@@ -389,7 +389,13 @@ impl<'a> Samples<'a> {
     }
 
     /// Each run as an arc or a breakdown: its opening, duration, peaks
-    /// and energy (trapezoids of |v·i|), and how it ended.
+    /// and energy, and how it ended. The energy is the net ∫v·i into the
+    /// gap (trapezoids of v·i, with v across the contact and i through it
+    /// in the same sense): what a discharge puts into the gap and then
+    /// gives back to the circuit (a gap that rings with its capacitance)
+    /// is not counted twice. The gap is passive, so a net below zero is
+    /// the integration's rounding over a discharge of a few samples, and
+    /// counts as 0.
     fn events(
         &self,
         runs: &[Run],
@@ -403,9 +409,10 @@ impl<'a> Samples<'a> {
             let (mut energy, mut charge) = (0.0, 0.0);
             for j in first..last {
                 let dt = time[j + 1] - time[j];
-                energy += 0.5 * ((v[j] * i[j]).abs() + (v[j + 1] * i[j + 1]).abs()) * dt;
+                energy += 0.5 * (v[j] * i[j] + v[j + 1] * i[j + 1]) * dt;
                 charge += 0.5 * (i[j].abs() + i[j + 1].abs()) * dt;
             }
+            let energy = energy.max(0.0);
             let peak_current = settled_peak(time, i, first, last);
             let (start, end) = (time[first], time[last]);
             let (operation, opening) = opening_at(openings, start);

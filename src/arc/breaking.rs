@@ -10,8 +10,16 @@
 //! s = √(I/(4·V)) for a printed figure (V, I) turns that into a line,
 //! s·V = s·a + √K, linear in the two unknowns a and √K: two figures fix
 //! them, more are fitted by least squares. One gap cannot tell C from D
-//! (only K = C + D·d is seen), so D is held and C fitted; with one
-//! figure, E is held too.
+//! (only K = C + D·d is seen). The low-current term belongs to the arc
+//! column and grows with its length, so the fit reads K as D·g: D is
+//! fitted and C (≈ 0: a metal-vapour arc across micrometres burns near
+//! V_min) held; C is fitted instead only when asked. With one figure, E
+//! is held too.
+//!
+//! The fit stays physical: a = V_min + E·g is kept below the lowest
+//! printed voltage (a fitted E that would put it there, so that the model
+//! broke any current at a voltage where the datasheet prints a limit, is
+//! refused and E held at its prior).
 //!
 //! The arc also goes out when its steady current falls below I_min, which
 //! caps what the model can show at high voltages: there the breakable
@@ -28,7 +36,22 @@
 use serde::Serialize;
 
 use super::model::ArcModel;
-use crate::scenario::BreakingFigure;
+
+/// V, the supply at which every power relay's DC breaking curve still
+/// prints a finite current (DC1 curves start at 24–30 V with the rated
+/// current): a fit may not put V_min + E·gap at or above it, where the
+/// model would break any current.
+pub const LOWEST_RATED_DC: f64 = 30.0;
+
+/// One printed point of a DC breaking-capacity curve: the largest current
+/// (A) a contact breaks on a resistive load at a supply voltage (V).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PrintedBreak {
+    /// V, the DC supply.
+    pub voltage: f64,
+    /// A, the largest current broken at that voltage.
+    pub current: f64,
+}
 
 /// One printed figure beside the model's answer.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -45,7 +68,7 @@ pub struct BreakingRow {
 
 /// Every figure of `figures` beside `model`'s breakable current at gap
 /// `gap` (m).
-pub fn rows(model: &ArcModel, gap: f64, figures: &[BreakingFigure]) -> Vec<BreakingRow> {
+pub fn rows(model: &ArcModel, gap: f64, figures: &[PrintedBreak]) -> Vec<BreakingRow> {
     figures
         .iter()
         .map(|f| BreakingRow {
@@ -63,6 +86,8 @@ pub struct BreakingFit {
     pub field: f64,
     /// V·A, the low-current term C.
     pub low_current: f64,
+    /// V·A/m, the low-current term's growth with the gap, D.
+    pub low_current_gap: f64,
     /// Whether E was fitted (two figures or more) or held.
     pub field_fitted: bool,
     /// A, the minimum arc current: the prior's, or (when fitted) the
@@ -76,8 +101,12 @@ pub struct BreakingFit {
     pub gap: f64,
     /// The figures beside the fitted model.
     pub rows: Vec<BreakingRow>,
-    /// The root-mean-square of ln(model/printed) over the figures.
+    /// The root-mean-square of ln(model/printed) over the figures: the
+    /// fit's own residual.
     pub rms_log_error: f64,
+    /// Why a free key was held (E that would break any current at a
+    /// printed voltage), for the report's notes.
+    pub held: Vec<String>,
 }
 
 /// Why a breaking curve cannot be fitted.
@@ -105,25 +134,28 @@ pub enum BreakingFitError {
     },
 }
 
-/// What a breaking fit may move besides C.
+/// What a breaking fit may move besides the low-current term (D, or C
+/// when `low_current` is set and `low_current_gap` is not).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct FreeArcKeys {
+    /// C is fitted (D held) instead of D (C held).
+    pub low_current: bool,
     /// E, the column gradient (with two figures or more).
     pub field: bool,
     /// I_min, lowered where the figures call for it.
     pub i_min: bool,
 }
 
-/// Fits C, E when `free.field` and there are two figures or more, and
-/// I_min when `free.i_min`, of `model` to `figures` at the full gap `gap`
-/// (m), holding V_min and D (and E, I_min otherwise).
+/// Fits the low-current term (D, or C with `free.low_current`), E when
+/// `free.field` and there are two figures or more, and I_min when
+/// `free.i_min`, of `model` to `figures` at the full gap `gap` (m), holding
+/// V_min and the rest.
 pub fn fit(
     model: &ArcModel,
     gap: f64,
-    figures: &[BreakingFigure],
+    figures: &[PrintedBreak],
     free: FreeArcKeys,
 ) -> Result<BreakingFit, BreakingFitError> {
-    let fit_field = free.field;
     if figures.is_empty() {
         return Err(BreakingFitError::NoFigures);
     }
@@ -138,7 +170,9 @@ pub fn fit(
         })
         .collect();
     let n = points.len() as f64;
-    let field_fitted = fit_field && points.len() >= 2;
+    let held_line = |a: f64| (a, points.iter().map(|&(s, sv)| sv - s * a).sum::<f64>() / n);
+    let mut held = Vec::new();
+    let mut field_fitted = free.field && points.len() >= 2;
     // s·V = s·a + q with q = √K: least squares in (a, q), or in q alone.
     let (a, q) = if field_fitted {
         let (sx, sy) = points
@@ -153,15 +187,33 @@ pub fn fit(
         } else {
             model.arc_voltage(gap)
         };
-        (a, my - a * mx)
+        let lowest = figures
+            .iter()
+            .map(|f| f.voltage)
+            .fold(LOWEST_RATED_DC, f64::min);
+        let q = my - a * mx;
+        if a >= lowest && q > 0.0 {
+            field_fitted = false;
+            held.push(format!(
+                "arc.field held at its value: fitted, it puts V_min + E·gap at {a:.1} V, at or \
+                 above {lowest} V, where a contact still breaks only a finite current (the \
+                 lowest printed voltage, or the 30 V at which DC curves start)"
+            ));
+            held_line(model.arc_voltage(gap))
+        } else {
+            (a, q)
+        }
     } else {
-        let a = model.arc_voltage(gap);
-        let q = points.iter().map(|&(s, sv)| sv - s * a).sum::<f64>() / n;
-        (a, q)
+        held_line(model.arc_voltage(gap))
     };
     let k = q * q;
-    let low_current = k - model.low_current_gap * gap;
-    if a < model.v_min || q <= 0.0 || low_current < 0.0 || !a.is_finite() {
+    // K = C + D·g: the free one of the two takes what the other leaves.
+    let (low_current, low_current_gap) = if free.low_current {
+        (k - model.low_current_gap * gap, model.low_current_gap)
+    } else {
+        (model.low_current, (k - model.low_current) / gap)
+    };
+    if a < model.v_min || q <= 0.0 || low_current < 0.0 || low_current_gap < 0.0 || !a.is_finite() {
         return Err(BreakingFitError::Unphysical {
             v_min: model.v_min,
             a,
@@ -185,6 +237,7 @@ pub fn fit(
             model.field
         },
         low_current,
+        low_current_gap,
         i_min: if i_min_fitted {
             tangent_floor
         } else {
@@ -205,12 +258,14 @@ pub fn fit(
     Ok(BreakingFit {
         field: fitted.field,
         low_current,
+        low_current_gap,
         field_fitted,
         i_min: fitted.i_min,
         i_min_fitted,
         gap,
         rows,
         rms_log_error,
+        held,
     })
 }
 
@@ -221,6 +276,7 @@ mod tests {
 
     /// E and C free, I_min held.
     const FIELD: FreeArcKeys = FreeArcKeys {
+        low_current: true,
         field: true,
         i_min: false,
     };
@@ -270,6 +326,7 @@ mod tests {
         // goes out below I_min: I = V·I_min/(V − a).
         let flat = ArcSection {
             low_current: Some(0.0),
+            low_current_gap: Some(0.0),
             ..ArcSection::default()
         }
         .model();
@@ -290,9 +347,9 @@ mod tests {
         }
         .model();
         let gap = 0.3e-3;
-        let figures: Vec<BreakingFigure> = [24.0, 30.0, 36.0, 48.0]
+        let figures: Vec<PrintedBreak> = [24.0, 30.0, 36.0, 48.0]
             .iter()
-            .map(|&voltage| BreakingFigure {
+            .map(|&voltage| PrintedBreak {
                 voltage,
                 current: truth.breaking_current(voltage, gap).unwrap(),
             })
@@ -322,11 +379,11 @@ mod tests {
         assert!((row.model.unwrap() / row.printed - 1.0).abs() < 1e-9);
         // Figures no arc can meet: an error, not numbers.
         let wrong = [
-            BreakingFigure {
+            PrintedBreak {
                 voltage: 30.0,
                 current: 0.1,
             },
-            BreakingFigure {
+            PrintedBreak {
                 voltage: 220.0,
                 current: 50.0,
             },
@@ -340,7 +397,16 @@ mod tests {
             Err(BreakingFitError::NoFigures)
         );
         // E held over several figures: C alone, by least squares.
-        let held = super::fit(&start, gap, &figures, FreeArcKeys::default()).unwrap();
+        let held = super::fit(
+            &start,
+            gap,
+            &figures,
+            FreeArcKeys {
+                low_current: true,
+                ..FreeArcKeys::default()
+            },
+        )
+        .unwrap();
         assert!(!held.field_fitted);
         assert_eq!(held.field, start.field);
         assert!(held.low_current > 0.0 && held.low_current != start.low_current);
@@ -348,9 +414,9 @@ mod tests {
 
     /// Finder 40.52, DC1 curve (resistive): 8 A at 30 V, 0.3 A at 110 V,
     /// 0.12 A at 220 V (40 Series datasheet, "Breaking capacity DC1").
-    fn finder() -> [BreakingFigure; 3] {
+    fn finder() -> [PrintedBreak; 3] {
         [(30.0, 8.0), (110.0, 0.3), (220.0, 0.12)]
-            .map(|(voltage, current)| BreakingFigure { voltage, current })
+            .map(|(voltage, current)| PrintedBreak { voltage, current })
     }
 
     fn agni() -> ArcModel {
@@ -364,7 +430,11 @@ mod tests {
     #[test]
     fn the_finder_curve_at_30_v_and_the_i_min_floor_above() {
         let printed = finder();
-        let fit = fit(&agni(), 0.3e-3, &printed, FIELD).unwrap();
+        let free = FreeArcKeys {
+            field: true,
+            ..FreeArcKeys::default()
+        };
+        let fit = fit(&agni(), 0.3e-3, &printed, free).unwrap();
         // The three points lie on one tangent curve: E of tens of kV/m.
         assert!(fit.field > 1e4 && fit.field < 1e5, "{}", fit.field);
         assert!(!fit.i_min_fitted && fit.i_min == 0.4);
@@ -380,6 +450,7 @@ mod tests {
     #[test]
     fn with_i_min_free_the_finder_curve_is_met_at_every_voltage() {
         let all = FreeArcKeys {
+            low_current: false,
             field: true,
             i_min: true,
         };
@@ -387,7 +458,8 @@ mod tests {
         assert!(fit.i_min_fitted);
         // I_min is the tangent current at 220 V: 2K/(V − a).
         let a = agni().v_min + fit.field * 0.3e-3;
-        let expected = 2.0 * fit.low_current / (220.0 - a);
+        let k = fit.low_current + fit.low_current_gap * 0.3e-3;
+        let expected = 2.0 * k / (220.0 - a);
         assert!((fit.i_min / expected - 1.0).abs() < 1e-12, "{}", fit.i_min);
         assert!(fit.i_min > 0.04 && fit.i_min < 0.07, "{}", fit.i_min);
         for row in &fit.rows {
@@ -404,6 +476,7 @@ mod tests {
             let model = ArcModel {
                 field: fit.field,
                 low_current: fit.low_current,
+                low_current_gap: fit.low_current_gap,
                 i_min: fit.i_min,
                 ..agni()
             };
@@ -417,11 +490,48 @@ mod tests {
             );
         }
         // A curve the prior's I_min already lets the tangent set: held.
-        let low = [BreakingFigure {
+        let low = [PrintedBreak {
             voltage: 30.0,
             current: 8.0,
         }];
         let held = super::fit(&agni(), 0.3e-3, &low, all).unwrap();
         assert!(!held.i_min_fitted && held.i_min == 0.4);
+    }
+
+    #[test]
+    fn a_field_that_would_break_any_current_at_30_v_is_held() {
+        // Two figures at 110 V and 220 V made by an arc whose
+        // V_min + E·gap is 39 V: fitted freely, E would say that the
+        // contact breaks any current at 30 V.
+        let gap = 0.3e-3;
+        let truth = ArcModel {
+            field: (39.0 - 12.0) / gap,
+            low_current: 0.0,
+            low_current_gap: 5.0e4,
+            i_min: 0.01,
+            ..agni()
+        };
+        let two = [110.0, 220.0].map(|voltage| PrintedBreak {
+            voltage,
+            current: truth.breaking_current(voltage, gap).unwrap(),
+        });
+        let free = FreeArcKeys {
+            field: true,
+            ..FreeArcKeys::default()
+        };
+        let fit = super::fit(&agni(), gap, &two, free).unwrap();
+        assert!(!fit.field_fitted, "{fit:?}");
+        assert_eq!(fit.field, agni().field);
+        assert_eq!(fit.held.len(), 1, "{:?}", fit.held);
+        let model = ArcModel {
+            field: fit.field,
+            low_current: fit.low_current,
+            low_current_gap: fit.low_current_gap,
+            ..agni()
+        };
+        assert!(model.breaking_current(30.0, gap).is_some());
+        // The low-current term is read as D·gap: C stays at the prior's 0.
+        assert_eq!(fit.low_current, 0.0);
+        assert!(fit.low_current_gap > 0.0);
     }
 }

@@ -34,7 +34,8 @@ pub mod vectors;
 pub use analysis::{ArcEvent, ArcReport, ArcTotals, Breakdown, StillBurning};
 pub use gap::GapProfile;
 pub use model::{
-    ArcModel, ArcSection, DEFAULT_FIELD, DEFAULT_LOW_CURRENT, DEFAULT_OPENING_SPEED,
-    FIELD_EMISSION_FIELD, Material, PASCHEN_MINIMUM, REFERENCE_MATERIAL, breakdown_voltage,
+    ArcModel, ArcSection, DEFAULT_CAPACITANCE, DEFAULT_FIELD, DEFAULT_LOW_CURRENT,
+    DEFAULT_LOW_CURRENT_GAP, DEFAULT_OPENING_SPEED, FIELD_EMISSION_FIELD, Material,
+    PASCHEN_MINIMUM, REFERENCE_MATERIAL, breakdown_voltage,
 };
 pub use vectors::ArcVectors;

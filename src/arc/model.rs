@@ -58,11 +58,17 @@ impl Material {
         }
     }
 
-    /// V·A, the default low-current term C of the arc voltage: silver's
-    /// [`DEFAULT_LOW_CURRENT`] for every material, as no breaking curve of
-    /// the others has been fitted (docs/arcs.md).
+    /// V·A, the default low-current term C of the arc voltage at zero
+    /// gap: [`DEFAULT_LOW_CURRENT`] (0) for every material.
     pub fn low_current(self) -> f64 {
         DEFAULT_LOW_CURRENT
+    }
+
+    /// V·A/m, the default growth D of the low-current term with the gap:
+    /// silver's [`DEFAULT_LOW_CURRENT_GAP`] for every material, as no
+    /// breaking curve of the others has been fitted (docs/arcs.md).
+    pub fn low_current_gap(self) -> f64 {
+        DEFAULT_LOW_CURRENT_GAP
     }
 
     /// A, the minimum arc current (docs/arcs.md, materials table).
@@ -81,12 +87,26 @@ impl Material {
 /// have gradients of a few kV/m (docs/arcs.md).
 pub const DEFAULT_FIELD: f64 = 2.0e3;
 
-/// V·A, the default low-current term C of the arc voltage
-/// (V_arc = V_min + E·d + (C + D·d)/|i|): the value with which the default
-/// column gradient and a 0.3 mm contact gap break 8 A at 30 V DC on a
-/// resistive load, the DC rating that small silver-contact power relays
-/// print (Finder 40.52, DC1 curve; docs/arcs.md).
-pub const DEFAULT_LOW_CURRENT: f64 = 20.0;
+/// V·A, the default low-current term at zero gap, C, of the arc voltage
+/// V_arc = V_min + E·d + (C + D·d)/|i|: 0. Ayrton's low-current term
+/// belongs to the arc column and grows with its length; a metal-vapour
+/// arc across a gap of micrometres (a bounce opening) burns near V_min
+/// (docs/arcs.md, "The short arc").
+pub const DEFAULT_LOW_CURRENT: f64 = 0.0;
+
+/// V·A/m, the default growth of the low-current term with the gap, D:
+/// the value with which the default column gradient and a 0.3 mm contact
+/// gap break 8 A at 30 V DC on a resistive load (K = D·0.3 mm ≈ 20 V·A),
+/// the DC rating that small silver-contact power relays print (Omron
+/// G5LE, Finder 40.52 DC1 curve; docs/arcs.md).
+pub const DEFAULT_LOW_CURRENT_GAP: f64 = 6.7e4;
+
+/// F, the default capacitance between a relay's open contacts: of order
+/// 1 pF (datasheets of signal and power relays print 0.5–2 pF between open
+/// contacts, e.g. TE Axicom IM: 1 pF, "capacitance between open
+/// contacts"). Without it an inductive break with no other capacitance
+/// rings at the integrator's frequency instead of a physical one.
+pub const DEFAULT_CAPACITANCE: f64 = 1e-12;
 
 /// m/s, how fast the gap opens and closes where no trajectory is known
 /// (a measured record of states): a typical contact separation speed.
@@ -117,14 +137,19 @@ pub struct ArcSection {
     /// which has no trajectory; a simulated relay uses its own.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub opening_speed: Option<f64>,
-    /// V·A, Ayrton's low-current term C: the arc burns higher the lower
-    /// its current, by (C + D·gap)/|i|. 0 here and in `low_current_gap`
-    /// gives the arc voltage V_min + E·gap alone.
+    /// V·A, Ayrton's low-current term at zero gap, C: the arc burns
+    /// higher the lower its current, by (C + D·gap)/|i|. Default 0; 0 here
+    /// and in `low_current_gap` gives the arc voltage V_min + E·gap alone.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub low_current: Option<f64>,
-    /// V·A/m, the low-current term's growth with the gap, D.
+    /// V·A/m, the low-current term's growth with the gap, D (default
+    /// [`DEFAULT_LOW_CURRENT_GAP`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub low_current_gap: Option<f64>,
+    /// F, the open contact's own capacitance between its electrodes
+    /// (default [`DEFAULT_CAPACITANCE`]; 0 leaves it out).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub capacitance: Option<f64>,
 }
 
 impl ArcSection {
@@ -141,6 +166,7 @@ impl ArcSection {
             opening_speed: Some(m.opening_speed),
             low_current: Some(m.low_current),
             low_current_gap: Some(m.low_current_gap),
+            capacitance: Some(m.capacitance),
         }
     }
 
@@ -153,7 +179,8 @@ impl ArcSection {
             field: self.field.unwrap_or(DEFAULT_FIELD),
             opening_speed: self.opening_speed.unwrap_or(DEFAULT_OPENING_SPEED),
             low_current: self.low_current.unwrap_or(material.low_current()),
-            low_current_gap: self.low_current_gap.unwrap_or(0.0),
+            low_current_gap: self.low_current_gap.unwrap_or(material.low_current_gap()),
+            capacitance: self.capacitance.unwrap_or(DEFAULT_CAPACITANCE),
         }
     }
 }
@@ -173,6 +200,8 @@ pub struct ArcModel {
     pub low_current: f64,
     /// V·A/m, D
     pub low_current_gap: f64,
+    /// F, the open contact's own capacitance
+    pub capacitance: f64,
 }
 
 impl ArcModel {
@@ -304,6 +333,9 @@ mod tests {
         assert_eq!((w.v_min, w.i_min), (15.0, 2.0));
         assert_eq!(w.arc_voltage(1e-3), 15.0 + DEFAULT_FIELD * 1e-3);
         assert_eq!(w.hold_voltage(0.0), 15.0 + DEFAULT_LOW_CURRENT / 2.0);
+        // The low-current term grows with the gap from ≈ 0 at contact.
+        assert_eq!(silver.low_current_term(0.0), DEFAULT_LOW_CURRENT);
+        assert!((silver.low_current_term(0.3e-3) - 20.1).abs() < 1e-9);
         for m in Material::ALL {
             assert!(m.v_min() >= 12.0 && m.i_min() >= 0.38, "{}", m.as_str());
         }

@@ -82,10 +82,13 @@ use crate::coil::{Coil, Source};
 use crate::mechanics::simulate;
 use crate::scenario::{PrintedFigure, Scenario, ScenarioError};
 
+#[path = "fit_breaking.rs"]
+mod breaking;
 #[path = "fit_report.rs"]
 mod report;
 #[path = "fit_start.rs"]
 mod start;
+use breaking::fit_breaking;
 use start::closed_form_start;
 
 /// s: residuals of event times are divided by this before they are
@@ -879,7 +882,8 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
     if arc_keys.is_empty() {
         return fit_mechanics(scenario, request, started);
     }
-    let mut report = if mechanical.is_empty() {
+    let arc_only = mechanical.is_empty();
+    let mut report = if arc_only {
         FitReport {
             parameters: Vec::new(),
             events: Vec::new(),
@@ -912,133 +916,12 @@ pub fn fit(scenario: &Scenario, request: &FitRequest) -> Result<FitReport, FitEr
         fit_mechanics(&scenario, &request, started)?
     };
     fit_breaking(scenario, &arc_keys, &mut report)?;
+    if arc_only {
+        // The breaking fit's own misfit: rms of ln(model/printed).
+        report.rms_residual = report.breaking.as_ref().map_or(0.0, |b| b.rms_log_error);
+    }
     report.elapsed = started.elapsed().as_secs_f64();
     Ok(report)
-}
-
-/// The arc constants `keys` (`arc.low_current`, and `arc.field` with two
-/// figures or more) fitted in closed form to `[datasheet] dc_breaking` at
-/// the contact's full gap (crate::arc::breaking), into `report`.
-fn fit_breaking(
-    scenario: &Scenario,
-    keys: &[String],
-    report: &mut FitReport,
-) -> Result<(), FitError> {
-    let path = scenario.origin.display().to_string();
-    for key in keys {
-        if !matches!(key.as_str(), "arc.low_current" | "arc.field" | "arc.i_min") {
-            return Err(FitError::Breaking {
-                path,
-                problem: format!(
-                    "free key `{key}`: of the arc, only arc.low_current, arc.field and \
-                     arc.i_min are fitted (to [datasheet] dc_breaking); arc.low_current_gap is \
-                     held, as one gap cannot tell it from arc.low_current"
-                ),
-            });
-        }
-    }
-    let figures = scenario
-        .datasheet
-        .as_ref()
-        .map(|d| d.dc_breaking.clone())
-        .unwrap_or_default();
-    if figures.is_empty() {
-        return Err(FitError::Breaking {
-            path,
-            problem: "the arc's keys are fitted to the DC breaking capacity: add \
-                      [datasheet] dc_breaking = [{ voltage = ..., current = ... }, ...]"
-                .to_owned(),
-        });
-    }
-    let section = scenario.arc.unwrap_or_default();
-    let model = section.model();
-    let gap = report.fitted.mechanics.gap;
-    let fit_field = keys.iter().any(|k| k == "arc.field");
-    let free = crate::arc::breaking::FreeArcKeys {
-        field: fit_field,
-        i_min: keys.iter().any(|k| k == "arc.i_min"),
-    };
-    let fitted =
-        crate::arc::breaking::fit(&model, gap, &figures, free).map_err(|e| FitError::Breaking {
-            path: path.clone(),
-            problem: e.to_string(),
-        })?;
-    // I_min is bounded by the figures, not fitted through them.
-    let through = keys.iter().filter(|k| *k != "arc.i_min").count();
-    let determined = if figures.len() == through {
-        Determined::Exactly
-    } else {
-        Determined::Yes
-    };
-    let mut rows = vec![ParameterRow {
-        key: "arc.low_current".to_owned(),
-        prior: model.low_current,
-        value: fitted.low_current,
-        sigma: None,
-        determined,
-    }];
-    if fit_field && fitted.field_fitted {
-        rows.insert(
-            0,
-            ParameterRow {
-                key: "arc.field".to_owned(),
-                prior: model.field,
-                value: fitted.field,
-                sigma: None,
-                determined,
-            },
-        );
-    } else if fit_field {
-        report.notes.push(
-            "arc.field held at its value: one DC breaking figure fixes arc.low_current only"
-                .to_owned(),
-        );
-    }
-    if free.i_min {
-        rows.push(ParameterRow {
-            key: "arc.i_min".to_owned(),
-            prior: model.i_min,
-            value: fitted.i_min,
-            sigma: None,
-            determined: if fitted.i_min_fitted {
-                Determined::Yes
-            } else {
-                Determined::No
-            },
-        });
-        report.notes.push(if fitted.i_min_fitted {
-            format!(
-                "arc.i_min lowered to {:.4} A, the arc's current at the tangent of the highest \
-                 printed voltage: the largest minimum arc current that lets every printed figure \
-                 be set by the tangent (an upper bound; any smaller value breaks the same \
-                 currents)",
-                fitted.i_min
-            )
-        } else {
-            "arc.i_min held at its value: the arc burns above it at every printed figure's \
-             tangent"
-                .to_owned()
-        });
-    }
-    report.parameters.extend(rows);
-    report.fitted.arc = Some(crate::arc::ArcSection {
-        field: Some(fitted.field),
-        low_current: Some(fitted.low_current),
-        i_min: if fitted.i_min_fitted {
-            Some(fitted.i_min)
-        } else {
-            section.i_min
-        },
-        ..section
-    });
-    if report.fitted_to.is_empty() {
-        report.fitted_to = "dc_breaking".to_owned();
-    } else if !report.fitted_to.contains("dc_breaking") {
-        report.fitted_to.push_str(" + dc_breaking");
-    }
-    report.breaking = Some(fitted);
-    report.fitted.provenance = Some(report.provenance());
-    Ok(())
 }
 
 fn fit_mechanics(

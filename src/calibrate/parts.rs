@@ -249,7 +249,10 @@ pub fn listing(part: &Part) -> Listing {
         dc_breaking: crate::arc::breaking::rows(
             &scenario.arc.unwrap_or_default().model(),
             scenario.mechanics.gap,
-            &d.dc_breaking,
+            &d.dc_breaking
+                .iter()
+                .map(|f| f.printed())
+                .collect::<Vec<_>>(),
         ),
         electrical_endurance: d.electrical_endurance.clone(),
     }

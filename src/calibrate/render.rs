@@ -107,10 +107,11 @@ pub fn table(report: &FitReport) -> String {
         let _ = write!(out, "{}", breaking_rows(&b.rows));
         let _ = writeln!(
             out,
-            "arc fitted at the full gap {}: field {}, low-current term {} (rms of ln(model/printed) {:.4})",
+            "arc fitted at the full gap {}: field {}, low-current term C {} + D {}·gap (rms of ln(model/printed) {:.4})",
             engineering(b.gap, "m"),
             engineering(b.field, "V/m"),
             engineering(b.low_current, "V·A"),
+            engineering(b.low_current_gap, "V·A/m"),
             b.rms_log_error
         );
     }

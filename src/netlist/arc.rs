@@ -134,6 +134,13 @@ fn arc_into(
             format_time(model.low_current_gap)
         ),
     );
+    if model.capacitance > 0.0 {
+        // The electrodes' own capacitance, outside the sensed arc current.
+        line(
+            &mut arc,
+            &format!("Cgap a b {}", format_time(model.capacitance)),
+        );
+    }
     line(&mut arc, "Vsense a ai 0");
     line(&mut arc, &format!("Xcore ai b {subckt}_core"));
     line(&mut arc, "Vclamp ai ac 0");
@@ -286,11 +293,24 @@ mod tests {
             opening_speed: 0.3,
             low_current: 0.0,
             low_current_gap: 0.0,
+            capacitance: 1e-12,
         };
         let gap = GapProfile::from_samples([(0.0, 1e-3), (1e-3, 0.0), (2e-3, 0.0), (3e-3, 2e-4)]);
         let plain = include();
+        let without = with_arc(
+            plain.clone(),
+            &ArcModel {
+                capacitance: 0.0,
+                ..arc
+            },
+            &gap,
+        )
+        .unwrap();
+        assert!(!without.text.contains("Cgap"));
         let with = with_arc(plain.clone(), &arc, &gap).unwrap();
         let text = &with.text;
+        // The electrodes' own capacitance, across the pins.
+        assert!(text.contains("Cgap a b 1e-12\n"), "{text}");
         // The contact first with pins a b; the plain contact after it.
         let outer = text
             .find(".subckt CONTACT a b\n")

@@ -573,9 +573,22 @@ fn probe_row(label: &str, a: &ProbeAnalysis) -> [String; 10] {
         time(a.shortest_pulse),
         time(a.debounce.map(|d| d.lockout)),
         time(a.debounce.map(|d| d.stable_for)),
-        engineering(a.min, unit),
-        engineering(a.max, unit),
+        with_and_without(a.min, a.min_without_ringing, unit),
+        with_and_without(a.max, a.max_without_ringing, unit),
     ]
+}
+
+/// An extreme of every sample, and beside it, when it differs, the same
+/// extreme without the integrator's ringing: `-157 mV (16 µV w/o ringing)`.
+fn with_and_without(all: f64, without: Option<f64>, unit: &str) -> String {
+    match without {
+        Some(w) => format!(
+            "{} ({} w/o ringing)",
+            engineering(all, unit),
+            engineering(w, unit)
+        ),
+        None => engineering(all, unit),
+    }
 }
 
 /// What the ending means, in words; at the end of time, what is true

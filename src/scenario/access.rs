@@ -110,13 +110,14 @@ macro_rules! number_field {
             "simulation.min_open_time" => Field::Plain($($r)* s.simulation.min_open_time),
             "simulation.min_gap" => Field::Plain($($r)* s.simulation.min_gap),
             "arc.v_min" | "arc.i_min" | "arc.field" | "arc.opening_speed" | "arc.low_current"
-            | "arc.low_current_gap" => match $($r)* s.arc {
+            | "arc.low_current_gap" | "arc.capacitance" => match $($r)* s.arc {
                 Some(a) => Field::Optional(match $key {
                     "arc.v_min" => $($r)* a.v_min,
                     "arc.i_min" => $($r)* a.i_min,
                     "arc.field" => $($r)* a.field,
                     "arc.low_current" => $($r)* a.low_current,
                     "arc.low_current_gap" => $($r)* a.low_current_gap,
+                    "arc.capacitance" => $($r)* a.capacitance,
                     _ => $($r)* a.opening_speed,
                 }),
                 None => Field::NoSection("[arc]"),

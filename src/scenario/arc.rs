@@ -46,6 +46,13 @@ impl Check<'_> {
                 a.low_current_gap.is_some_and(|v| v >= 0.0),
                 "must be ≥ 0: the growth D of the low-current term with the gap, in V·A/m",
             ),
+            (
+                "arc.capacitance",
+                a.capacitance,
+                a.capacitance.is_some_and(|v| (0.0..=1e-6).contains(&v)),
+                "must be ≥ 0 and at most 1 µF: the open contact's own capacitance, in F \
+                 (about 1 pF; 0 leaves it out)",
+            ),
         ] {
             if let Some(v) = value {
                 self.number(key, v, ok, requirement)?;

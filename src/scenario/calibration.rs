@@ -65,6 +65,16 @@ pub struct BreakingFigure {
     pub current: f64,
 }
 
+impl BreakingFigure {
+    /// The figure as the breaking fit reads it.
+    pub fn printed(&self) -> crate::arc::breaking::PrintedBreak {
+        crate::arc::breaking::PrintedBreak {
+            voltage: self.voltage,
+            current: self.current,
+        }
+    }
+}
+
 impl DatasheetSection {
     /// The figures given, by key, in a fixed order: coil resistance,
     /// pick-up, drop-out, operate, bounce, release.
@@ -213,10 +223,36 @@ impl super::check::Check<'_> {
                 "must be > 0: the nominal coil voltage, in V",
             )?;
         }
+        for (k, f) in d.electrical_endurance.iter().enumerate() {
+            let key = |what: &str| format!("datasheet.electrical_endurance[{k}].{what}");
+            for (what, value, unit) in [
+                ("operations", f.operations, "operations"),
+                ("voltage", f.voltage, "V"),
+                ("current", f.current, "A"),
+            ] {
+                self.number(
+                    &key(what),
+                    value,
+                    value > 0.0,
+                    format!("must be > 0 (in {unit}): the printed endurance figure's {what}"),
+                )?;
+            }
+            if let Some(h) = f.frequency {
+                if f.supply == crate::life::Supply::Dc {
+                    return Err(self.invalid(
+                        &key("frequency"),
+                        h,
+                        "a DC endurance figure has no frequency: remove it, or write \
+                         supply = \"ac\" if the figure is for an AC supply",
+                    ));
+                }
+                self.number(&key("frequency"), h, h > 0.0, "must be > 0 Hz")?;
+            }
+        }
         for (k, f) in d.dc_breaking.iter().enumerate() {
             for (what, value) in [("voltage", f.voltage), ("current", f.current)] {
                 self.number(
-                    "datasheet.dc_breaking",
+                    &format!("datasheet.dc_breaking[{k}].{what}"),
                     value,
                     value > 0.0,
                     format!(

@@ -54,6 +54,7 @@ pub const NUMBER_KEYS: &[&str] = &[
     "arc.opening_speed",
     "arc.low_current",
     "arc.low_current_gap",
+    "arc.capacitance",
 ];
 
 /// The unit of number key `key` (one of [`NUMBER_KEYS`] or `probe[N].low`
@@ -119,6 +120,7 @@ pub const ENVELOPE: &[(&str, f64, f64, &str)] = &[
     ("arc.opening_speed", 0.0, 1e3, "m/s"),
     ("arc.low_current", 0.0, 1e6, "V·A"),
     ("arc.low_current_gap", 0.0, 1e10, "V·A/m"),
+    ("arc.capacitance", 0.0, 1e-6, "F"),
 ];
 
 /// Number keys under this prefix name a `.param` of the netlist.

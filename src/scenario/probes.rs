@@ -45,6 +45,12 @@ pub struct Probe {
     /// debouncer that waits for a stable input for T needs T > stable_for).
     #[serde(default)]
     pub max_stable_for: Option<f64>,
+    /// Hold `max_peak`, `max_value` and `min_value` against the range
+    /// without the integrator's ringing right after a contact edge
+    /// (samples that alternate from one time point to the next), instead
+    /// of against every sample (the default).
+    #[serde(default)]
+    pub ignore_ringing: bool,
 }
 
 impl Probe {

@@ -296,18 +296,22 @@ fn power_parts_break_what_their_datasheets_print() {
     let text = part
         .scenario
         .replace("field = ", "# field = ")
-        .replace("low_current = ", "# low_current = ");
+        .replace("low_current_gap = ", "# low_current_gap = ");
     assert!(text.contains("current = 0.3\n"));
     let prior = dir.path().join("prior.toml");
     std::fs::write(&prior, &text).unwrap();
     let defaults = Scenario::load(&prior).unwrap().arc.unwrap().model();
     assert_eq!(defaults.low_current, chatterspice::arc::DEFAULT_LOW_CURRENT);
+    assert_eq!(
+        defaults.low_current_gap,
+        chatterspice::arc::DEFAULT_LOW_CURRENT_GAP
+    );
     let fitted = dir.path().join("fitted.toml");
     let out = Command::cargo_bin("chatterspice")
         .unwrap()
         .args(["fit"])
         .arg(&prior)
-        .args(["--free", "arc.field,arc.low_current", "-o"])
+        .args(["--free", "arc.field,arc.low_current_gap", "-o"])
         .arg(&fitted)
         .output()
         .unwrap();
@@ -318,12 +322,16 @@ fn power_parts_break_what_their_datasheets_print() {
     );
     let model = Scenario::load(&fitted).unwrap().arc.unwrap().model();
     // The three figures lie on one tangent curve: a = 21.0 V, K = 5.40 V·A
-    // at the 0.3 mm gap.
+    // at the 0.3 mm gap, read as D·gap (C stays 0).
     assert!(
         (model.arc_voltage(0.3e-3) / 21.0 - 1.0).abs() < 2e-3,
         "{model:?}"
     );
-    assert!((model.low_current / 5.40 - 1.0).abs() < 2e-3, "{model:?}");
+    assert!(
+        (model.low_current_term(0.3e-3) / 5.40 - 1.0).abs() < 2e-3,
+        "{model:?}"
+    );
+    assert_eq!(model.low_current, 0.0, "{model:?}");
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         stdout.contains("dc_breaking") && stdout.contains("arc.field"),
@@ -331,7 +339,7 @@ fn power_parts_break_what_their_datasheets_print() {
     );
     // The mechanics' provenance is kept, the arc's added.
     let written = std::fs::read_to_string(&fitted).unwrap();
-    assert!(written.contains("mechanics.mass") && written.contains("\"arc.low_current\""));
+    assert!(written.contains("mechanics.mass") && written.contains("\"arc.low_current_gap\""));
 
     // A figure that is not a number a datasheet prints names its key.
     let bad = dir.path().join("bad.toml");
@@ -340,13 +348,15 @@ fn power_parts_break_what_their_datasheets_print() {
         .unwrap()
         .args(["fit"])
         .arg(&bad)
-        .args(["--free", "arc.low_current"])
+        .args(["--free", "arc.low_current_gap"])
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        stderr.contains("datasheet.dc_breaking") && stderr.contains("figure 2"),
+        stderr.contains("bad.toml:")
+            && stderr.contains("].current` = -0.3")
+            && stderr.contains("must be > 0"),
         "{stderr}"
     );
     // Arc keys without a breaking curve: told what to add.

@@ -482,7 +482,7 @@ fn life_calibrates_on_one_figure_and_predicts_the_others() {
     let netlist = dir.path().join("load.cir");
     std::fs::write(
         &netlist,
-        "30 V, 6 ohm\nV1 vcc 0 30\nR1 vcc a 6\nX1 a 0 CONTACT\n.tran 1u 20m 0 2u\n.end\n",
+        "30 V, 30 ohm\nV1 vcc 0 30\nR1 vcc a 30\nX1 a 0 CONTACT\n.tran 1u 20m 0 2u\n.end\n",
     )
     .unwrap();
     let base = chatterspice::scenario::DEFAULT_SCENARIO_TOML;
@@ -490,8 +490,8 @@ fn life_calibrates_on_one_figure_and_predicts_the_others() {
     let text = format!(
         "{}[circuit]\nnetlist = {:?}\n\n[arc]\nmaterial = \"Ag\"\n\n[datasheet]\n\
          electrical_endurance = [\n\
-           {{ operations = 1.0e5, voltage = 30.0, current = 5.0, supply = \"dc\" }},\n\
-           {{ operations = 4.0e5, voltage = 30.0, current = 5.0, supply = \"dc\" }},\n\
+           {{ operations = 1.0e5, voltage = 30.0, current = 1.0, supply = \"dc\" }},\n\
+           {{ operations = 4.0e5, voltage = 30.0, current = 1.0, supply = \"dc\" }},\n\
            {{ operations = 5.0e4, voltage = 125.0, current = 10.0, supply = \"ac\", frequency = 60.0 }},\n\
          ]\nweibull_shape = 2.0\n",
         &base[..cut],
@@ -525,7 +525,7 @@ fn life_calibrates_on_one_figure_and_predicts_the_others() {
     assert!((figures[1]["ratio"].as_f64().unwrap() - 0.25).abs() < 1e-9);
     assert_eq!(figures[0]["phases"], 1);
     assert_eq!(figures[2]["phases"], 4);
-    // 10 A at 125 V AC burns far longer than 5 A at 30 V DC breaks.
+    // 10 A at 125 V AC burns far longer than 1 A at 30 V DC breaks.
     assert!(
         figures[2]["energy_per_operation"].as_f64().unwrap() > 10.0 * e1,
         "{doc}"
