@@ -264,12 +264,23 @@ pub fn relay_checks(
     let never = |what: &str| format!("the contact {what} ({})", chatter.outcome);
     let first = chatter.first_impact.ok_or_else(|| never("never touches"));
     // Closing times from each operation's own t = 0 (coil on, or the
-    // force step), the longest of all operations.
+    // force step), the longest of all operations. A re-closure with the
+    // coil off has no energisation to time an operate or settle time
+    // from; its bounces count like any closing's.
     let closings = Closing::all(chatter, operations);
-    let longest = |get: fn(&Closing) -> Option<f64>, what: &str| {
+    let numbered = |k: usize, what: &str| {
+        if operations.len() > 1 {
+            format!("operation {}: the contact {what}", k + 1)
+        } else {
+            never(what)
+        }
+    };
+    let longest = |get: fn(&Closing) -> Option<f64>, what: &str, reclosures: bool| {
         closings
             .iter()
-            .map(|c| get(c).ok_or_else(|| never(what)))
+            .enumerate()
+            .filter(|(k, _)| reclosures || !operations.get(*k).is_some_and(Operation::is_reclosure))
+            .map(|(k, c)| get(c).ok_or_else(|| numbered(k, what)))
             .reduce(|a, b| match (a, b) {
                 (Ok(a), Ok(b)) => Ok(a.max(b)),
                 (Err(e), _) | (_, Err(e)) => Err(e),
@@ -290,9 +301,28 @@ pub fn relay_checks(
             })
             .unwrap_or_else(|| Err(never("never closes for good")))
     };
-    let operate = longest(|c| c.operate_time, "never touches");
-    let settle = longest(|c| c.settle_time, "never closes for good");
-    let bounce_time = longest(|c| c.bounce_time, "never closes for good");
+    let operate = longest(|c| c.operate_time, "never touches", false);
+    let settle = longest(|c| c.settle_time, "never closes for good", false);
+    let bounce_time = longest(|c| c.bounce_time, "never closes for good", true);
+    // Bounces: the most of any operation's closing (re-closures included).
+    let bounces = if operations.is_empty() {
+        first.clone().map(|_| chatter.bounce_count as f64)
+    } else {
+        operations
+            .iter()
+            .enumerate()
+            .map(|(k, op)| {
+                op.stroke
+                    .first_make
+                    .map(|_| op.stroke.bounces as f64)
+                    .ok_or_else(|| numbered(k, "never touches"))
+            })
+            .reduce(|a, b| match (a, b) {
+                (Ok(a), Ok(b)) => Ok(a.max(b)),
+                (Err(e), _) | (_, Err(e)) => Err(e),
+            })
+            .unwrap_or_else(|| Err(never("never touches")))
+    };
     let mut out = Vec::new();
     if let Some(limit) = limits.max_bounces {
         out.push(LimitCheck::new(
@@ -301,7 +331,7 @@ pub fn relay_checks(
             "",
             Bound::Max,
             limit as f64,
-            first.clone().map(|_| chatter.bounce_count as f64),
+            bounces,
         ));
     }
     if let Some(limit) = limits.max_bounce_time {
@@ -368,9 +398,14 @@ pub fn relay_checks(
         release_unevaluated(operations, what)?;
         let values: Vec<f64> = operations.iter().filter_map(get).collect();
         if values.is_empty() {
+            let why = if what == "release" {
+                "the contact never broke after the coil went off"
+            } else {
+                "the armature is not back on its rest stop before the run ends"
+            };
             Err(format!(
-                "not evaluated: no {what} in the run (the contact never broke after the coil \
-                 went off)"
+                "not evaluated: no {what} in the run ({why}; raise `simulation.t_end` and the \
+                 `.tran` stop time)"
             ))
         } else {
             Ok(values.into_iter().fold(f64::NEG_INFINITY, f64::max))
@@ -429,9 +464,9 @@ fn release_unevaluated(operations: &[Operation], what: &str) -> Result<(), Strin
         .find(|op| op.coil_off.is_some() && op.release_time.is_none())
     {
         return Err(format!(
-            "not evaluated: the coil goes off at {} s but the run ends before the contact \
+            "not evaluated: the coil goes off at {} but the run ends before the contact \
              breaks; raise `simulation.t_end` (and the `.tran` stop time) past the release",
-            op.coil_off.unwrap_or_default()
+            crate::report::units::engineering(op.coil_off.unwrap_or_default(), "s")
         ));
     }
     Ok(())
@@ -594,10 +629,12 @@ pub fn arc_checks(
     let burning = arcs.and_then(|a| a.totals.still_burning.as_ref());
     let missing = || match burning {
         Some(b) => format!(
-            "the arc at {} still burns when the run ends, after {} s and {} J: the contact \
+            "the arc at {} still burns when the run ends, after {} and {}: the contact \
              does not break this load within the run (extend the `.tran` stop time to see \
              whether it ever does)",
-            b.opening, b.duration, b.energy
+            b.opening,
+            crate::report::units::engineering(b.duration, "s"),
+            crate::report::units::engineering(b.energy, "J")
         ),
         None => missing(),
     };
@@ -933,7 +970,7 @@ mod tests {
             on: vec![0.0, 20e-3],
             off: vec![10e-3, 28e-3],
         };
-        let ops = operations(&[stroke(1e-3, 2), stroke(21e-3, 4)], &switching);
+        let ops = operations(&[stroke(1e-3, 2), stroke(21e-3, 4)], &[], &switching);
         let limits = LimitsSection {
             max_release_time: Some(3e-3),
             max_nc_bounce_time: Some(3e-3),

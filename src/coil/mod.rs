@@ -56,4 +56,4 @@ pub use direct::{
     CoilEvents, CoilRun, CoilState, EnergyBalance, PullInDip, Source, simulate_direct,
 };
 pub use magnet::{Coil, CoilError, MU0};
-pub use timing::{Closing, Operation, Switching, operations};
+pub use timing::{Closing, CoilLevels, Operation, Switching, operations};

@@ -34,10 +34,11 @@ use crate::arc::ArcVectors;
 use crate::arc::GapProfile;
 use crate::chatter::{Chatter, ContactState, Interval};
 use crate::coil::accelerate::{CircuitRun, CouplingTolerances, settle};
+use crate::coil::pick_up::{LoadLine, drop_out, pick_up};
 #[cfg(test)]
 use crate::coil::samples::interpolate_at;
 use crate::coil::samples::{Interpolator, back_of, event_change, thin};
-use crate::coil::timing::{Operation, Switching, operations};
+use crate::coil::timing::{CoilLevels, Operation, Switching, operations};
 use crate::coil::{Coil, CoilError};
 use crate::mechanics::Mechanics;
 use crate::mechanics::Trajectory;
@@ -173,6 +174,8 @@ pub struct Coupled {
     pub back: Chatter,
     /// The coil switching found in the circuit.
     pub switching: Switching,
+    /// The levels the coil's drive was read against (drop-out, pick-up).
+    pub levels: CoilLevels,
     /// Each stroke with its timing.
     pub operations: Vec<Operation>,
     /// (s, m): the armature's path.
@@ -379,6 +382,7 @@ pub fn run_coupled_plan(
             path: origin.clone(),
         })?;
     let coil = Coil::from(section);
+    let levels = coil_levels(scenario, &coil);
     let circuit = scenario
         .circuit
         .as_ref()
@@ -552,9 +556,10 @@ pub fn run_coupled_plan(
                 }];
                 let thinning = options.path_tolerance * (coil.air_gap + coil.iron_gap);
                 let (chatter, back, path, strokes, pole_face) = records(cycle, thinning);
-                let switching = switching_of(&plot, &volts, &current, 1)?;
+                let switching = switching_of(&plot, &volts, &levels, 1)?;
                 return Ok(Coupled {
-                    operations: operations(&strokes, &switching),
+                    operations: operations(&strokes, &chatter.impacts, &switching),
+                    levels,
                     switching,
                     chatter,
                     back,
@@ -734,9 +739,10 @@ pub fn run_coupled_plan(
             continue;
         };
         if converged {
-            let switching = switching_of(&plot, &volts, &current, iteration)?;
+            let switching = switching_of(&plot, &volts, &levels, iteration)?;
             return Ok(Coupled {
-                operations: operations(&strokes, &switching),
+                operations: operations(&strokes, &chatter.impacts, &switching),
+                levels,
                 switching,
                 chatter,
                 back,
@@ -759,12 +765,24 @@ pub fn run_coupled_plan(
     })
 }
 
+/// The levels `coil`'s drive is read against: the drop-out and pick-up
+/// voltages of the relay of `scenario` (its magnet against its load line),
+/// and the coil's L/R with the armature open.
+pub fn coil_levels(scenario: &Scenario, coil: &Coil) -> CoilLevels {
+    let line = LoadLine::of_relay(&scenario.armature(), &scenario.two_stage());
+    CoilLevels {
+        drop_out_voltage: drop_out(coil, &line).voltage,
+        pick_up_voltage: pick_up(coil, &line).voltage,
+        time_constant: coil.inductance(0.0) / coil.resistance,
+    }
+}
+
 /// The coil's switching in `plot`, read from the voltage across it
-/// (`volts`) and its current (`current`), of ngspice run `iteration`.
+/// (`volts`) against `levels`, of ngspice run `iteration`.
 fn switching_of(
     plot: &Plot,
     volts: &str,
-    current: &str,
+    levels: &CoilLevels,
     iteration: usize,
 ) -> Result<Switching, CouplingError> {
     let vector = |name: &str| {
@@ -779,7 +797,7 @@ fn switching_of(
             vector: "time".to_owned(),
         });
     };
-    Ok(Switching::from_coil(time, vector(volts)?, vector(current)?))
+    Ok(Switching::from_coil(time, vector(volts)?, levels))
 }
 
 /// The shared library to run a lock-step coupling with, or why not (a

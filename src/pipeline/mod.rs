@@ -264,6 +264,9 @@ pub struct RunResult {
     /// For a coil-driven relay: each operation (closing and release) with
     /// its timing. Empty for a step force.
     pub operations: Vec<Operation>,
+    /// For a coil-driven relay: the drop-out and pick-up levels its coil's
+    /// drive was read against.
+    pub coil_levels: Option<crate::coil::CoilLevels>,
     /// With `[arc]`: every arc and breakdown at the contact.
     pub arcs: Option<ArcReport>,
     /// With `[pole_face]`: the armature's impacts on the pole face (the
@@ -654,6 +657,7 @@ fn run_chatter(
     Ok(RunResult {
         coupling: None,
         operations: Vec::new(),
+        coil_levels: None,
         pole_face: None,
         makes,
         life: None,
@@ -789,6 +793,12 @@ fn run_coil(plan: &Plan, runner: &dyn Runner, options: &RunOptions) -> Result<Ru
         .map(ToString::to_string)
         .collect();
     warnings.extend(coupled.fallback.clone());
+    warnings.extend(
+        coupled
+            .operations
+            .iter()
+            .filter_map(crate::coil::Operation::reclosure_warning),
+    );
     if let Some(text) = netlist_text {
         warnings.extend(arc_warnings(
             scenario,
@@ -838,6 +848,7 @@ fn run_coil(plan: &Plan, runner: &dyn Runner, options: &RunOptions) -> Result<Ru
         probes,
         warnings,
         coupling: Some(coupled.iterations),
+        coil_levels: Some(coupled.levels),
         operations: coupled.operations,
         pole_face: plan
             .two_stage()

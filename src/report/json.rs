@@ -144,6 +144,10 @@ pub struct RunJson<'a> {
     /// Each closing and release of a coil-driven relay, with its timing.
     #[serde(skip_serializing_if = "<[_]>::is_empty")]
     operations: &'a [Operation],
+    /// The drop-out and pick-up levels a coil-driven relay's drive was
+    /// read against, with the coil's time constant.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    coil_levels: Option<&'a crate::coil::CoilLevels>,
     /// The first closing's operate, bounce and settle time, from the
     /// coil being energized (or the force step).
     timing: Closing,
@@ -242,6 +246,7 @@ impl<'a> RunJson<'a> {
             warnings: &run.warnings,
             coupling: run.coupling.as_deref(),
             operations: &run.operations,
+            coil_levels: run.coil_levels.as_ref(),
             timing: Closing::first(&run.chatter, &run.operations),
             arcs: run.arcs.as_ref().map(|a| a.arcs.as_slice()),
             arc_totals: run.arcs.as_ref().map(|a| &a.totals),

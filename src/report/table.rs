@@ -200,6 +200,23 @@ fn run_lines(run: &RunResult) -> Vec<(&'static str, String)> {
 fn relay_line(run: &RunResult) -> String {
     let c = &run.chatter;
     let closing = Closing::first(c, &run.operations);
+    // A coil-driven relay: its first operation's closing, which ends when
+    // the coil goes off whatever the run does after.
+    if let Some(op) = run.operations.first().filter(|op| op.coil_off.is_some()) {
+        if let (Some(operate), Some(settle)) = (op.operate_time, op.settle_time) {
+            return format!(
+                "{} bounce{}, closed for good until the coil went off at {}; operate {}, bounce \
+                 time {}, closed for good {}{}",
+                op.stroke.bounces,
+                if op.stroke.bounces == 1 { "" } else { "s" },
+                ms(op.coil_off),
+                ms(Some(operate)),
+                ms(Some(settle - operate)),
+                ms(Some(settle)),
+                from_coil_on(&closing),
+            );
+        }
+    }
     match (closing.operate_time, closing.settle_time) {
         (Some(operate), Some(settle)) => format!(
             "{} bounce{}, {} ({}); operate {}, bounce time {}, closed for good {}{}",
@@ -486,11 +503,15 @@ pub fn render_check_of(
         verdict.checks.len()
     );
     let closing = Closing::first(chatter, operations);
+    let (outcome, bounces) = match operations.first() {
+        Some(op) => (op.outcome(chatter.outcome), op.stroke.bounces),
+        None => (chatter.outcome, chatter.bounce_count),
+    };
     let _ = writeln!(
         out,
         "{label}: {}, {} bounces, operate {}, bounce time {}, closed for good {}{}",
-        chatter.outcome,
-        chatter.bounce_count,
+        outcome,
+        bounces,
         ms(closing.operate_time),
         ms(closing.bounce_time),
         ms(closing.settle_time),
@@ -701,8 +722,18 @@ fn from_coil_on(closing: &Closing) -> String {
 /// contacts answered, times from the coil's switching.
 fn operation_line(number: usize, op: &Operation) -> String {
     let time = |t: Option<f64>| t.map_or_else(|| "-".to_owned(), |t| engineering(t, "s"));
-    let mut line = format!("operation {number}: coil on {}", time(op.coil_on));
     let s = &op.stroke;
+    if let Some(after) = op.recloses_after {
+        return format!(
+            "operation {number}: re-closure with the coil off, {} after the release: makes at \
+             {}, {} bounces in {}",
+            time(Some(after)),
+            time(s.first_make),
+            s.bounces,
+            time(op.bounce_time)
+        );
+    }
+    let mut line = format!("operation {number}: coil on {}", time(op.coil_on));
     if s.first_make.is_some() {
         let _ = write!(
             line,
@@ -718,13 +749,21 @@ fn operation_line(number: usize, op: &Operation) -> String {
     if let Some(off) = op.coil_off {
         let _ = write!(
             line,
-            "; coil off {}, release +{}, NC make +{} ({} bounces in {})",
+            "; coil off {}, release +{}",
             time(Some(off)),
-            time(op.release_time),
-            time(op.nc_make_time),
-            s.back_bounces,
-            time(op.nc_bounce_time)
+            time(op.release_time)
         );
+        if op.nc_make_time.is_some() {
+            let _ = write!(
+                line,
+                ", NC make +{} ({} bounces in {})",
+                time(op.nc_make_time),
+                s.back_bounces,
+                time(op.nc_bounce_time)
+            );
+        } else if op.release_time.is_some() {
+            line.push_str(", not back on its rest stop before it closes again or the run ends");
+        }
     }
     line
 }

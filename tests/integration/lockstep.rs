@@ -104,6 +104,7 @@ macro_rules! examples {
 examples! {
     lock_step_agrees_with_the_passes_on_relay_driver: "relay-driver.toml",
     lock_step_agrees_with_the_passes_on_relay_driver_zener: "relay-driver-zener.toml",
+    lock_step_agrees_with_the_passes_on_relay_driver_snubber: "relay-driver-snubber.toml",
     lock_step_agrees_with_the_passes_on_solenoid: "solenoid.toml",
     lock_step_agrees_with_the_passes_on_mains_heater: "mains-heater.toml",
     lock_step_agrees_with_the_passes_on_dc_break: "dc-break.toml",

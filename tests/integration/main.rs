@@ -23,6 +23,7 @@ mod coil_netlist;
 mod coil_release;
 mod coupling_accelerated;
 mod differential;
+mod drivers;
 mod envelope;
 mod extremes;
 mod fit;

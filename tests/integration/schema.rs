@@ -573,8 +573,8 @@ fn life_calibrates_on_one_figure_and_predicts_the_others() {
     // Bad figures: exit 2, naming what to fix.
     for (bad, says) in [
         (
-            text.replacen("current = 5.0, supply", "current = -5.0, supply", 1),
-            "figure 1",
+            text.replacen("current = 1.0, supply", "current = -1.0, supply", 1),
+            "electrical_endurance[0].current",
         ),
         (
             text.replace("supply = \"ac\"", "supply = \"ac\", load = \"motor\""),
