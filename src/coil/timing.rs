@@ -511,15 +511,8 @@ mod tests {
 
     fn impact(at: f64, release: Option<f64>) -> Impact {
         Impact {
-            impact_time: at,
-            impact_velocity: 0.1,
             release_time: release,
-            release_velocity: None,
-            restitution: None,
-            contact_time: None,
-            peak_force: None,
-            min_force: None,
-            max_gap_after: None,
+            ..Impact::touch(at, 0.1)
         }
     }
 
