@@ -29,6 +29,7 @@ use chatterspice::report::{self, Format};
 use chatterspice::scenario::Scenario;
 use chatterspice::spice::Ngspice;
 use chatterspice::sweep::{self, Sampler, Shard, SweepMode, SweepOptions};
+use chatterspice::verdict;
 use chatterspice::waveform::{ContactModel, Waveform, read_state_csv};
 
 /// Relay contact bounce from physics, into circuit simulation.
@@ -213,36 +214,12 @@ pub struct LifeInRunArgs {
 }
 
 impl LifeInRunArgs {
-    /// The life of `scenario` at its circuit's run `own` (`None`: run the
-    /// circuit), or `None` when the scenario prints no endurance figures
-    /// or `--no-life` was given and `needed` is false. A life that is not
-    /// `needed` (for a limit) and cannot be estimated is a warning, not a
-    /// failure of the run.
-    fn estimate(
-        &self,
-        scenario: &Scenario,
-        runner: &dyn chatterspice::spice::Runner,
-        options: &RunOptions,
-        own: Option<&pipeline::RunResult>,
-        needed: bool,
-    ) -> Result<Option<chatterspice::life::LifeReport>> {
-        if !(needed || (!self.no_life && chatterspice::life::has_figures(scenario))) {
-            return Ok(None);
-        }
-        match chatterspice::life::estimate_at(
-            scenario,
-            runner,
-            options,
-            self.life_phases,
-            cpus(),
-            own,
-        ) {
-            Ok(report) => Ok(Some(report)),
-            Err(e) if !needed && chatterspice::interrupt::stopping().is_none() => {
-                eprintln!("warning: the electrical life was not estimated: {e}");
-                Ok(None)
-            }
-            Err(e) => Err(e.into()),
+    /// The life these arguments ask for.
+    fn options(&self) -> chatterspice::verdict::LifeOptions {
+        chatterspice::verdict::LifeOptions {
+            phases: self.life_phases,
+            estimate: !self.no_life,
+            ..chatterspice::verdict::LifeOptions::default()
         }
     }
 }
@@ -335,10 +312,20 @@ impl SimulatorArgs {
     /// ngspice, located and probed within `--timeout`, started as these
     /// arguments say.
     fn ngspice(&self) -> Result<Ngspice> {
+        Ok(self.locate()?)
+    }
+
+    /// ngspice as [`SimulatorArgs::ngspice`] finds it, for the library.
+    fn locate(&self) -> Result<Ngspice, chatterspice::spice::SpiceError> {
         Ok(
             Ngspice::locate_within(self.ngspice.as_deref(), self.timeout())?
                 .skip_user_init(self.no_spiceinit),
         )
+    }
+
+    /// ngspice, located when a verdict first needs it.
+    fn lazy(&self) -> chatterspice::verdict::LazyNgspice<'_> {
+        chatterspice::verdict::LazyNgspice::new(|| self.locate())
     }
 
     /// `--timeout`, which covers the version check too.
@@ -504,11 +491,6 @@ pub struct LifeArgs {
     pub simulator: SimulatorArgs,
 }
 
-/// The number of CPUs, at least 1.
-fn cpus() -> usize {
-    std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
-}
-
 fn parse_phases(text: &str) -> Result<usize, String> {
     match text.parse::<usize>() {
         Ok(n) if (2..=1024).contains(&n) => Ok(n),
@@ -521,19 +503,17 @@ fn parse_phases(text: &str) -> Result<usize, String> {
 fn life(args: &LifeArgs) -> Result<()> {
     let scenario = load_scenario(args.scenario.as_deref())?;
     let ngspice = args.simulator.ngspice()?;
-    let report = chatterspice::life::estimate(
-        &scenario,
-        &ngspice,
-        &args.simulator.run_options(),
-        args.phases,
-        args.jobs.map_or_else(cpus, std::num::NonZeroUsize::get),
-    )?;
+    let options = chatterspice::verdict::LifeOptions {
+        phases: args.phases,
+        jobs: args
+            .jobs
+            .map_or_else(verdict::cpus, std::num::NonZeroUsize::get),
+        ..chatterspice::verdict::LifeOptions::default()
+    };
+    let report =
+        chatterspice::verdict::life(&scenario, &ngspice, &args.simulator.run_options(), &options)?;
     let text = match args.format {
-        RunFormat::Json => {
-            let mut t = serde_json::to_string_pretty(&report).expect("the report serializes");
-            t.push('\n');
-            t
-        }
+        RunFormat::Json => chatterspice::verdict::life_json(&report),
         RunFormat::Table => chatterspice::life::render(&report),
     };
     emit(&text, None, false)
@@ -556,6 +536,9 @@ fn run(args: &RunArgs) -> Result<()> {
     if let Some(csv) = &args.measured {
         report::protect_input(csv);
     }
+    if args.envelope.envelope && args.measured.is_some() {
+        bail!("--envelope samples the relay's mechanics, which --measured replaces");
+    }
     let _lock = match &args.out {
         Some(dir) => {
             let lock = chatterspice::output::OutputLock::acquire(dir, "run")?;
@@ -570,47 +553,41 @@ fn run(args: &RunArgs) -> Result<()> {
         compare_ideal: !args.no_ideal,
         ..args.simulator.run_options()
     };
-    let mut result = match &args.measured {
-        Some(csv) => pipeline::run_measured(&scenario, read_measured(csv)?, &ngspice, &options)?,
-        None => pipeline::run(&scenario, &ngspice, &options)?,
-    };
-    // The electrical life at this circuit, from this run's arcs.
-    result.life = args
-        .life
-        .estimate(&scenario, &ngspice, &options, Some(&result), false)?;
-    // Shown relative to where the user is, when it is below it.
-    if let Some(relative) = std::env::current_dir()
-        .ok()
-        .and_then(|cwd| result.netlist.strip_prefix(cwd).ok().map(Path::to_path_buf))
-    {
-        result.netlist = relative;
-    }
-    let dimensionless = chatterspice::commands::dimensionless(&scenario);
+    let measured = args.measured.as_deref().map(read_measured).transpose()?;
+    let outcome = verdict::run(
+        &scenario,
+        &ngspice,
+        &options,
+        measured,
+        &args.life.options(),
+    )?;
+    let result = &outcome.result;
     for sim in std::iter::once(&result.simulation).chain(&result.ideal) {
         if let Some(dir) = &sim.workdir {
             eprintln!("ngspice work directory kept: {}", dir.display());
         }
     }
     let mut text = match args.format {
-        RunFormat::Json => report::json::render_run(&result, dimensionless.as_ref()),
-        RunFormat::Table => report::table::render_run(&result),
+        RunFormat::Json => outcome.json(),
+        RunFormat::Table => report::table::render_run_with_life(result, outcome.life.as_ref()),
     };
     if args.envelope.envelope {
-        if args.measured.is_some() {
-            bail!("--envelope samples the relay's mechanics, which --measured replaces");
-        }
-        let env = envelope::run(&scenario, Some(&ngspice), &args.envelope.options(options))?;
+        let env = verdict::run_envelope(&scenario, &ngspice, &args.envelope.options(options))?;
         text = match args.format {
             RunFormat::Json => envelope::json_with_envelope(&text, &env.report),
             RunFormat::Table => format!("{text}\n{}", envelope::band_table(&env.report)),
         };
     }
-    for warning in &result.warnings {
+    for warning in &outcome.warnings {
         eprintln!("warning: {warning}");
     }
     if let Some(dir) = &args.out {
-        let files = report::bundle::run_files(&result, dimensionless.as_ref())
-            .context("the run succeeded, but its files could not be made")?;
+        let files = report::bundle::run_files_with_life(
+            result,
+            outcome.dimensionless.as_ref(),
+            outcome.life.as_ref(),
+        )
+        .context("the run succeeded, but its files could not be made")?;
         report::write_bundle(dir, &files, args.force)?;
         warn_if_no_fonts();
     }
@@ -619,79 +596,44 @@ fn run(args: &RunArgs) -> Result<()> {
 
 fn check(args: &CheckArgs) -> Result<Status> {
     let scenario = load_scenario(args.scenario.as_deref())?;
-    let needs_ngspice =
-        chatterspice::commands::check_needs_ngspice(&scenario, args.measured.is_some());
     let options = args.simulator.run_options();
+    let ngspice = args.simulator.lazy();
     if args.envelope.envelope {
-        return check_envelope(args, &scenario, needs_ngspice, options);
+        let env = verdict::check_envelope(&scenario, &ngspice, &args.envelope.options(options))?;
+        return check_envelope(args, &env);
     }
-    let (verdict, evidence) = if let Some(csv) = &args.measured {
-        let intervals = read_measured(csv)?;
-        if needs_ngspice {
-            let ngspice = args.simulator.ngspice()?;
-            check::measured(&scenario, intervals, Some(&ngspice), &options)?
-        } else {
-            check::measured(&scenario, intervals, None, &options)?
-        }
-    } else if needs_ngspice {
-        let ngspice = args.simulator.ngspice()?;
-        check::run_with(&scenario, &ngspice, &options)?
-    } else {
-        // The relay's limits alone: no circuit, no ngspice needed.
-        check::relay_only(&scenario)?
-    };
-    // The electrical life: with [limits] min_electrical_life always, else
-    // for a scenario with endurance figures whose circuit the check ran
-    // (from that run's arcs, not a second run).
-    let limit = scenario.limits.and_then(|l| l.min_electrical_life);
-    let own = match &evidence {
-        check::Evidence::Run(run) => Some(run.as_ref()),
-        check::Evidence::Mechanics(..) => None,
-    };
-    let life = if limit.is_some() || own.is_some() {
-        let ngspice = args.simulator.ngspice()?;
-        args.life
-            .estimate(&scenario, &ngspice, &options, own, limit.is_some())?
-    } else {
-        None
-    };
-    let verdict = match (limit, &life) {
-        (Some(limit), Some(life)) => {
-            let row = chatterspice::life::limit_check(limit, life);
-            if let Some(note) = &row.note {
-                eprintln!("note: min_electrical_life: {note}");
-            }
-            let mut checks = verdict.checks;
-            checks.push(row);
-            check::Verdict::new(checks)
-        }
-        _ => verdict,
-    };
-    let dimensionless = chatterspice::commands::dimensionless(&scenario);
+    let measured = args.measured.as_deref().map(read_measured).transpose()?;
+    let outcome = verdict::check(
+        &scenario,
+        &ngspice,
+        &options,
+        measured,
+        &args.life.options(),
+    )?;
+    for note in &outcome.notes {
+        eprintln!("note: {note}");
+    }
     let text = match args.format {
-        RunFormat::Json => report::json::render_check_with_life(
-            &verdict,
-            &evidence,
-            dimensionless.as_ref(),
-            life.as_ref(),
-        ),
+        RunFormat::Json => outcome.json(),
         RunFormat::Table => {
-            let mut text =
-                report::table::render_check(&verdict, evidence.chatter(), evidence.operations());
-            if let Some(life) = &life {
+            let evidence = &outcome.evidence;
+            let mut text = report::table::render_check(
+                &outcome.verdict,
+                evidence.chatter(),
+                evidence.operations(),
+            );
+            if let Some(life) = &outcome.life {
                 text.push_str("\nelectrical life\n");
                 text.push_str(&chatterspice::life::render(life));
             }
             text
         }
     };
-    if let check::Evidence::Run(run) = &evidence {
-        for warning in &run.warnings {
-            eprintln!("warning: {warning}");
-        }
+    for warning in &outcome.warnings {
+        eprintln!("warning: {warning}");
     }
     emit(&text, None, false)?;
-    Ok(if verdict.passed {
+    Ok(if outcome.verdict.passed {
         Status::Success
     } else {
         Status::CheckFailed
@@ -700,30 +642,13 @@ fn check(args: &CheckArgs) -> Result<Status> {
 
 /// `check --envelope`: every limit against the worst relay the envelope
 /// keeps.
-fn check_envelope(
-    args: &CheckArgs,
-    scenario: &Scenario,
-    needs_ngspice: bool,
-    options: RunOptions,
-) -> Result<Status> {
-    let ngspice = if needs_ngspice {
-        Some(args.simulator.ngspice()?)
-    } else {
-        None
-    };
-    let runner = ngspice
-        .as_ref()
-        .map(|n| n as &dyn chatterspice::spice::Runner);
-    let env = envelope::run(scenario, runner, &args.envelope.options(options))?;
+fn check_envelope(args: &CheckArgs, env: &envelope::Envelope) -> Result<Status> {
     let worst = env
         .worst()
         .expect("an envelope that kept a relay has a worst one");
     let verdict = &env.verdict;
     let text = match args.format {
-        RunFormat::Json => envelope::json_with_envelope(
-            &report::json::render_check(verdict, &worst.evidence, None),
-            &env.report,
-        ),
+        RunFormat::Json => verdict::envelope_check_json(env),
         RunFormat::Table => format!(
             "{}\n{}",
             report::table::render_check_of(

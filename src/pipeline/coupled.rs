@@ -190,6 +190,8 @@ pub struct Coupled {
     pub deck: Deck,
     /// ngspice's version, e.g. `"39"`.
     pub version: Option<String>,
+    /// What ngspice printed on the last circuit run.
+    pub log: String,
     /// A relay with a pole face: the armature's impacts on it.
     pub pole_face: Vec<crate::chatter::Impact>,
     /// Why the run was coupled by passes although lock-step was asked for
@@ -564,6 +566,7 @@ pub fn run_coupled_plan(
                     iterations,
                     deck,
                     version: simulation.version,
+                    log: simulation.log,
                     pole_face,
                     fallback: None,
                 });
@@ -663,6 +666,7 @@ pub fn run_coupled_plan(
         })?;
         let ngspice_elapsed = simulation.elapsed.as_secs_f64();
         let version = simulation.version;
+        let log = simulation.log;
         let plot = simulation.plot;
         let flux = series(&plot, &psi).ok_or_else(|| CouplingError::MissingVector {
             iteration,
@@ -746,6 +750,7 @@ pub fn run_coupled_plan(
                 iterations,
                 deck,
                 version,
+                log,
                 pole_face,
                 fallback,
             });
