@@ -3,8 +3,9 @@
 //! Python package alike.
 //!
 //! The rooms below compute their parts: [`pipeline`] the run through
-//! ngspice, [`check`] the limits against a closing or a run, [`life`] the
-//! electrical life, [`envelope`] every relay the datasheet allows. This
+//! ngspice, [`check`](mod@crate::check) the limits against a closing or a
+//! run, [`life`](mod@crate::life) the electrical life, [`envelope`] every
+//! relay the datasheet allows. This
 //! layer composes them as a command does: a run with the life at its
 //! circuit, a check with `[limits] min_electrical_life` held like every
 //! other limit. The front ends only read their arguments into
