@@ -89,9 +89,22 @@ def test_check_of_every_example_is_the_cli_check(pool, path):
 
 
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
-def test_bounce_of_every_example_is_the_cli_bounce(pool, path):
-    theirs, ours = both(pool, ("bounce", path), chatterspice.bounce, path)
-    assert ours == theirs
+def test_bounce_of_every_example_is_the_cli_bounce(path):
+    done = subprocess.run(
+        [str(_cli_binary()), "bounce", str(path), "--format", "json"],
+        capture_output=True,
+        text=True,
+    )
+    if done.returncode == 2:
+        # Refused alike (a coil with no voltage of its own to close on),
+        # in the same words.
+        with pytest.raises(chatterspice.InputError) as raised:
+            chatterspice.bounce(path)
+        said = done.stderr.splitlines()[0].removeprefix("error: ")
+        assert str(raised.value).splitlines()[0] == said
+        return
+    assert done.returncode == 0, done.stderr
+    assert chatterspice.bounce(path) == json.loads(done.stdout)
 
 
 @pytest.mark.parametrize(
