@@ -27,7 +27,7 @@ from typing import (
 import numpy as np
 import numpy.typing as npt
 
-_Path = Union[str, "os.PathLike[str]"]
+_Path = Union[str, bytes, "os.PathLike[str]", "os.PathLike[bytes]"]
 _Array = npt.NDArray[Any]
 
 __all__ = [
@@ -35,6 +35,7 @@ __all__ = [
     "run",
     "check",
     "envelope",
+    "life",
     "sweep",
     "fit",
     "capture",
@@ -50,6 +51,7 @@ __all__ = [
     "InputError",
     "NgspiceError",
     "SimulationError",
+    "ChatterspiceWarning",
     "DEFAULT_SCENARIO",
     "__version__",
 ]
@@ -80,6 +82,11 @@ class SimulationError(RuntimeError):
     key: Optional[str]
     path: Optional[str]
     line: Optional[int]
+
+class ChatterspiceWarning(UserWarning):
+    """Something worth a look that did not stop the call: a run that is not
+    physical as set up, a coupling that fell back from lock-step to passes,
+    a life that could not be estimated, a remark on a limit's figure."""
 
 @final
 class Run:
@@ -270,11 +277,26 @@ def run(
     ideal: bool = True,
     timeout: float = 60.0,
     keep_workdir: bool = False,
+    element: Optional[str] = None,
+    coupling: Optional[str] = None,
+    max_iterations: int = 20,
+    coupling_tolerance: float = 1e-07,
+    ngspice: Optional[_Path] = None,
+    no_spiceinit: bool = False,
+    envelope: bool = False,
+    samples: int = 32,
+    seed: int = 1,
+    jobs: Optional[int] = None,
+    life_phases: int = 16,
+    no_life: bool = False,
 ) -> Run:
     """The relay's chatter switching the scenario's circuit in ngspice, and
-    the analysis of every probe. ``ideal=False`` skips the ideal-contact run;
+    the analysis of every probe, as ``chatterspice run``: the same options
+    with the same defaults. ``ideal=False`` skips the ideal-contact run;
     ``timeout`` bounds each ngspice run, in s; ``keep_workdir`` leaves the
-    work directories (named in the result)."""
+    work directories (named in the result); ``coupling`` is ``"lock-step"``
+    or ``"passes"`` for a coil-driven relay. Warnings are issued as
+    :class:`ChatterspiceWarning`."""
 
 def check(
     path: Optional[_Path] = None,
@@ -283,9 +305,22 @@ def check(
     origin: Optional[_Path] = None,
     measured: Optional[_Path] = None,
     timeout: float = 60.0,
+    element: Optional[str] = None,
+    coupling: Optional[str] = None,
+    max_iterations: int = 20,
+    coupling_tolerance: float = 1e-07,
+    ngspice: Optional[_Path] = None,
+    no_spiceinit: bool = False,
+    envelope: bool = False,
+    samples: int = 32,
+    seed: int = 1,
+    jobs: Optional[int] = None,
+    life_phases: int = 16,
+    no_life: bool = False,
 ) -> Dict[str, Any]:
     """The scenario's limits held against its run: the JSON of ``chatterspice
-    check --format json``; ``passed`` is False when a limit failed."""
+    check --format json``; ``passed`` is False when a limit failed (the
+    electrical life's ``min_electrical_life`` among them)."""
 
 def envelope(
     path: Optional[_Path] = None,
@@ -296,9 +331,33 @@ def envelope(
     seed: int = 1,
     jobs: Optional[int] = None,
     timeout: float = 60.0,
+    element: Optional[str] = None,
+    coupling: Optional[str] = None,
+    max_iterations: int = 20,
+    coupling_tolerance: float = 1e-07,
+    ngspice: Optional[_Path] = None,
+    no_spiceinit: bool = False,
 ) -> Dict[str, Any]:
     """Every relay the datasheet allows, each limit held against the worst:
     the JSON of ``chatterspice check --envelope --format json``."""
+
+def life(
+    path: Optional[_Path] = None,
+    *,
+    toml_text: Optional[str] = None,
+    origin: Optional[_Path] = None,
+    phases: int = 16,
+    jobs: Optional[int] = None,
+    timeout: float = 60.0,
+    element: Optional[str] = None,
+    coupling: Optional[str] = None,
+    max_iterations: int = 20,
+    coupling_tolerance: float = 1e-07,
+    ngspice: Optional[_Path] = None,
+    no_spiceinit: bool = False,
+) -> Dict[str, Any]:
+    """The contacts' electrical life from the scenario's endurance figures:
+    the JSON of ``chatterspice life --format json``."""
 
 def sweep(
     path: Optional[_Path] = None,

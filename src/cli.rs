@@ -5,7 +5,7 @@
 //! `main` turns them into a message and an exit code. To add a command,
 //! add a variant to [`Command`], its `Args` struct, and a handler.
 
-use std::io::{self, IsTerminal, Read, Write};
+use std::io::{self, Read, Write};
 use std::num::NonZeroUsize;
 use std::path::{Path, PathBuf};
 
@@ -17,6 +17,10 @@ use std::time::Duration;
 mod calibrate;
 mod capture;
 mod raw;
+mod sweeping;
+
+pub use sweeping::{MergeArgs, SweepArgs};
+use sweeping::{merge, sweep};
 
 use chatterspice::arc::GapProfile;
 use chatterspice::chatter::Chatter;
@@ -28,7 +32,7 @@ use chatterspice::pipeline::{self, RunOptions};
 use chatterspice::report::{self, Format};
 use chatterspice::scenario::Scenario;
 use chatterspice::spice::Ngspice;
-use chatterspice::sweep::{self, Sampler, Shard, SweepMode, SweepOptions};
+use chatterspice::verdict;
 use chatterspice::waveform::{ContactModel, Waveform, read_state_csv};
 
 /// Relay contact bounce from physics, into circuit simulation.
@@ -213,36 +217,12 @@ pub struct LifeInRunArgs {
 }
 
 impl LifeInRunArgs {
-    /// The life of `scenario` at its circuit's run `own` (`None`: run the
-    /// circuit), or `None` when the scenario prints no endurance figures
-    /// or `--no-life` was given and `needed` is false. A life that is not
-    /// `needed` (for a limit) and cannot be estimated is a warning, not a
-    /// failure of the run.
-    fn estimate(
-        &self,
-        scenario: &Scenario,
-        runner: &dyn chatterspice::spice::Runner,
-        options: &RunOptions,
-        own: Option<&pipeline::RunResult>,
-        needed: bool,
-    ) -> Result<Option<chatterspice::life::LifeReport>> {
-        if !(needed || (!self.no_life && chatterspice::life::has_figures(scenario))) {
-            return Ok(None);
-        }
-        match chatterspice::life::estimate_at(
-            scenario,
-            runner,
-            options,
-            self.life_phases,
-            cpus(),
-            own,
-        ) {
-            Ok(report) => Ok(Some(report)),
-            Err(e) if !needed && chatterspice::interrupt::stopping().is_none() => {
-                eprintln!("warning: the electrical life was not estimated: {e}");
-                Ok(None)
-            }
-            Err(e) => Err(e.into()),
+    /// The life these arguments ask for.
+    fn options(&self) -> chatterspice::verdict::LifeOptions {
+        chatterspice::verdict::LifeOptions {
+            phases: self.life_phases,
+            estimate: !self.no_life,
+            ..chatterspice::verdict::LifeOptions::default()
         }
     }
 }
@@ -335,10 +315,20 @@ impl SimulatorArgs {
     /// ngspice, located and probed within `--timeout`, started as these
     /// arguments say.
     fn ngspice(&self) -> Result<Ngspice> {
+        Ok(self.locate()?)
+    }
+
+    /// ngspice as [`SimulatorArgs::ngspice`] finds it, for the library.
+    fn locate(&self) -> Result<Ngspice, chatterspice::spice::SpiceError> {
         Ok(
             Ngspice::locate_within(self.ngspice.as_deref(), self.timeout())?
                 .skip_user_init(self.no_spiceinit),
         )
+    }
+
+    /// ngspice, located when a verdict first needs it.
+    fn lazy(&self) -> chatterspice::verdict::LazyNgspice<'_> {
+        chatterspice::verdict::LazyNgspice::new(|| self.locate())
     }
 
     /// `--timeout`, which covers the version check too.
@@ -504,11 +494,6 @@ pub struct LifeArgs {
     pub simulator: SimulatorArgs,
 }
 
-/// The number of CPUs, at least 1.
-fn cpus() -> usize {
-    std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
-}
-
 fn parse_phases(text: &str) -> Result<usize, String> {
     match text.parse::<usize>() {
         Ok(n) if (2..=1024).contains(&n) => Ok(n),
@@ -521,19 +506,17 @@ fn parse_phases(text: &str) -> Result<usize, String> {
 fn life(args: &LifeArgs) -> Result<()> {
     let scenario = load_scenario(args.scenario.as_deref())?;
     let ngspice = args.simulator.ngspice()?;
-    let report = chatterspice::life::estimate(
-        &scenario,
-        &ngspice,
-        &args.simulator.run_options(),
-        args.phases,
-        args.jobs.map_or_else(cpus, std::num::NonZeroUsize::get),
-    )?;
+    let options = chatterspice::verdict::LifeOptions {
+        phases: args.phases,
+        jobs: args
+            .jobs
+            .map_or_else(verdict::cpus, std::num::NonZeroUsize::get),
+        ..chatterspice::verdict::LifeOptions::default()
+    };
+    let report =
+        chatterspice::verdict::life(&scenario, &ngspice, &args.simulator.run_options(), &options)?;
     let text = match args.format {
-        RunFormat::Json => {
-            let mut t = serde_json::to_string_pretty(&report).expect("the report serializes");
-            t.push('\n');
-            t
-        }
+        RunFormat::Json => chatterspice::verdict::life_json(&report),
         RunFormat::Table => chatterspice::life::render(&report),
     };
     emit(&text, None, false)
@@ -556,6 +539,9 @@ fn run(args: &RunArgs) -> Result<()> {
     if let Some(csv) = &args.measured {
         report::protect_input(csv);
     }
+    if args.envelope.envelope && args.measured.is_some() {
+        bail!("--envelope samples the relay's mechanics, which --measured replaces");
+    }
     let _lock = match &args.out {
         Some(dir) => {
             let lock = chatterspice::output::OutputLock::acquire(dir, "run")?;
@@ -570,47 +556,41 @@ fn run(args: &RunArgs) -> Result<()> {
         compare_ideal: !args.no_ideal,
         ..args.simulator.run_options()
     };
-    let mut result = match &args.measured {
-        Some(csv) => pipeline::run_measured(&scenario, read_measured(csv)?, &ngspice, &options)?,
-        None => pipeline::run(&scenario, &ngspice, &options)?,
-    };
-    // The electrical life at this circuit, from this run's arcs.
-    result.life = args
-        .life
-        .estimate(&scenario, &ngspice, &options, Some(&result), false)?;
-    // Shown relative to where the user is, when it is below it.
-    if let Some(relative) = std::env::current_dir()
-        .ok()
-        .and_then(|cwd| result.netlist.strip_prefix(cwd).ok().map(Path::to_path_buf))
-    {
-        result.netlist = relative;
-    }
-    let dimensionless = chatterspice::commands::dimensionless(&scenario);
+    let measured = args.measured.as_deref().map(read_measured).transpose()?;
+    let outcome = verdict::run(
+        &scenario,
+        &ngspice,
+        &options,
+        measured,
+        &args.life.options(),
+    )?;
+    let result = &outcome.result;
     for sim in std::iter::once(&result.simulation).chain(&result.ideal) {
         if let Some(dir) = &sim.workdir {
             eprintln!("ngspice work directory kept: {}", dir.display());
         }
     }
     let mut text = match args.format {
-        RunFormat::Json => report::json::render_run(&result, dimensionless.as_ref()),
-        RunFormat::Table => report::table::render_run(&result),
+        RunFormat::Json => outcome.json(),
+        RunFormat::Table => report::table::render_run_with_life(result, outcome.life.as_ref()),
     };
     if args.envelope.envelope {
-        if args.measured.is_some() {
-            bail!("--envelope samples the relay's mechanics, which --measured replaces");
-        }
-        let env = envelope::run(&scenario, Some(&ngspice), &args.envelope.options(options))?;
+        let env = verdict::run_envelope(&scenario, &ngspice, &args.envelope.options(options))?;
         text = match args.format {
             RunFormat::Json => envelope::json_with_envelope(&text, &env.report),
             RunFormat::Table => format!("{text}\n{}", envelope::band_table(&env.report)),
         };
     }
-    for warning in &result.warnings {
+    for warning in &outcome.warnings {
         eprintln!("warning: {warning}");
     }
     if let Some(dir) = &args.out {
-        let files = report::bundle::run_files(&result, dimensionless.as_ref())
-            .context("the run succeeded, but its files could not be made")?;
+        let files = report::bundle::run_files_with_life(
+            result,
+            outcome.dimensionless.as_ref(),
+            outcome.life.as_ref(),
+        )
+        .context("the run succeeded, but its files could not be made")?;
         report::write_bundle(dir, &files, args.force)?;
         warn_if_no_fonts();
     }
@@ -619,79 +599,44 @@ fn run(args: &RunArgs) -> Result<()> {
 
 fn check(args: &CheckArgs) -> Result<Status> {
     let scenario = load_scenario(args.scenario.as_deref())?;
-    let needs_ngspice =
-        chatterspice::commands::check_needs_ngspice(&scenario, args.measured.is_some());
     let options = args.simulator.run_options();
+    let ngspice = args.simulator.lazy();
     if args.envelope.envelope {
-        return check_envelope(args, &scenario, needs_ngspice, options);
+        let env = verdict::check_envelope(&scenario, &ngspice, &args.envelope.options(options))?;
+        return check_envelope(args, &env);
     }
-    let (verdict, evidence) = if let Some(csv) = &args.measured {
-        let intervals = read_measured(csv)?;
-        if needs_ngspice {
-            let ngspice = args.simulator.ngspice()?;
-            check::measured(&scenario, intervals, Some(&ngspice), &options)?
-        } else {
-            check::measured(&scenario, intervals, None, &options)?
-        }
-    } else if needs_ngspice {
-        let ngspice = args.simulator.ngspice()?;
-        check::run_with(&scenario, &ngspice, &options)?
-    } else {
-        // The relay's limits alone: no circuit, no ngspice needed.
-        check::relay_only(&scenario)?
-    };
-    // The electrical life: with [limits] min_electrical_life always, else
-    // for a scenario with endurance figures whose circuit the check ran
-    // (from that run's arcs, not a second run).
-    let limit = scenario.limits.and_then(|l| l.min_electrical_life);
-    let own = match &evidence {
-        check::Evidence::Run(run) => Some(run.as_ref()),
-        check::Evidence::Mechanics(..) => None,
-    };
-    let life = if limit.is_some() || own.is_some() {
-        let ngspice = args.simulator.ngspice()?;
-        args.life
-            .estimate(&scenario, &ngspice, &options, own, limit.is_some())?
-    } else {
-        None
-    };
-    let verdict = match (limit, &life) {
-        (Some(limit), Some(life)) => {
-            let row = chatterspice::life::limit_check(limit, life);
-            if let Some(note) = &row.note {
-                eprintln!("note: min_electrical_life: {note}");
-            }
-            let mut checks = verdict.checks;
-            checks.push(row);
-            check::Verdict::new(checks)
-        }
-        _ => verdict,
-    };
-    let dimensionless = chatterspice::commands::dimensionless(&scenario);
+    let measured = args.measured.as_deref().map(read_measured).transpose()?;
+    let outcome = verdict::check(
+        &scenario,
+        &ngspice,
+        &options,
+        measured,
+        &args.life.options(),
+    )?;
+    for note in &outcome.notes {
+        eprintln!("note: {note}");
+    }
     let text = match args.format {
-        RunFormat::Json => report::json::render_check_with_life(
-            &verdict,
-            &evidence,
-            dimensionless.as_ref(),
-            life.as_ref(),
-        ),
+        RunFormat::Json => outcome.json(),
         RunFormat::Table => {
-            let mut text =
-                report::table::render_check(&verdict, evidence.chatter(), evidence.operations());
-            if let Some(life) = &life {
+            let evidence = &outcome.evidence;
+            let mut text = report::table::render_check(
+                &outcome.verdict,
+                evidence.chatter(),
+                evidence.operations(),
+            );
+            if let Some(life) = &outcome.life {
                 text.push_str("\nelectrical life\n");
                 text.push_str(&chatterspice::life::render(life));
             }
             text
         }
     };
-    if let check::Evidence::Run(run) = &evidence {
-        for warning in &run.warnings {
-            eprintln!("warning: {warning}");
-        }
+    for warning in &outcome.warnings {
+        eprintln!("warning: {warning}");
     }
     emit(&text, None, false)?;
-    Ok(if verdict.passed {
+    Ok(if outcome.verdict.passed {
         Status::Success
     } else {
         Status::CheckFailed
@@ -700,30 +645,13 @@ fn check(args: &CheckArgs) -> Result<Status> {
 
 /// `check --envelope`: every limit against the worst relay the envelope
 /// keeps.
-fn check_envelope(
-    args: &CheckArgs,
-    scenario: &Scenario,
-    needs_ngspice: bool,
-    options: RunOptions,
-) -> Result<Status> {
-    let ngspice = if needs_ngspice {
-        Some(args.simulator.ngspice()?)
-    } else {
-        None
-    };
-    let runner = ngspice
-        .as_ref()
-        .map(|n| n as &dyn chatterspice::spice::Runner);
-    let env = envelope::run(scenario, runner, &args.envelope.options(options))?;
+fn check_envelope(args: &CheckArgs, env: &envelope::Envelope) -> Result<Status> {
     let worst = env
         .worst()
         .expect("an envelope that kept a relay has a worst one");
     let verdict = &env.verdict;
     let text = match args.format {
-        RunFormat::Json => envelope::json_with_envelope(
-            &report::json::render_check(verdict, &worst.evidence, None),
-            &env.report,
-        ),
+        RunFormat::Json => verdict::envelope_check_json(env),
         RunFormat::Table => format!(
             "{}\n{}",
             report::table::render_check_of(
@@ -927,481 +855,4 @@ fn emit(text: &str, output: Option<&Path>, force: bool) -> Result<()> {
             }
         }
     }
-}
-
-#[derive(Debug, Args)]
-pub struct SweepArgs {
-    /// Scenario file (TOML) with a [sweep] section; `-` reads it from stdin.
-    #[arg(value_name = "SCENARIO")]
-    pub scenario: PathBuf,
-
-    /// Random samples to run [default: `sweep.samples`, else 100]. Not
-    /// with a [sweep.grid], which runs each of its points.
-    #[arg(long, value_name = "N")]
-    pub samples: Option<u64>,
-
-    /// Seed of the random draws [default: `sweep.seed`, else 0].
-    #[arg(long, value_name = "S")]
-    pub seed: Option<u64>,
-
-    /// Samples run at once [default: one per core]. With ngspice, each
-    /// sample is one ngspice process: J is the most ngspice processes at
-    /// once.
-    #[arg(short = 'j', long, value_name = "J")]
-    pub jobs: Option<NonZeroUsize>,
-
-    /// Directory for sweep.csv, summary.json, sweep.svg and sweep.png (created if
-    /// needed) [default: the current directory]. Existing files there are
-    /// an error unless --force.
-    #[arg(long, value_name = "DIR", conflicts_with = "resume")]
-    pub out: Option<PathBuf>,
-
-    /// Continue the sweep interrupted in DIR (by Ctrl-C or a signal) from
-    /// its finished rows: the scenario, seed, sample count, shard and
-    /// options must be the same (checked against DIR's sweep.meta.json);
-    /// the files written are those of an uninterrupted run.
-    #[arg(long, value_name = "DIR", conflicts_with = "force")]
-    pub resume: Option<PathBuf>,
-
-    /// Simulate the mechanics only (bounces and times, no circuit, no
-    /// ngspice): microseconds per sample. A coil-driven relay closes on the
-    /// ideal DC step of its coil (`coil.drive_voltage`, else
-    /// `datasheet.coil_voltage`), as `bounce` and `check` simulate it.
-    #[arg(long)]
-    pub mechanics_only: bool,
-
-    /// Run only the K-th of N slices (samples i with i % N == K-1) into
-    /// sweep.K-of-N.csv; join the slices with `chatterspice merge`.
-    #[arg(long, value_name = "K/N", value_parser = parse_shard)]
-    pub shard: Option<Shard>,
-
-    /// Replace files that already exist in DIR.
-    #[arg(long)]
-    pub force: bool,
-
-    /// Also run each sample with an ideal contact, adding each probe's
-    /// `<signal>.ideal_edges` column: two ngspice runs per sample, one
-    /// after the other, so it takes twice as long.
-    #[arg(long, conflicts_with = "mechanics_only")]
-    pub ideal: bool,
-
-    #[command(flatten)]
-    pub simulator: SimulatorArgs,
-}
-
-#[derive(Debug, Args)]
-pub struct MergeArgs {
-    /// The merged CSV to write. An existing file is an error unless --force.
-    #[arg(value_name = "OUT.csv")]
-    pub output: PathBuf,
-
-    /// The shards' CSVs, in any order.
-    #[arg(value_name = "IN.csv", required = true)]
-    pub inputs: Vec<PathBuf>,
-
-    /// The sweep's number of samples, so that missing last samples are
-    /// found too [default: up to the largest index present].
-    #[arg(long, value_name = "N")]
-    pub samples: Option<u64>,
-
-    /// Write the rows there are even when samples are missing.
-    #[arg(long)]
-    pub allow_missing: bool,
-
-    /// Replace OUT.csv if it already exists.
-    #[arg(long)]
-    pub force: bool,
-
-    /// Accept shards that have no identity file beside them (IN.meta.json,
-    /// which `sweep --shard` writes): their seed, scenario and sample count
-    /// cannot be checked, and summary.json says `"identity": "unverified"`.
-    /// Without it such a shard is refused.
-    #[arg(long)]
-    pub unverified: bool,
-}
-
-fn parse_shard(text: &str) -> Result<Shard, String> {
-    text.parse::<Shard>().map_err(|e| e.to_string())
-}
-
-/// The sweep's file names in `--out`: a shard writes its CSV alone.
-fn sweep_files(shard: Option<Shard>) -> Vec<String> {
-    match shard {
-        Some(s) => vec![format!("sweep.{}-of-{}.csv", s.index, s.count)],
-        None => vec![
-            "sweep.csv".to_owned(),
-            "summary.json".to_owned(),
-            "sweep.svg".to_owned(),
-            "sweep.png".to_owned(),
-        ],
-    }
-}
-
-/// An indicatif bar on a terminal's stderr.
-struct Bar(indicatif::ProgressBar);
-
-impl sweep::Progress for Bar {
-    fn start(&self, total: u64) {
-        self.0.set_length(total);
-    }
-    fn advance(&self, done: u64) {
-        self.0.inc(done);
-    }
-    fn finish(&self) {
-        self.0.finish_and_clear();
-    }
-}
-
-/// Exit status 1 when a sample failed a limit or could not run: the
-/// sweep's files are written either way.
-///
-/// The CSV is written under a temporary name in the output directory and
-/// renamed into place at the end; a signal puts its whole rows in place
-/// with `sweep.meta.json` marked incomplete, for `--resume`.
-fn sweep(args: &SweepArgs) -> Result<Status> {
-    let (scenario, text) = load_scenario_text(&args.scenario)?;
-    let sampler = Sampler::new(&scenario, args.samples, args.seed)?;
-    let resume = args.resume.is_some();
-    let dir = args
-        .resume
-        .clone()
-        .or_else(|| args.out.clone())
-        .unwrap_or_else(|| PathBuf::from("."));
-    let names = sweep_files(args.shard);
-    let csv_path = dir.join(&names[0]);
-    let meta_path = sweep::resume::meta_path(&csv_path);
-    let _lock = chatterspice::output::OutputLock::acquire(&dir, &names[0])?;
-    if !resume {
-        refuse_existing_sweep(&dir, &names, &meta_path, args.force)?;
-    }
-    let ngspice = if args.mechanics_only {
-        None
-    } else {
-        Some(args.simulator.ngspice()?)
-    };
-    let options = sweep_options(args, ngspice.as_ref());
-    let identity = sweep_identity(args, &scenario, &text, &sampler);
-
-    let (partial_csv, partial_meta) = (
-        sweep::resume::partial(&csv_path),
-        sweep::resume::partial(&meta_path),
-    );
-    // What a run killed outright left, else what a signal left.
-    let (from_csv, from_meta) = if partial_csv.exists() && partial_meta.exists() {
-        (partial_csv.clone(), partial_meta.clone())
-    } else {
-        (csv_path.clone(), meta_path.clone())
-    };
-    let kept = if resume {
-        sweep::resume::check_meta(&from_meta, &identity)?;
-        let (header, signals, columns) = sweep::run::layout(&scenario, &sampler, &options)?;
-        Some(sweep::resume::finished_rows(
-            &from_csv,
-            &header,
-            sampler.keys().len(),
-            signals.len(),
-            columns,
-            options.shard,
-        )?)
-    } else {
-        if partial_csv.exists() {
-            eprintln!(
-                "note: {} holds the rows of an interrupted sweep; this new sweep replaces it \
-                 (--resume {} would have continued it)",
-                partial_csv.display(),
-                dir.display()
-            );
-        }
-        None
-    };
-    let mut staged =
-        chatterspice::output::Staged::with_name(&csv_path, &partial_csv, args.force || resume)?;
-    let partial_meta_text = sweep::resume::Meta {
-        identity: identity.clone(),
-        complete: false,
-        rows: 0,
-    }
-    .to_json();
-    std::fs::write(&partial_meta, partial_meta_text)
-        .with_context(|| format!("{}: cannot write it", partial_meta.display()))?;
-    // Gone with the partial CSV when the sweep fails; kept beside it when
-    // the process is killed.
-    let _partial_meta = tempfile::TempPath::try_from_path(&partial_meta)
-        .with_context(|| format!("{}: cannot hold it", partial_meta.display()))?;
-    let done = match kept {
-        Some((bytes, done)) => {
-            staged.file().write_all(&bytes).with_context(|| {
-                format!("{}: cannot write the sweep's CSV", partial_csv.display())
-            })?;
-            eprintln!(
-                "resuming {}: {} of {} samples done",
-                from_csv.display(),
-                done.len(),
-                options.shard.len(sampler.count())
-            );
-            done
-        }
-        None => Vec::new(),
-    };
-    let at_stop = keep_rows_at_stop(
-        &partial_csv,
-        &csv_path,
-        &meta_path,
-        &partial_meta,
-        &identity,
-    );
-
-    let bar = progress_bar();
-    let progress: &dyn sweep::Progress = match &bar {
-        Some(b) => b,
-        None => &sweep::NoProgress,
-    };
-    let collected = sweep::run_from(&scenario, &sampler, &options, staged.file(), progress, done)
-        .with_context(|| format!("{}: the sweep stopped", csv_path.display()))?;
-    let summary = collected.summary(&sampler)?;
-    let rows = collected.len() as u64;
-    let mut files = Vec::new();
-    if args.shard.is_none() {
-        let svg = sweep::plot::render(&collected, &sampler)?;
-        let png = report::png::render(&svg)?;
-        files.push((names[1].clone(), summary.to_json().into_bytes()));
-        files.push((names[2].clone(), svg.into_bytes()));
-        files.push((names[3].clone(), png.bytes));
-    }
-    let meta = sweep::resume::Meta {
-        identity,
-        complete: true,
-        rows,
-    };
-    let meta_name = meta_path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    files.push((meta_name, meta.to_json().into_bytes()));
-    drop(at_stop);
-    staged.commit()?;
-    report::write_bundle(&dir, &files, true)?;
-    if args.shard.is_none() {
-        warn_if_no_fonts();
-    }
-    let mut text = summary.render_table();
-    text.push_str(&format!(
-        "\nwritten: {}\n",
-        names
-            .iter()
-            .map(|n| dir.join(n).display().to_string())
-            .collect::<Vec<_>>()
-            .join(", ")
-    ));
-    emit(&text, None, false)?;
-    Ok(if summary.failing + summary.errors > 0 {
-        Status::CheckFailed
-    } else {
-        Status::Success
-    })
-}
-
-/// Fail before any work if the sweep's files exist (unless `force`), or
-/// something is in the way of one.
-fn refuse_existing_sweep(
-    dir: &Path,
-    names: &[String],
-    meta_path: &Path,
-    force: bool,
-) -> Result<()> {
-    let csv_path = dir.join(&names[0]);
-    for path in names
-        .iter()
-        .map(|n| dir.join(n))
-        .chain([meta_path.to_path_buf()])
-    {
-        if let Err(e) = chatterspice::output::check_target(&path, force) {
-            if matches!(e, report::WriteError::Exists { .. }) && path == csv_path {
-                bail!(
-                    "{}: already exists; pass --force to overwrite the sweep's files, \
-                         --resume {} to continue an interrupted sweep, or choose another --out",
-                    path.display(),
-                    dir.display()
-                );
-            }
-            return Err(e.into());
-        }
-    }
-    Ok(())
-}
-
-/// How the sweep runs, from the command line.
-fn sweep_options<'n>(args: &SweepArgs, ngspice: Option<&'n Ngspice>) -> SweepOptions<'n> {
-    let mut options = SweepOptions::new(match ngspice {
-        Some(n) => SweepMode::Circuit(n),
-        None => SweepMode::Mechanics,
-    });
-    if let Some(jobs) = args.jobs {
-        options.jobs = jobs;
-    }
-    options.shard = args.shard.unwrap_or(Shard::WHOLE);
-    // A sample is one ngspice process (two with --ideal, in turn), so
-    // --jobs is the number of ngspice processes at once.
-    options.run = RunOptions {
-        compare_ideal: args.ideal,
-        ideal_alongside: false,
-        ..args.simulator.run_options()
-    };
-    options
-}
-
-/// Which sweep this is, for `sweep.meta.json` and `--resume`.
-fn sweep_identity(
-    args: &SweepArgs,
-    scenario: &Scenario,
-    text: &str,
-    sampler: &Sampler,
-) -> sweep::resume::Identity {
-    let netlist_text = match scenario.netlist() {
-        Some(Ok((_, netlist))) => netlist,
-        _ => String::new(),
-    };
-    sweep::resume::Identity {
-        tool: format!("chatterspice {}", env!("CARGO_PKG_VERSION")),
-        scenario_digest: sweep::resume::digest(&[text.as_bytes(), netlist_text.as_bytes()]),
-        seed: sampler.seed(),
-        samples: sampler.count(),
-        shard: args.shard.map(|s| s.to_string()),
-        mode: if args.mechanics_only {
-            "mechanics"
-        } else {
-            "circuit"
-        }
-        .to_owned(),
-        ideal: args.ideal,
-    }
-}
-
-/// At a signal: the rows written so far into `partial_csv`, whole, moved
-/// to `csv`, and `meta` saying they are incomplete, where `--resume`
-/// finds them.
-fn keep_rows_at_stop(
-    partial_csv: &Path,
-    csv: &Path,
-    meta: &Path,
-    partial_meta: &Path,
-    identity: &sweep::resume::Identity,
-) -> chatterspice::interrupt::Registered {
-    let (tmp, csv, meta, tmp_meta, identity) = (
-        partial_csv.to_path_buf(),
-        csv.to_path_buf(),
-        meta.to_path_buf(),
-        partial_meta.to_path_buf(),
-        identity.clone(),
-    );
-    chatterspice::interrupt::finish_at_stop(move || {
-        if sweep::resume::truncate_to_whole_lines(&tmp).is_err() {
-            return;
-        }
-        let rows = std::fs::read(&tmp).map_or(0, |b| sweep::resume::row_count(&b));
-        if std::fs::rename(&tmp, &csv).is_ok() {
-            let record = sweep::resume::Meta {
-                identity,
-                complete: false,
-                rows,
-            };
-            if std::fs::write(&meta, record.to_json()).is_ok() {
-                let _ = std::fs::remove_file(&tmp_meta);
-            }
-            eprintln!(
-                "sweep interrupted: {rows} finished rows kept in {}; continue with --resume {}",
-                csv.display(),
-                csv.parent().unwrap_or(Path::new(".")).display()
-            );
-        }
-    })
-}
-
-/// A progress bar on stderr when it is a terminal.
-fn progress_bar() -> Option<Bar> {
-    if io::stderr().is_terminal() {
-        let bar = indicatif::ProgressBar::new(0);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{bar:40} {pos}/{len} samples, {per_sec}, {eta} left",
-            )
-            .expect("a valid template"),
-        );
-        Some(Bar(bar))
-    } else {
-        None
-    }
-}
-
-/// A scenario file (or `-`, standard input) and its text, its files
-/// protected as inputs.
-fn load_scenario_text(path: &Path) -> Result<(Scenario, String)> {
-    let text = if path == Path::new("-") {
-        let mut text = String::new();
-        io::stdin()
-            .read_to_string(&mut text)
-            .context("cannot read the scenario from standard input")?;
-        text
-    } else {
-        chatterspice::input::read_to_string(path).map_err(|source| {
-            chatterspice::scenario::ScenarioError::Read {
-                path: path.to_owned(),
-                source,
-            }
-        })?
-    };
-    let origin = if path == Path::new("-") {
-        Path::new("<stdin>")
-    } else {
-        path
-    };
-    let scenario = Scenario::parse(&text, origin)?;
-    if path != Path::new("-") {
-        report::protect_input(path);
-    }
-    if let Some(circuit) = &scenario.circuit {
-        report::protect_input(&circuit.netlist);
-    }
-    Ok((scenario, text))
-}
-
-fn merge(args: &MergeArgs) -> Result<()> {
-    for input in &args.inputs {
-        report::protect_input(input);
-    }
-    let report = sweep::merge::merge_files(
-        &args.output,
-        &args.inputs,
-        args.samples,
-        args.allow_missing,
-        args.force,
-        args.unverified,
-    )?;
-    if !report.duplicates.is_empty() {
-        eprintln!(
-            "note: {} sample(s) were in more than one input, with the same row: {}",
-            report.duplicates.len(),
-            sweep::table::ranges(&report.duplicates)
-        );
-    }
-    if !report.missing.is_empty() {
-        eprintln!(
-            "warning: {} sample(s) missing: {}",
-            report.missing.len(),
-            sweep::table::ranges(&report.missing)
-        );
-    }
-    eprintln!(
-        "{}: {} rows from {} file(s)",
-        args.output.display(),
-        report.rows,
-        args.inputs.len()
-    );
-    if args.unverified {
-        eprintln!(
-            "note: --unverified: shards without an identity file were merged unchecked; \
-             summary.json says \"identity\": \"unverified\""
-        );
-    }
-    Ok(())
 }

@@ -11,8 +11,10 @@
 //! the probed signals ([`analysis`]); [`pipeline`] runs them in order.
 //! A coil-driven relay is coupled to its driver circuit ([`coil`]); on a
 //! power load the contact arcs ([`arc`]); scope captures and datasheets
-//! calibrate the model ([`capture`], [`calibrate`]). [`commands`] holds
-//! the work of `bounce` and `check` for the binary and the Python package.
+//! calibrate the model ([`capture`], [`calibrate`]). [`verdict`] is every
+//! verdict a command gives (`run`, `check` with the electrical life among
+//! its limits, `check --envelope`, `life`), computed once for the binary
+//! and the Python package; [`commands`] holds the work of `bounce`.
 
 pub mod analysis;
 pub mod arc;
@@ -36,6 +38,7 @@ pub mod report;
 pub mod scenario;
 pub mod spice;
 pub mod sweep;
+pub mod verdict;
 pub mod waveform;
 
 pub use chatter::{Chatter, ContactState, Impact, Interval, Outcome};

@@ -8,6 +8,8 @@
 use std::path::PathBuf;
 use std::time::Duration;
 
+use chatterspice::netlist::ContactElement;
+use chatterspice::pipeline::Coupling;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyFloat, PyInt, PyString};
 
@@ -235,4 +237,106 @@ pub fn free_arg(obj: &Bound<'_, PyAny>) -> PyResult<Option<Vec<String>>> {
         keys.push(item.extract()?);
     }
     Ok(Some(keys))
+}
+
+/// A whole number within `range`, as the command line's option of the
+/// same name takes it.
+fn bounded(
+    obj: &Bound<'_, PyAny>,
+    name: &str,
+    range: std::ops::RangeInclusive<u64>,
+    what: &str,
+) -> PyResult<usize> {
+    let want = format!(
+        "a whole number from {} to {}: {what}",
+        range.start(),
+        range.end()
+    );
+    match count(obj, name, *range.start(), what) {
+        Ok(Some(n)) if range.contains(&n) => {
+            usize::try_from(n).map_err(|_| refuse(name, obj, &want))
+        }
+        _ => Err(refuse(name, obj, &want)),
+    }
+}
+
+pub fn ngspice_arg(obj: &Bound<'_, PyAny>) -> PyResult<Option<PathBuf>> {
+    path(obj, "ngspice")
+}
+
+pub fn element_arg(obj: &Bound<'_, PyAny>) -> PyResult<Option<ContactElement>> {
+    let want = "\"pwl\", \"event-ramp\" or \"switch\", how the contact is emitted";
+    match text(obj, "element", want)? {
+        None => Ok(None),
+        Some(name) => name
+            .parse::<ContactElement>()
+            .map(Some)
+            .map_err(|_| refuse("element", obj, want)),
+    }
+}
+
+pub fn coupling_arg(obj: &Bound<'_, PyAny>) -> PyResult<Option<Coupling>> {
+    let want = "\"lock-step\" or \"passes\", how a coil-driven relay is coupled to its circuit";
+    match text(obj, "coupling", want)? {
+        None => Ok(None),
+        Some(name) => name
+            .parse::<Coupling>()
+            .map(Some)
+            .map_err(|_| refuse("coupling", obj, want)),
+    }
+}
+
+pub fn max_iterations_arg(obj: &Bound<'_, PyAny>) -> PyResult<usize> {
+    bounded(
+        obj,
+        "max_iterations",
+        1..=1_000_000,
+        "the most coupling passes",
+    )
+}
+
+pub fn coupling_tolerance_arg(obj: &Bound<'_, PyAny>) -> PyResult<f64> {
+    let want = "a time in seconds > 0 (e.g. 1e-7): how far an event may still move";
+    match number(obj, "coupling_tolerance", want)? {
+        Some(s) if s.is_finite() && s > 0.0 => Ok(s),
+        _ => Err(refuse("coupling_tolerance", obj, want)),
+    }
+}
+
+pub fn life_phases_arg(obj: &Bound<'_, PyAny>) -> PyResult<usize> {
+    bounded(
+        obj,
+        "life_phases",
+        2..=1024,
+        "switching phases of an AC endurance figure",
+    )
+}
+
+pub fn phases_arg(obj: &Bound<'_, PyAny>) -> PyResult<usize> {
+    bounded(
+        obj,
+        "phases",
+        2..=1024,
+        "switching phases of an AC endurance figure",
+    )
+}
+
+pub fn no_life_arg(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
+    flag(obj, "no_life")
+}
+
+pub fn no_spiceinit_arg(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
+    flag(obj, "no_spiceinit")
+}
+
+pub fn envelope_arg(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
+    flag(obj, "envelope")
+}
+
+pub fn envelope_samples_arg(obj: &Bound<'_, PyAny>) -> PyResult<usize> {
+    bounded(obj, "samples", 1..=1_000_000_000, "relays drawn")
+}
+
+pub fn envelope_seed_arg(obj: &Bound<'_, PyAny>) -> PyResult<u64> {
+    Ok(count(obj, "seed", 0, "the seed of the draw")?.unwrap_or(1))
 }

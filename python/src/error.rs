@@ -17,13 +17,17 @@ use chatterspice::calibrate::fit::FitError;
 use chatterspice::capture::{CaptureError, EdgeError};
 use chatterspice::check::CheckError;
 use chatterspice::envelope::EnvelopeError;
+use chatterspice::life::LifeError;
 use chatterspice::pipeline::{CouplingError, PassError, RunError};
 use chatterspice::rawfile::RawError;
 use chatterspice::scenario::{Location, ScenarioError};
 use chatterspice::spice::SpiceError;
 use chatterspice::sweep::SweepError;
+use chatterspice::verdict::VerdictError;
 use chatterspice::waveform::WaveformError;
-use pyo3::exceptions::{PyFileNotFoundError, PyPermissionError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{
+    PyFileNotFoundError, PyPermissionError, PyRuntimeError, PyUserWarning, PyValueError,
+};
 use pyo3::prelude::*;
 
 pyo3::create_exception!(
@@ -46,6 +50,82 @@ pyo3::create_exception!(
     PyRuntimeError,
     "The mechanics, the coil coupling or the analysis of a run failed."
 );
+
+pyo3::create_exception!(
+    chatterspice,
+    ChatterspiceWarning,
+    PyUserWarning,
+    "Something worth a look that did not stop the call: a run that is not \
+     physical as set up, a coupling that fell back from lock-step to passes, \
+     a life that could not be estimated, a remark on a limit's figure."
+);
+
+/// Issue each of `said` as a [`ChatterspiceWarning`], worded for Python.
+pub fn warn_all(py: Python<'_>, said: &[String]) -> PyResult<()> {
+    let category = py.get_type::<ChatterspiceWarning>();
+    for text in said {
+        let message = std::ffi::CString::new(pythonic(text).replace('\0', " ")).unwrap_or_default();
+        PyErr::warn(py, &category, &message, 1)?;
+    }
+    Ok(())
+}
+
+/// `message` with the command line's options named as the Python
+/// arguments that set them (`--keep-workdir` is `keep_workdir=True`).
+pub fn pythonic(message: &str) -> String {
+    const WORDS: [(&str, &str); 14] = [
+        ("--keep-workdir", "keep_workdir=True"),
+        ("--free KEY,...", "free=[...]"),
+        ("--capture or --measured", "capture= or measured="),
+        ("pass --mechanics-only", "pass mechanics_only=True"),
+        ("drop --mechanics-only", "drop mechanics_only=True"),
+        ("--mechanics-only", "mechanics_only=True"),
+        ("drop --samples", "drop samples="),
+        ("--samples ", "samples="),
+        ("(or --samples)", "(or samples=)"),
+        (
+            "`chatterspice raw FILE --format csv` streams",
+            "read_raw reads",
+        ),
+        ("--force overwrites", "force=True overwrites"),
+        ("pass --force", "pass force=True"),
+        ("--resume ", "resume="),
+        ("choose another --out", "choose another out="),
+    ];
+    let mut text = message.to_owned();
+    for (flag, argument) in WORDS {
+        text = text.replace(flag, argument);
+    }
+    // Any other option: its argument's name (`--max-iterations` is
+    // `max_iterations=`).
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text.as_str();
+    while let Some(at) = rest.find("--") {
+        let (before, after) = rest.split_at(at);
+        out.push_str(before);
+        let name: String = after[2..]
+            .chars()
+            .take_while(|c| c.is_ascii_lowercase() || *c == '-')
+            .collect();
+        let starts_word = before
+            .chars()
+            .last()
+            .is_none_or(|c| c.is_whitespace() || "(`'\"[".contains(c));
+        if starts_word
+            && name.len() > 1
+            && name.chars().next().is_some_and(|c| c.is_ascii_lowercase())
+        {
+            out.push_str(&name.replace('-', "_"));
+            out.push('=');
+            rest = &after[2 + name.len()..];
+        } else {
+            out.push_str("--");
+            rest = &after[2..];
+        }
+    }
+    out.push_str(rest);
+    out
+}
 
 /// Which Python exception an error becomes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -132,6 +212,70 @@ impl Failure {
     }
 }
 
+impl Failure {
+    /// The failure with the key, file and line its message names filled
+    /// in where the error itself did not say them.
+    fn located(self) -> Failure {
+        let named = named_place(&self.message);
+        let key = self.key.or_else(|| named_key(&self.message));
+        let location = match (self.location, named) {
+            (Some(l), _) => Some(l),
+            (None, Some((path, line))) => Some(Location {
+                path: path.into(),
+                line,
+            }),
+            (None, None) => None,
+        };
+        Failure {
+            key,
+            location,
+            ..self
+        }
+    }
+}
+
+/// The file (and line) a message starts with, `FILE: ...` or
+/// `FILE:LINE: ...`, when it is a file's name.
+fn named_place(message: &str) -> Option<(String, Option<usize>)> {
+    let first = message.lines().next()?;
+    let head = &first[..first.find(": ")?];
+    let (path, line) = match head.rsplit_once(':') {
+        Some((p, l)) if !p.is_empty() && l.chars().all(|c| c.is_ascii_digit()) && !l.is_empty() => {
+            (p, l.parse::<usize>().ok())
+        }
+        _ => (head, None),
+    };
+    let looks_like_file = path.starts_with('<') && path.ends_with('>')
+        || Path::new(path).extension().is_some_and(|e| {
+            e.to_str().is_some_and(|e| {
+                e.len() <= 5 && e.chars().all(|c| c.is_ascii_alphanumeric()) && !e.is_empty()
+            })
+        }) && !path.contains(' ')
+        || Path::new(path).is_file();
+    looks_like_file.then(|| (path.to_owned(), line))
+}
+
+/// The first scenario key a message names in backquotes, e.g.
+/// `` `coil.drive_voltage` ``, or the `[limits] KEY` it names.
+fn named_key(message: &str) -> Option<String> {
+    let is_key = |k: &str| {
+        k.contains('.')
+            && !k.starts_with('.')
+            && !k.ends_with('.')
+            && k.chars()
+                .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_' || c == '.')
+            && k.split('.').all(|part| {
+                !part.is_empty() && part.chars().next().is_some_and(|c| c.is_ascii_lowercase())
+            })
+    };
+    message
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .find(|k| is_key(k))
+        .map(str::to_owned)
+}
+
 /// The error and each cause on lines of their own, as the command line
 /// prints them.
 fn with_causes(err: &(dyn StdError + 'static)) -> String {
@@ -165,6 +309,10 @@ fn io_kind(err: &(dyn StdError + 'static)) -> Option<io::ErrorKind> {
 
 impl From<Failure> for PyErr {
     fn from(f: Failure) -> PyErr {
+        let f = Failure {
+            message: pythonic(&f.message),
+            ..f.located()
+        };
         let err = match (f.kind, f.io) {
             (Kind::Input, Some(io::ErrorKind::NotFound)) => PyFileNotFoundError::new_err(f.message),
             (Kind::Input, Some(io::ErrorKind::PermissionDenied)) => {
@@ -225,7 +373,22 @@ impl From<WaveformError> for Failure {
 
 impl From<FitError> for Failure {
     fn from(e: FitError) -> Failure {
-        Failure::of(Kind::Input, &e)
+        match e {
+            // The scenario's own error names the file: said once.
+            FitError::UnknownKey { key, source, .. } => {
+                let scenario = Failure::scenario(&source, true);
+                let message = match scenario.message.split_once(": ") {
+                    Some((path, rest)) => format!("{path}: free key `{key}`: {rest}"),
+                    None => format!("free key `{key}`: {}", scenario.message),
+                };
+                Failure {
+                    message,
+                    key: Some(key),
+                    ..scenario
+                }
+            }
+            e => Failure::of(Kind::Input, &e),
+        }
     }
 }
 
@@ -284,6 +447,52 @@ impl From<EnvelopeError> for Failure {
         match e {
             EnvelopeError::Scenario(e) => e.into(),
             e => Failure::of(Kind::Input, &e),
+        }
+    }
+}
+
+impl From<LifeError> for Failure {
+    fn from(e: LifeError) -> Failure {
+        match e {
+            LifeError::Closing(e) => e.into(),
+            LifeError::Run { .. } | LifeError::Own(_) => {
+                let kind = match &e {
+                    LifeError::Run { source, .. } | LifeError::Own(source) => {
+                        Failure::from_run_kind(source)
+                    }
+                    _ => Kind::Simulation,
+                };
+                Failure::of(kind, &e)
+            }
+            LifeError::Io(_) => Failure::of(Kind::Simulation, &e),
+            e => Failure::of(Kind::Input, &e),
+        }
+    }
+}
+
+impl Failure {
+    /// The kind a run error becomes.
+    fn from_run_kind(e: &RunError) -> Kind {
+        match e {
+            RunError::Pass(PassError::Spice { .. }) => Kind::Ngspice,
+            RunError::Mechanics { .. }
+            | RunError::Motion { .. }
+            | RunError::Waveform { .. }
+            | RunError::Arc { .. } => Kind::Simulation,
+            _ => Kind::Input,
+        }
+    }
+}
+
+impl From<VerdictError> for Failure {
+    fn from(e: VerdictError) -> Failure {
+        match e {
+            VerdictError::Run(e) => e.into(),
+            VerdictError::Check(e) => e.into(),
+            VerdictError::Life(e) => e.into(),
+            VerdictError::Envelope(e) => e.into(),
+            VerdictError::Spice(e) => e.into(),
+            e => Failure::of(Kind::Simulation, &e),
         }
     }
 }

@@ -16,10 +16,11 @@ mod error;
 mod overlay;
 mod raw;
 mod results;
+mod verdicts;
 mod work;
 
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 use std::time::Duration;
 
 use chatterspice::calibrate::fit::{self, FitRequest, Record};
@@ -27,11 +28,10 @@ use chatterspice::capture::{Capture, Closed, read_capture};
 use chatterspice::chatter::{Chatter, Interval};
 use chatterspice::check;
 use chatterspice::commands;
-use chatterspice::envelope::{self, EnvelopeOptions};
 use chatterspice::pipeline::{self, RunOptions, RunResult};
 use chatterspice::report::{self, Format};
 use chatterspice::scenario::{BUNDLED_PARTS, DEFAULT_SCENARIO_TOML, Scenario, bundled_part};
-use chatterspice::spice::{Ngspice, RunOutput, RunRequest, Runner, SpiceError};
+use chatterspice::spice::Ngspice;
 use chatterspice::sweep::{self, Sampler, SweepMode, SweepOptions};
 use chatterspice::waveform::read_state_csv;
 use pyo3::prelude::*;
@@ -152,139 +152,8 @@ fn py_bounce<'py>(
     json(py, &text)
 }
 
-/// What one ngspice run of a call said, recorded on its way through.
-struct Said {
-    deck: String,
-    includes: Vec<String>,
-    log: String,
-}
-
-/// ngspice, recording each run's deck and log (the library's result
-/// keeps the plot, not the log).
-struct Recorder {
-    ngspice: Ngspice,
-    said: Mutex<Vec<Said>>,
-}
-
-impl Recorder {
-    fn note(&self, req: &RunRequest, out: &Result<RunOutput, SpiceError>) {
-        if let Ok(out) = out {
-            let mut said = self.said.lock().unwrap_or_else(|e| e.into_inner());
-            said.push(Said {
-                deck: req.deck.clone(),
-                includes: req.includes.iter().map(|(_, text)| text.clone()).collect(),
-                log: out.log.clone(),
-            });
-        }
-    }
-
-    /// The logs of the bounced run (its deck is `deck` and it includes
-    /// `include`) and of the other (ideal-contact) run, the last of each.
-    fn logs(&self, deck: &str, include: &str) -> (String, Option<String>) {
-        let said = self.said.lock().unwrap_or_else(|e| e.into_inner());
-        let bounced = |s: &Said| s.deck == deck && s.includes.iter().any(|i| i == include);
-        let log = said
-            .iter()
-            .rev()
-            .find(|s| bounced(s))
-            .or(said.last())
-            .map(|s| s.log.clone())
-            .unwrap_or_default();
-        let other = said
-            .iter()
-            .rev()
-            .find(|s| !bounced(s))
-            .map(|s| s.log.clone());
-        (log, other)
-    }
-}
-
-impl Runner for Recorder {
-    fn run(&self, req: &RunRequest) -> Result<RunOutput, SpiceError> {
-        let out = self.ngspice.run(req);
-        self.note(req, &out);
-        out
-    }
-
-    fn run_many(&self, reqs: &[RunRequest]) -> Vec<Result<RunOutput, SpiceError>> {
-        let outs = self.ngspice.run_many(reqs);
-        for (req, out) in reqs.iter().zip(&outs) {
-            self.note(req, out);
-        }
-        outs
-    }
-}
-
-/// The relay's chatter switching the scenario's circuit in ngspice, and
-/// the analysis of every probe: the main job.
-///
-/// Returns a Run: ``report`` (the JSON of ``chatterspice run --format
-/// json``), ``waveforms`` (every vector of the raw file as a float64
-/// array: ``time`` in s, voltages in V, currents in A), the ideal-contact
-/// run's ``ideal_waveforms``, the ``deck`` and contact ``include`` ngspice
-/// ran, its ``log``, and with ``keep_workdir`` the ``workdir`` and
-/// ``raw_path`` left behind.
-///
-/// Parameters:
-///     path, toml_text, origin: the scenario (see ``bounce``).
-///     measured: a ``time,state`` CSV record switching the circuit
-///         instead of the mechanics.
-///     ideal: also run an ideal contact (one clean edge) and compare.
-///     timeout: the wall-clock limit of each ngspice run, in s.
-///     keep_workdir: leave ngspice's work directories (deck, includes,
-///         raw file) in place and name them in the result.
-///
-/// Raises InputError, FileNotFoundError, NgspiceError (ngspice missing,
-/// failing or timing out), SimulationError; KeyboardInterrupt on Ctrl-C,
-/// with every ngspice process killed and work directory removed.
-#[pyfunction]
-#[pyo3(name = "run", signature = (path=None, *, toml_text=None, origin=None, measured=None,
-                                  ideal=true, timeout=Duration::from_secs(60),
-                                  keep_workdir=false))]
-#[pyo3(
-    text_signature = "(path=None, *, toml_text=None, origin=None, measured=None, ideal=True, timeout=60.0, keep_workdir=False)"
-)]
-#[allow(clippy::too_many_arguments)]
-fn py_run(
-    py: Python<'_>,
-    #[pyo3(from_py_with = args::path_arg)] path: Option<PathBuf>,
-    #[pyo3(from_py_with = args::toml_text_arg)] toml_text: Option<String>,
-    #[pyo3(from_py_with = args::origin_arg)] origin: Option<PathBuf>,
-    #[pyo3(from_py_with = args::measured_arg)] measured: Option<PathBuf>,
-    #[pyo3(from_py_with = args::ideal_arg)] ideal: bool,
-    #[pyo3(from_py_with = args::timeout_arg)] timeout: Duration,
-    #[pyo3(from_py_with = args::keep_workdir_arg)] keep_workdir: bool,
-) -> PyResult<Run> {
-    let loaded = load_scenario(path, toml_text, origin)?;
-    let intervals = measured.as_deref().map(read_measured).transpose()?;
-    let options = RunOptions {
-        timeout,
-        compare_ideal: ideal,
-        keep_workdir,
-        ..RunOptions::default()
-    };
-    let scenario = loaded.scenario;
-    let (mut result, logs, dimensionless) =
-        work::interruptible(py, None, move |_| -> Result<_, Failure> {
-            let recorder = Recorder {
-                ngspice: ngspice(timeout)?,
-                said: Mutex::new(Vec::new()),
-            };
-            let result: RunResult = match intervals {
-                Some(i) => pipeline::run_measured(&scenario, i, &recorder, &options)?,
-                None => pipeline::run(&scenario, &recorder, &options)?,
-            };
-            let logs = recorder.logs(&result.deck.text, &result.include.text);
-            Ok((result, logs, commands::dimensionless(&scenario)))
-        })?;
-    // As the command line shows it: relative to where the user is.
-    if let Some(relative) = std::env::current_dir()
-        .ok()
-        .and_then(|cwd| result.netlist.strip_prefix(cwd).ok().map(Path::to_path_buf))
-    {
-        result.netlist = relative;
-    }
-    let text = report::json::render_run(&result, dimensionless.as_ref());
+/// The Run of `result`, its report the JSON `text`.
+pub(crate) fn run_result(py: Python<'_>, result: &RunResult, text: &str) -> PyResult<Run> {
     let ideal_waveforms = match &result.ideal {
         Some(sim) => Some(raw::vectors(py, &sim.plot)?.unbind()),
         None => None,
@@ -292,13 +161,13 @@ fn py_run(
     let shown = |p: &Option<PathBuf>| p.as_ref().map(|d| d.display().to_string());
     let workdir = &result.simulation.workdir;
     Ok(Run {
-        report: json(py, &text)?.unbind(),
+        report: json(py, text)?.unbind(),
         waveforms: raw::vectors(py, &result.simulation.plot)?.unbind(),
         ideal_waveforms,
         deck: result.deck.text.clone(),
         include: result.include.text.clone(),
-        log: logs.0,
-        ideal_log: result.ideal.as_ref().and(logs.1),
+        log: result.simulation.log.clone(),
+        ideal_log: result.ideal.as_ref().map(|s| s.log.clone()),
         workdir: shown(workdir),
         raw_path: shown(
             &workdir
@@ -307,127 +176,6 @@ fn py_run(
         ),
         ideal_workdir: shown(&result.ideal.as_ref().and_then(|s| s.workdir.clone())),
     })
-}
-
-/// The scenario's limits held against its closing and, when a limit
-/// needs it, its run through ngspice.
-///
-/// Returns the JSON of ``chatterspice check --format json`` as a dict:
-/// ``passed`` is False when a limit failed (where the command exits with
-/// 1), ``failed`` counts them and ``checks`` lists every limit with
-/// ``key``, ``actual``, ``limit`` and ``margin`` (in the limit's unit: s,
-/// V, counts) and ``passed``. Relay limits alone need no ngspice.
-///
-/// Parameters:
-///     path, toml_text, origin: the scenario (see ``bounce``).
-///     measured: a ``time,state`` CSV record instead of the mechanics.
-///     timeout: the wall-clock limit of each ngspice run, in s.
-///
-/// Raises InputError, FileNotFoundError, NgspiceError, SimulationError;
-/// KeyboardInterrupt on Ctrl-C.
-#[pyfunction]
-#[pyo3(name = "check", signature = (path=None, *, toml_text=None, origin=None, measured=None,
-                                    timeout=Duration::from_secs(60)))]
-#[pyo3(text_signature = "(path=None, *, toml_text=None, origin=None, measured=None, timeout=60.0)")]
-fn py_check<'py>(
-    py: Python<'py>,
-    #[pyo3(from_py_with = args::path_arg)] path: Option<PathBuf>,
-    #[pyo3(from_py_with = args::toml_text_arg)] toml_text: Option<String>,
-    #[pyo3(from_py_with = args::origin_arg)] origin: Option<PathBuf>,
-    #[pyo3(from_py_with = args::measured_arg)] measured: Option<PathBuf>,
-    #[pyo3(from_py_with = args::timeout_arg)] timeout: Duration,
-) -> PyResult<Bound<'py, PyAny>> {
-    let loaded = load_scenario(path, toml_text, origin)?;
-    let scenario = loaded.scenario;
-    let intervals = measured.as_deref().map(read_measured).transpose()?;
-    let options = RunOptions {
-        timeout,
-        ..RunOptions::default()
-    };
-    let needs_ngspice = commands::check_needs_ngspice(&scenario, intervals.is_some());
-    let text = work::interruptible(py, None, move |_| -> Result<_, Failure> {
-        let ngspice = needs_ngspice.then(|| ngspice(timeout)).transpose()?;
-        let (verdict, evidence) = match (intervals, &ngspice) {
-            (Some(i), n) => check::measured(&scenario, i, n.as_ref().map(|n| n as _), &options)?,
-            (None, Some(n)) => check::run_with(&scenario, n, &options)?,
-            (None, None) => check::relay_only(&scenario)?,
-        };
-        let dimensionless = commands::dimensionless(&scenario);
-        Ok(report::json::render_check(
-            &verdict,
-            &evidence,
-            dimensionless.as_ref(),
-        ))
-    })?;
-    json(py, &text)
-}
-
-/// Every relay the datasheet allows: the scenario's ``[envelope]`` (and
-/// its printed tolerances) sampled, the relays that meet every printed
-/// figure kept and run, each limit held against the worst kept relay.
-///
-/// Returns the JSON of ``chatterspice check --envelope --format json`` as
-/// a dict: the worst relay's ``checks`` and ``passed``, and under
-/// ``envelope`` the bands (min, median, p95, max) of every quantity, the
-/// counts drawn, kept and rejected, and the worst relay.
-///
-/// Parameters:
-///     path, toml_text, origin: the scenario (see ``bounce``).
-///     samples: relays drawn (≥ 1).
-///     seed: the seed of the quasi-random draw (the same seed draws the
-///         same relays).
-///     jobs: relays run at once; default one per core.
-///     timeout: the wall-clock limit of each ngspice run, in s.
-///
-/// Raises InputError (no ``[envelope]``, every relay rejected, a bad
-/// argument), NgspiceError, SimulationError; KeyboardInterrupt on Ctrl-C.
-#[pyfunction]
-#[pyo3(name = "envelope", signature = (path=None, *, toml_text=None, origin=None, samples=Some(32),
-                                       seed=Some(1), jobs=None, timeout=Duration::from_secs(60)))]
-#[pyo3(
-    text_signature = "(path=None, *, toml_text=None, origin=None, samples=32, seed=1, jobs=None, timeout=60.0)"
-)]
-#[allow(clippy::too_many_arguments)]
-fn py_envelope<'py>(
-    py: Python<'py>,
-    #[pyo3(from_py_with = args::path_arg)] path: Option<PathBuf>,
-    #[pyo3(from_py_with = args::toml_text_arg)] toml_text: Option<String>,
-    #[pyo3(from_py_with = args::origin_arg)] origin: Option<PathBuf>,
-    #[pyo3(from_py_with = args::samples_arg)] samples: Option<u64>,
-    #[pyo3(from_py_with = args::seed_arg)] seed: Option<u64>,
-    #[pyo3(from_py_with = args::jobs_arg)] jobs: Option<u64>,
-    #[pyo3(from_py_with = args::timeout_arg)] timeout: Duration,
-) -> PyResult<Bound<'py, PyAny>> {
-    let loaded = load_scenario(path, toml_text, origin)?;
-    let scenario = loaded.scenario;
-    let defaults = EnvelopeOptions::default();
-    let options = EnvelopeOptions {
-        samples: samples.map_or(defaults.samples, |s| {
-            usize::try_from(s).unwrap_or(usize::MAX)
-        }),
-        seed: seed.unwrap_or(defaults.seed),
-        jobs: self::jobs(jobs).unwrap_or_else(|| {
-            std::thread::available_parallelism().unwrap_or(std::num::NonZeroUsize::MIN)
-        }),
-        run: RunOptions {
-            timeout,
-            ..RunOptions::default()
-        },
-    };
-    let needs_ngspice = commands::check_needs_ngspice(&scenario, false);
-    let text = work::interruptible(py, None, move |_| -> Result<_, Failure> {
-        let ngspice = needs_ngspice.then(|| ngspice(timeout)).transpose()?;
-        let runner = ngspice.as_ref().map(|n| n as &dyn Runner);
-        let env = envelope::run(&scenario, runner, &options)?;
-        let worst = env
-            .worst()
-            .expect("an envelope that kept a relay has a worst one");
-        Ok(envelope::json_with_envelope(
-            &report::json::render_check(&env.verdict, &worst.evidence, None),
-            &env.report,
-        ))
-    })?;
-    json(py, &text)
 }
 
 /// The scenario run many times with the numbers of its ``[sweep]``
@@ -816,10 +564,16 @@ fn contact_include(
 #[pyo3(name = "chatterspice")]
 fn chatterspice_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
+    // numpy and its C API now, with the package: a Ctrl-C while they load
+    // is then a KeyboardInterrupt of the import, never a failure to reach
+    // the API inside a call.
+    py.import("numpy")?;
+    drop(numpy::PyArray1::<f64>::zeros(py, 0, false));
     m.add_function(wrap_pyfunction!(py_bounce, m)?)?;
-    m.add_function(wrap_pyfunction!(py_run, m)?)?;
-    m.add_function(wrap_pyfunction!(py_check, m)?)?;
-    m.add_function(wrap_pyfunction!(py_envelope, m)?)?;
+    m.add_function(wrap_pyfunction!(verdicts::py_run, m)?)?;
+    m.add_function(wrap_pyfunction!(verdicts::py_check, m)?)?;
+    m.add_function(wrap_pyfunction!(verdicts::py_envelope, m)?)?;
+    m.add_function(wrap_pyfunction!(verdicts::py_life, m)?)?;
     m.add_function(wrap_pyfunction!(py_sweep, m)?)?;
     m.add_function(wrap_pyfunction!(py_fit, m)?)?;
     m.add_function(wrap_pyfunction!(py_capture, m)?)?;
@@ -835,6 +589,10 @@ fn chatterspice_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("InputError", py.get_type::<error::InputError>())?;
     m.add("NgspiceError", py.get_type::<error::NgspiceError>())?;
     m.add("SimulationError", py.get_type::<error::SimulationError>())?;
+    m.add(
+        "ChatterspiceWarning",
+        py.get_type::<error::ChatterspiceWarning>(),
+    )?;
     m.add("DEFAULT_SCENARIO", DEFAULT_SCENARIO_TOML)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     let mapping = py.import("collections.abc")?.getattr("Mapping")?;

@@ -54,7 +54,7 @@ fn opt<'py, T>(py: Python<'py>, value: &Option<Py<T>>) -> Bound<'py, PyAny> {
     }
 }
 
-/// What [`run`](crate) returns: the report, the waveforms and what
+/// What ``run`` returns: the report, the waveforms and what
 /// ngspice ran and said.
 #[pyclass(module = "chatterspice", frozen)]
 pub struct Run {

@@ -18,15 +18,14 @@
 //!   include, so ngspice carries the arc) puts in the raw file;
 //! - [`analysis`] finds every arc and breakdown in the run's raw file;
 //! - [`making`] is each make's peak current and what it does to the
-//!   contact spot, [`make_force`] the contact force at a coil-driven
-//!   relay's makes;
+//!   contact spot (the contact force at a coil-driven relay's makes comes
+//!   from its run: [`crate::pipeline::make_force`]);
 //! - [`breaking`] is the largest DC current the contact breaks, and the
 //!   arc constants fitted to a printed breaking curve.
 
 pub mod analysis;
 pub mod breaking;
 pub mod gap;
-pub mod make_force;
 pub mod making;
 mod model;
 pub mod vectors;

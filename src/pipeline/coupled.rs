@@ -193,6 +193,8 @@ pub struct Coupled {
     pub deck: Deck,
     /// ngspice's version, e.g. `"39"`.
     pub version: Option<String>,
+    /// What ngspice printed on the last circuit run.
+    pub log: String,
     /// A relay with a pole face: the armature's impacts on it.
     pub pole_face: Vec<crate::chatter::Impact>,
     /// Why the run was coupled by passes although lock-step was asked for
@@ -569,6 +571,7 @@ pub fn run_coupled_plan(
                     iterations,
                     deck,
                     version: simulation.version,
+                    log: simulation.log,
                     pole_face,
                     fallback: None,
                 });
@@ -668,6 +671,7 @@ pub fn run_coupled_plan(
         })?;
         let ngspice_elapsed = simulation.elapsed.as_secs_f64();
         let version = simulation.version;
+        let log = simulation.log;
         let plot = simulation.plot;
         let flux = series(&plot, &psi).ok_or_else(|| CouplingError::MissingVector {
             iteration,
@@ -752,6 +756,7 @@ pub fn run_coupled_plan(
                 iterations,
                 deck,
                 version,
+                log,
                 pole_face,
                 fallback,
             });

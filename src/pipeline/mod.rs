@@ -19,6 +19,7 @@
 
 pub mod coupled;
 pub mod lockstep;
+pub mod make_force;
 pub mod pass;
 
 pub use pass::{Pass, PassError, Simulation, circuit_pass};
@@ -276,10 +277,6 @@ pub struct RunResult {
     /// bounce): its peak current and, where the run knows the contact
     /// force, the spot's voltage, temperature and weld margin.
     pub makes: Vec<crate::arc::making::Make>,
-    /// The electrical life at this circuit, when the caller estimated it
-    /// (`run` and `check` do for a scenario with `[datasheet]
-    /// electrical_endurance`; the pipeline itself leaves it `None`).
-    pub life: Option<crate::life::LifeReport>,
 }
 
 /// Run the whole pipeline on `scenario` with `runner`. A scenario with a
@@ -444,7 +441,7 @@ fn run_dc_step(
         .clone()
         .filter(|_| plan.two_stage().pole_face.is_some());
     // The contact force at each make, from the closing's own motion.
-    let force = crate::arc::make_force::dc_step(plan, &coil, &source, two_stage.clone());
+    let force = make_force::dc_step(plan, &coil, &source, two_stage.clone());
     let pole_face = pole_face.map(|run| run.pole_face);
     let (waveform, model) = contact_waveform_of(scenario, plan.surface(), &chatter)?;
     let mut result = run_chatter(plan, chatter, waveform, &model, gap, runner, options)?;
@@ -660,7 +657,6 @@ fn run_chatter(
         coil_levels: None,
         pole_face: None,
         makes,
-        life: None,
         arcs,
         netlist: netlist_path,
         chatter,
@@ -812,7 +808,7 @@ fn run_coil(plan: &Plan, runner: &dyn Runner, options: &RunOptions) -> Result<Ru
     }
     // The contact force at each make, from the armature moved again under
     // the converged pass's flux.
-    let force = crate::arc::make_force::coupled(plan, &coupled);
+    let force = make_force::coupled(plan, &coupled);
     if force.is_none() && !coupled.chatter.impacts.is_empty() {
         warnings.push(
             "the contact force at the makes could not be rebuilt from the coupled run, so \
@@ -831,7 +827,6 @@ fn run_coil(plan: &Plan, runner: &dyn Runner, options: &RunOptions) -> Result<Ru
     );
     Ok(RunResult {
         makes,
-        life: None,
         netlist: netlist_path,
         chatter: coupled.chatter,
         waveform,
@@ -843,6 +838,7 @@ fn run_coil(plan: &Plan, runner: &dyn Runner, options: &RunOptions) -> Result<Ru
             elapsed: Duration::from_secs_f64(elapsed),
             warnings: Vec::new(),
             workdir: None,
+            log: coupled.log,
         },
         ideal: None,
         probes,

@@ -29,6 +29,9 @@ pub struct Simulation {
     pub warnings: Vec<String>,
     /// The kept work directory, when asked for.
     pub workdir: Option<PathBuf>,
+    /// What ngspice printed (for a coil-driven relay, on the last
+    /// circuit run).
+    pub log: String,
 }
 
 /// Why a circuit pass gave no plot.
@@ -143,6 +146,7 @@ fn simulation_of(
         elapsed,
         workdir,
         warnings,
+        log,
         ..
     } = output;
     let plot_names = || {
@@ -166,5 +170,6 @@ fn simulation_of(
         elapsed,
         warnings,
         workdir,
+        log,
     })
 }

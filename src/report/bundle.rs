@@ -48,6 +48,15 @@ pub fn run_files(
     run: &RunResult,
     dimensionless: Option<&Dimensionless>,
 ) -> Result<Vec<(String, Vec<u8>)>, BundleError> {
+    run_files_with_life(run, dimensionless, None)
+}
+
+/// [`run_files`] with the electrical life `life` in `report.json`.
+pub fn run_files_with_life(
+    run: &RunResult,
+    dimensionless: Option<&Dimensionless>,
+    life: Option<&crate::life::LifeReport>,
+) -> Result<Vec<(String, Vec<u8>)>, BundleError> {
     // The probes' signals; without probes, every vector the run saved.
     let plot_vectors = |plot: &'_ crate::rawfile::Plot| -> Vec<String> {
         plot.variables
@@ -65,7 +74,7 @@ pub fn run_files(
     let mut files = vec![
         (
             "report.json".to_owned(),
-            json::render_run(run, dimensionless).into_bytes(),
+            json::render_run_with_life(run, dimensionless, life).into_bytes(),
         ),
         (
             "waveforms.csv".to_owned(),

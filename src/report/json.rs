@@ -253,7 +253,7 @@ impl<'a> RunJson<'a> {
             breakdowns: run.arcs.as_ref().map(|a| a.breakdowns.as_slice()),
             arc_model: run.arcs.as_ref().map(|a| &a.model),
             makes: &run.makes,
-            life: run.life.as_ref(),
+            life: None,
         }
     }
 }
@@ -285,8 +285,7 @@ pub fn render_check(
 }
 
 /// [`render_check`] with the electrical life `life` estimated for the
-/// check (else the run's own, when the evidence carries one), at the top
-/// level of the document.
+/// check, at the top level of the document.
 pub fn render_check_with_life(
     verdict: &Verdict,
     evidence: &Evidence,
@@ -298,10 +297,6 @@ pub fn render_check_with_life(
         Evidence::Run(run) => run.pole_face.as_deref(),
         Evidence::Mechanics(_, pole_face) => pole_face.as_deref(),
     };
-    let run_life = match evidence {
-        Evidence::Run(run) => run.life.as_ref(),
-        Evidence::Mechanics(..) => None,
-    };
     let doc = CheckJson {
         verdict,
         bounce: match pole_face {
@@ -310,13 +305,10 @@ pub fn render_check_with_life(
         },
         timing: Closing::first(evidence.chatter(), evidence.operations()),
         run: match evidence {
-            Evidence::Run(run) => Some(RunJson {
-                life: None,
-                ..RunJson::new(run, dimensionless)
-            }),
+            Evidence::Run(run) => Some(RunJson::new(run, dimensionless)),
             Evidence::Mechanics(..) => None,
         },
-        life: life.or(run_life),
+        life,
     };
     let mut text = serde_json::to_string_pretty(&doc).expect("a check result always serializes");
     text.push('\n');
@@ -325,8 +317,21 @@ pub fn render_check_with_life(
 
 /// The `run` result as pretty-printed JSON with a trailing newline.
 pub fn render_run(run: &RunResult, dimensionless: Option<&Dimensionless>) -> String {
-    let mut text = serde_json::to_string_pretty(&RunJson::new(run, dimensionless))
-        .expect("a run result always serializes");
+    render_run_with_life(run, dimensionless, None)
+}
+
+/// [`render_run`] with the electrical life `life` estimated at the run's
+/// circuit.
+pub fn render_run_with_life(
+    run: &RunResult,
+    dimensionless: Option<&Dimensionless>,
+    life: Option<&crate::life::LifeReport>,
+) -> String {
+    let doc = RunJson {
+        life,
+        ..RunJson::new(run, dimensionless)
+    };
+    let mut text = serde_json::to_string_pretty(&doc).expect("a run result always serializes");
     text.push('\n');
     text
 }

@@ -118,6 +118,12 @@ pub fn pole_face(impacts: &[crate::chatter::Impact]) -> String {
 /// sentence per probe saying what the bounce added. Current probes get a
 /// table of their closures.
 pub fn render_run(run: &RunResult) -> String {
+    render_run_with_life(run, None)
+}
+
+/// [`render_run`] with the electrical life `life` estimated at the run's
+/// circuit.
+pub fn render_run_with_life(run: &RunResult, life: Option<&crate::life::LifeReport>) -> String {
     let mut out = String::new();
     for (label, value) in run_lines(run) {
         let _ = writeln!(out, "{label:<8} {value}");
@@ -154,7 +160,7 @@ pub fn render_run(run: &RunResult) -> String {
         out.push('\n');
         out.push_str(&render_arcs(report));
     }
-    if let Some(life) = &run.life {
+    if let Some(life) = life {
         out.push_str("\nelectrical life\n");
         out.push_str(&crate::life::render(life));
     }

@@ -97,7 +97,7 @@ fn every_make_of_a_coil_driven_relay_has_its_force() {
     let coupled = pipeline::run_coupled(&scenario, &ng, &Default::default())
         .unwrap_or_else(|e| panic!("{}", common::chain(&e)));
     let plan = chatterspice::plan::Plan::new(scenario.clone()).unwrap();
-    let trajectory = chatterspice::arc::make_force::coupled_trajectory(&plan, &coupled)
+    let trajectory = chatterspice::pipeline::make_force::coupled_trajectory(&plan, &coupled)
         .expect("the converged pass moves again under its own flux");
     assert_eq!(
         trajectory.chatter().intervals.len(),

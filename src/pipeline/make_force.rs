@@ -18,7 +18,7 @@ use crate::mechanics::cycle::Stops;
 use crate::mechanics::surface::surface_force;
 use crate::mechanics::two_stage::{TwoStageRun, driven_run};
 use crate::mechanics::{Mechanics, Surface, Trajectory};
-use crate::pipeline::Coupled;
+use crate::pipeline::coupled::Coupled;
 use crate::plan::Plan;
 use crate::rawfile::Vector;
 

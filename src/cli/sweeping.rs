@@ -1,0 +1,495 @@
+//! `chatterspice sweep` and `chatterspice merge`: the sweep's files in
+//! `--out` (written row by row, kept at a signal for `--resume`) and the
+//! shards joined.
+
+use std::io::{self, IsTerminal, Read, Write};
+use std::num::NonZeroUsize;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+
+use chatterspice::pipeline::RunOptions;
+use chatterspice::report;
+use chatterspice::scenario::Scenario;
+use chatterspice::spice::Ngspice;
+use chatterspice::sweep::{self, Sampler, Shard, SweepMode, SweepOptions};
+
+use super::{SimulatorArgs, Status, emit, warn_if_no_fonts};
+
+#[derive(Debug, Args)]
+pub struct SweepArgs {
+    /// Scenario file (TOML) with a [sweep] section; `-` reads it from stdin.
+    #[arg(value_name = "SCENARIO")]
+    pub scenario: PathBuf,
+
+    /// Random samples to run [default: `sweep.samples`, else 100]. Not
+    /// with a [sweep.grid], which runs each of its points.
+    #[arg(long, value_name = "N")]
+    pub samples: Option<u64>,
+
+    /// Seed of the random draws [default: `sweep.seed`, else 0].
+    #[arg(long, value_name = "S")]
+    pub seed: Option<u64>,
+
+    /// Samples run at once [default: one per core]. With ngspice, each
+    /// sample is one ngspice process: J is the most ngspice processes at
+    /// once.
+    #[arg(short = 'j', long, value_name = "J")]
+    pub jobs: Option<NonZeroUsize>,
+
+    /// Directory for sweep.csv, summary.json, sweep.svg and sweep.png (created if
+    /// needed) [default: the current directory]. Existing files there are
+    /// an error unless --force.
+    #[arg(long, value_name = "DIR", conflicts_with = "resume")]
+    pub out: Option<PathBuf>,
+
+    /// Continue the sweep interrupted in DIR (by Ctrl-C or a signal) from
+    /// its finished rows: the scenario, seed, sample count, shard and
+    /// options must be the same (checked against DIR's sweep.meta.json);
+    /// the files written are those of an uninterrupted run.
+    #[arg(long, value_name = "DIR", conflicts_with = "force")]
+    pub resume: Option<PathBuf>,
+
+    /// Simulate the mechanics only (bounces and times, no circuit, no
+    /// ngspice): microseconds per sample. A coil-driven relay closes on the
+    /// ideal DC step of its coil (`coil.drive_voltage`, else
+    /// `datasheet.coil_voltage`), as `bounce` and `check` simulate it.
+    #[arg(long)]
+    pub mechanics_only: bool,
+
+    /// Run only the K-th of N slices (samples i with i % N == K-1) into
+    /// sweep.K-of-N.csv; join the slices with `chatterspice merge`.
+    #[arg(long, value_name = "K/N", value_parser = parse_shard)]
+    pub shard: Option<Shard>,
+
+    /// Replace files that already exist in DIR.
+    #[arg(long)]
+    pub force: bool,
+
+    /// Also run each sample with an ideal contact, adding each probe's
+    /// `<signal>.ideal_edges` column: two ngspice runs per sample, one
+    /// after the other, so it takes twice as long.
+    #[arg(long, conflicts_with = "mechanics_only")]
+    pub ideal: bool,
+
+    #[command(flatten)]
+    pub simulator: SimulatorArgs,
+}
+
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// The merged CSV to write. An existing file is an error unless --force.
+    #[arg(value_name = "OUT.csv")]
+    pub output: PathBuf,
+
+    /// The shards' CSVs, in any order.
+    #[arg(value_name = "IN.csv", required = true)]
+    pub inputs: Vec<PathBuf>,
+
+    /// The sweep's number of samples, so that missing last samples are
+    /// found too [default: up to the largest index present].
+    #[arg(long, value_name = "N")]
+    pub samples: Option<u64>,
+
+    /// Write the rows there are even when samples are missing.
+    #[arg(long)]
+    pub allow_missing: bool,
+
+    /// Replace OUT.csv if it already exists.
+    #[arg(long)]
+    pub force: bool,
+
+    /// Accept shards that have no identity file beside them (IN.meta.json,
+    /// which `sweep --shard` writes): their seed, scenario and sample count
+    /// cannot be checked, and summary.json says `"identity": "unverified"`.
+    /// Without it such a shard is refused.
+    #[arg(long)]
+    pub unverified: bool,
+}
+
+fn parse_shard(text: &str) -> Result<Shard, String> {
+    text.parse::<Shard>().map_err(|e| e.to_string())
+}
+
+/// The sweep's file names in `--out`: a shard writes its CSV alone.
+fn sweep_files(shard: Option<Shard>) -> Vec<String> {
+    match shard {
+        Some(s) => vec![format!("sweep.{}-of-{}.csv", s.index, s.count)],
+        None => vec![
+            "sweep.csv".to_owned(),
+            "summary.json".to_owned(),
+            "sweep.svg".to_owned(),
+            "sweep.png".to_owned(),
+        ],
+    }
+}
+
+/// An indicatif bar on a terminal's stderr.
+struct Bar(indicatif::ProgressBar);
+
+impl sweep::Progress for Bar {
+    fn start(&self, total: u64) {
+        self.0.set_length(total);
+    }
+    fn advance(&self, done: u64) {
+        self.0.inc(done);
+    }
+    fn finish(&self) {
+        self.0.finish_and_clear();
+    }
+}
+
+/// Exit status 1 when a sample failed a limit or could not run: the
+/// sweep's files are written either way.
+///
+/// The CSV is written under a temporary name in the output directory and
+/// renamed into place at the end; a signal puts its whole rows in place
+/// with `sweep.meta.json` marked incomplete, for `--resume`.
+pub fn sweep(args: &SweepArgs) -> Result<Status> {
+    let (scenario, text) = load_scenario_text(&args.scenario)?;
+    let sampler = Sampler::new(&scenario, args.samples, args.seed)?;
+    let resume = args.resume.is_some();
+    let dir = args
+        .resume
+        .clone()
+        .or_else(|| args.out.clone())
+        .unwrap_or_else(|| PathBuf::from("."));
+    let names = sweep_files(args.shard);
+    let csv_path = dir.join(&names[0]);
+    let meta_path = sweep::resume::meta_path(&csv_path);
+    let _lock = chatterspice::output::OutputLock::acquire(&dir, &names[0])?;
+    if !resume {
+        refuse_existing_sweep(&dir, &names, &meta_path, args.force)?;
+    }
+    let ngspice = if args.mechanics_only {
+        None
+    } else {
+        Some(args.simulator.ngspice()?)
+    };
+    let options = sweep_options(args, ngspice.as_ref());
+    let identity = sweep_identity(args, &scenario, &text, &sampler);
+
+    let (partial_csv, partial_meta) = (
+        sweep::resume::partial(&csv_path),
+        sweep::resume::partial(&meta_path),
+    );
+    // What a run killed outright left, else what a signal left.
+    let (from_csv, from_meta) = if partial_csv.exists() && partial_meta.exists() {
+        (partial_csv.clone(), partial_meta.clone())
+    } else {
+        (csv_path.clone(), meta_path.clone())
+    };
+    let kept = if resume {
+        sweep::resume::check_meta(&from_meta, &identity)?;
+        let (header, signals, columns) = sweep::run::layout(&scenario, &sampler, &options)?;
+        Some(sweep::resume::finished_rows(
+            &from_csv,
+            &header,
+            sampler.keys().len(),
+            signals.len(),
+            columns,
+            options.shard,
+        )?)
+    } else {
+        if partial_csv.exists() {
+            eprintln!(
+                "note: {} holds the rows of an interrupted sweep; this new sweep replaces it \
+                 (--resume {} would have continued it)",
+                partial_csv.display(),
+                dir.display()
+            );
+        }
+        None
+    };
+    let mut staged =
+        chatterspice::output::Staged::with_name(&csv_path, &partial_csv, args.force || resume)?;
+    let partial_meta_text = sweep::resume::Meta {
+        identity: identity.clone(),
+        complete: false,
+        rows: 0,
+    }
+    .to_json();
+    std::fs::write(&partial_meta, partial_meta_text)
+        .with_context(|| format!("{}: cannot write it", partial_meta.display()))?;
+    // Gone with the partial CSV when the sweep fails; kept beside it when
+    // the process is killed.
+    let _partial_meta = tempfile::TempPath::try_from_path(&partial_meta)
+        .with_context(|| format!("{}: cannot hold it", partial_meta.display()))?;
+    let done = match kept {
+        Some((bytes, done)) => {
+            staged.file().write_all(&bytes).with_context(|| {
+                format!("{}: cannot write the sweep's CSV", partial_csv.display())
+            })?;
+            eprintln!(
+                "resuming {}: {} of {} samples done",
+                from_csv.display(),
+                done.len(),
+                options.shard.len(sampler.count())
+            );
+            done
+        }
+        None => Vec::new(),
+    };
+    let at_stop = keep_rows_at_stop(
+        &partial_csv,
+        &csv_path,
+        &meta_path,
+        &partial_meta,
+        &identity,
+    );
+
+    let bar = progress_bar();
+    let progress: &dyn sweep::Progress = match &bar {
+        Some(b) => b,
+        None => &sweep::NoProgress,
+    };
+    let collected = sweep::run_from(&scenario, &sampler, &options, staged.file(), progress, done)
+        .with_context(|| format!("{}: the sweep stopped", csv_path.display()))?;
+    let summary = collected.summary(&sampler)?;
+    let rows = collected.len() as u64;
+    let mut files = Vec::new();
+    if args.shard.is_none() {
+        let svg = sweep::plot::render(&collected, &sampler)?;
+        let png = report::png::render(&svg)?;
+        files.push((names[1].clone(), summary.to_json().into_bytes()));
+        files.push((names[2].clone(), svg.into_bytes()));
+        files.push((names[3].clone(), png.bytes));
+    }
+    let meta = sweep::resume::Meta {
+        identity,
+        complete: true,
+        rows,
+    };
+    let meta_name = meta_path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    files.push((meta_name, meta.to_json().into_bytes()));
+    drop(at_stop);
+    staged.commit()?;
+    report::write_bundle(&dir, &files, true)?;
+    if args.shard.is_none() {
+        warn_if_no_fonts();
+    }
+    let mut text = summary.render_table();
+    text.push_str(&format!(
+        "\nwritten: {}\n",
+        names
+            .iter()
+            .map(|n| dir.join(n).display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    ));
+    emit(&text, None, false)?;
+    Ok(if summary.failing + summary.errors > 0 {
+        Status::CheckFailed
+    } else {
+        Status::Success
+    })
+}
+
+/// Fail before any work if the sweep's files exist (unless `force`), or
+/// something is in the way of one.
+fn refuse_existing_sweep(
+    dir: &Path,
+    names: &[String],
+    meta_path: &Path,
+    force: bool,
+) -> Result<()> {
+    let csv_path = dir.join(&names[0]);
+    for path in names
+        .iter()
+        .map(|n| dir.join(n))
+        .chain([meta_path.to_path_buf()])
+    {
+        if let Err(e) = chatterspice::output::check_target(&path, force) {
+            if matches!(e, report::WriteError::Exists { .. }) && path == csv_path {
+                bail!(
+                    "{}: already exists; pass --force to overwrite the sweep's files, \
+                         --resume {} to continue an interrupted sweep, or choose another --out",
+                    path.display(),
+                    dir.display()
+                );
+            }
+            return Err(e.into());
+        }
+    }
+    Ok(())
+}
+
+/// How the sweep runs, from the command line.
+fn sweep_options<'n>(args: &SweepArgs, ngspice: Option<&'n Ngspice>) -> SweepOptions<'n> {
+    let mut options = SweepOptions::new(match ngspice {
+        Some(n) => SweepMode::Circuit(n),
+        None => SweepMode::Mechanics,
+    });
+    if let Some(jobs) = args.jobs {
+        options.jobs = jobs;
+    }
+    options.shard = args.shard.unwrap_or(Shard::WHOLE);
+    // A sample is one ngspice process (two with --ideal, in turn), so
+    // --jobs is the number of ngspice processes at once.
+    options.run = RunOptions {
+        compare_ideal: args.ideal,
+        ideal_alongside: false,
+        ..args.simulator.run_options()
+    };
+    options
+}
+
+/// Which sweep this is, for `sweep.meta.json` and `--resume`.
+fn sweep_identity(
+    args: &SweepArgs,
+    scenario: &Scenario,
+    text: &str,
+    sampler: &Sampler,
+) -> sweep::resume::Identity {
+    let netlist_text = match scenario.netlist() {
+        Some(Ok((_, netlist))) => netlist,
+        _ => String::new(),
+    };
+    sweep::resume::Identity {
+        tool: format!("chatterspice {}", env!("CARGO_PKG_VERSION")),
+        scenario_digest: sweep::resume::digest(&[text.as_bytes(), netlist_text.as_bytes()]),
+        seed: sampler.seed(),
+        samples: sampler.count(),
+        shard: args.shard.map(|s| s.to_string()),
+        mode: if args.mechanics_only {
+            "mechanics"
+        } else {
+            "circuit"
+        }
+        .to_owned(),
+        ideal: args.ideal,
+    }
+}
+
+/// At a signal: the rows written so far into `partial_csv`, whole, moved
+/// to `csv`, and `meta` saying they are incomplete, where `--resume`
+/// finds them.
+fn keep_rows_at_stop(
+    partial_csv: &Path,
+    csv: &Path,
+    meta: &Path,
+    partial_meta: &Path,
+    identity: &sweep::resume::Identity,
+) -> chatterspice::interrupt::Registered {
+    let (tmp, csv, meta, tmp_meta, identity) = (
+        partial_csv.to_path_buf(),
+        csv.to_path_buf(),
+        meta.to_path_buf(),
+        partial_meta.to_path_buf(),
+        identity.clone(),
+    );
+    chatterspice::interrupt::finish_at_stop(move || {
+        if sweep::resume::truncate_to_whole_lines(&tmp).is_err() {
+            return;
+        }
+        let rows = std::fs::read(&tmp).map_or(0, |b| sweep::resume::row_count(&b));
+        if std::fs::rename(&tmp, &csv).is_ok() {
+            let record = sweep::resume::Meta {
+                identity,
+                complete: false,
+                rows,
+            };
+            if std::fs::write(&meta, record.to_json()).is_ok() {
+                let _ = std::fs::remove_file(&tmp_meta);
+            }
+            eprintln!(
+                "sweep interrupted: {rows} finished rows kept in {}; continue with --resume {}",
+                csv.display(),
+                csv.parent().unwrap_or(Path::new(".")).display()
+            );
+        }
+    })
+}
+
+/// A progress bar on stderr when it is a terminal.
+fn progress_bar() -> Option<Bar> {
+    if io::stderr().is_terminal() {
+        let bar = indicatif::ProgressBar::new(0);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{bar:40} {pos}/{len} samples, {per_sec}, {eta} left",
+            )
+            .expect("a valid template"),
+        );
+        Some(Bar(bar))
+    } else {
+        None
+    }
+}
+
+/// A scenario file (or `-`, standard input) and its text, its files
+/// protected as inputs.
+fn load_scenario_text(path: &Path) -> Result<(Scenario, String)> {
+    let text = if path == Path::new("-") {
+        let mut text = String::new();
+        io::stdin()
+            .read_to_string(&mut text)
+            .context("cannot read the scenario from standard input")?;
+        text
+    } else {
+        chatterspice::input::read_to_string(path).map_err(|source| {
+            chatterspice::scenario::ScenarioError::Read {
+                path: path.to_owned(),
+                source,
+            }
+        })?
+    };
+    let origin = if path == Path::new("-") {
+        Path::new("<stdin>")
+    } else {
+        path
+    };
+    let scenario = Scenario::parse(&text, origin)?;
+    if path != Path::new("-") {
+        report::protect_input(path);
+    }
+    if let Some(circuit) = &scenario.circuit {
+        report::protect_input(&circuit.netlist);
+    }
+    Ok((scenario, text))
+}
+
+pub fn merge(args: &MergeArgs) -> Result<()> {
+    for input in &args.inputs {
+        report::protect_input(input);
+    }
+    let report = sweep::merge::merge_files(
+        &args.output,
+        &args.inputs,
+        args.samples,
+        args.allow_missing,
+        args.force,
+        args.unverified,
+    )?;
+    if !report.duplicates.is_empty() {
+        eprintln!(
+            "note: {} sample(s) were in more than one input, with the same row: {}",
+            report.duplicates.len(),
+            sweep::table::ranges(&report.duplicates)
+        );
+    }
+    if !report.missing.is_empty() {
+        eprintln!(
+            "warning: {} sample(s) missing: {}",
+            report.missing.len(),
+            sweep::table::ranges(&report.missing)
+        );
+    }
+    eprintln!(
+        "{}: {} rows from {} file(s)",
+        args.output.display(),
+        report.rows,
+        args.inputs.len()
+    );
+    if args.unverified {
+        eprintln!(
+            "note: --unverified: shards without an identity file were merged unchecked; \
+             summary.json says \"identity\": \"unverified\""
+        );
+    }
+    Ok(())
+}
