@@ -460,7 +460,7 @@ pub fn compare(seed: u64) -> Result<(usize, Outcome), String> {
         .map_err(|e| format!("seed {seed}: the engine failed: {e}\n{relay:?}"))?;
     let contact = |e: &&Ev| matches!(e.kind, Kind::Touch | Kind::Release);
     let events = engine_events(&run, f64::INFINITY);
-    let last = events.iter().filter(contact).last().map_or(0.0, |e| e.t);
+    let last = events.iter().rfind(contact).map_or(0.0, |e| e.t);
     let settle = run.contact.settle_time.unwrap_or(last).max(last);
     // The reference goes on past the contact's last event: a contact
     // event there would be one the engine's ending said could not happen.
