@@ -24,10 +24,17 @@
 //!   `δ̇ ≤ −1/χ`: the bound is the global minimum of V plus `½ m_b/χ²`,
 //!   or the position bound, whichever is lower.
 //! - An open contact that was touched is reached again only through
-//!   `x_b = g`: below the same position bound it `ends_open`.
+//!   `x_b = g` (or, pressed in past it after a release by force, by the
+//!   release's own condition): below the same bound it `ends_open`.
+//! - The pole face releases the armature, or is reached again, only
+//!   through `x_a = g + o` (or, released by force, where its own law
+//!   lets go): below the least energy there the pole face never changes
+//!   its state again, and its record is complete.
 //!
-//! Minima of a convex function of one variable are found by golden
-//! section; of two, by golden section nested in golden section.
+//! Under a constant drive the bounds depend on the relay alone and are
+//! found once per run; a check then costs one energy. Minima of a convex
+//! function of one variable are found by golden section; of two, by
+//! golden section nested in golden section.
 
 use super::model::{RelayModel, StopModes, Y};
 use super::relay::Release;
@@ -37,20 +44,72 @@ use crate::mechanics::surface::{Surface, surface_energy};
 /// Golden-section iterations: the bracket shrinks by 0.618^80 ≈ 2e-17.
 const ITERATIONS: usize = 80;
 
-/// The energy bound's state: when it was last checked.
+/// The energy bound's state: when it was last checked, and under a
+/// constant drive the bounds themselves, which then depend on the relay
+/// alone and are found once.
 pub(crate) struct EnergyBound {
     steps: usize,
+    cached: Option<Bounds>,
+}
+
+/// The least energies at which a stop can change its state, with the
+/// drive frozen.
+#[derive(Debug, Clone, Copy)]
+struct Bounds {
+    /// J, the closed contact releases (or, pressed in past its surface
+    /// after a release by force, engages again).
+    release: f64,
+    /// J, the open contact, back behind its surface, reaches it again.
+    reach: f64,
+    /// J, the pole face releases the armature or is reached again
+    /// (infinite without a pole face: it never changes).
+    pole: f64,
 }
 
 impl EnergyBound {
     pub(crate) fn new() -> EnergyBound {
-        EnergyBound { steps: 0 }
+        EnergyBound {
+            steps: 0,
+            cached: None,
+        }
+    }
+
+    /// A new count of steps, with the bounds found so far.
+    pub(crate) fn fresh(&self) -> EnergyBound {
+        EnergyBound {
+            steps: 0,
+            cached: self.cached,
+        }
     }
 
     /// Whether to check at this step: every fourth accepted step.
     pub(crate) fn due(&mut self) -> bool {
         self.steps += 1;
         self.steps % 4 == 0
+    }
+
+    /// The energy of `y` with the drive frozen at `t`, and the bounds
+    /// there.
+    fn at<D: DriveModel>(&mut self, model: &RelayModel<'_, D>, t: f64, y: &Y) -> (f64, Bounds) {
+        let frozen = Frozen::at(model, t, y);
+        let bounds = match self.cached {
+            Some(b) => b,
+            None => {
+                let b = frozen.bounds();
+                if model.drive.constant().is_some() {
+                    self.cached = Some(b);
+                }
+                b
+            }
+        };
+        (frozen.energy(y), bounds)
+    }
+
+    /// Whether energy `e` is below `bound` beyond a margin for rounding.
+    fn below<D: DriveModel>(model: &RelayModel<'_, D>, e: f64, bound: f64) -> bool {
+        let m = model.m;
+        let margin = 1e-9 * (e.abs() + bound.abs() + m.stiffness * m.gap * m.gap);
+        e < bound - margin
     }
 
     /// Whether the closed contact can never release again.
@@ -61,13 +120,13 @@ impl EnergyBound {
         y: &Y,
         _modes: StopModes,
     ) -> bool {
-        let frozen = Frozen::at(model, t, y);
-        let e = frozen.energy(y);
-        let bound = frozen.release_bound(e);
-        e < bound - frozen.margin(e, bound)
+        let (e, b) = self.at(model, t, y);
+        Self::below(model, e, b.release)
     }
 
-    /// Whether the open contact can never be reached again.
+    /// Whether the open contact can never be reached again: behind its
+    /// surface it must come back through it; pressed in past it (let go
+    /// by its force) it engages again as a release would.
     pub(crate) fn cannot_reach<D: DriveModel>(
         &mut self,
         model: &RelayModel<'_, D>,
@@ -75,13 +134,29 @@ impl EnergyBound {
         y: &Y,
         _modes: StopModes,
     ) -> bool {
-        if y[2] > 0.0 {
-            return false;
+        let (e, b) = self.at(model, t, y);
+        let contact_u = if model.build.blade.is_some() {
+            y[2]
+        } else {
+            y[0]
+        };
+        let bound = if contact_u > 0.0 { b.release } else { b.reach };
+        Self::below(model, e, bound)
+    }
+
+    /// Whether the pole face can never change its state again (released
+    /// or reached): always, without a pole face.
+    pub(crate) fn pole_settled<D: DriveModel>(
+        &mut self,
+        model: &RelayModel<'_, D>,
+        t: f64,
+        y: &Y,
+    ) -> bool {
+        if model.build.pole_face.is_none() {
+            return true;
         }
-        let frozen = Frozen::at(model, t, y);
-        let e = frozen.energy(y);
-        let bound = frozen.at_contact(0.0);
-        e < bound - frozen.margin(e, bound)
+        let (e, b) = self.at(model, t, y);
+        Self::below(model, e, b.pole)
     }
 }
 
@@ -171,33 +246,80 @@ impl<'m, 'a, D: DriveModel> Frozen<'m, 'a, D> {
         golden(|xa| self.potential(xa, xb), self.lo, self.hi).1
     }
 
-    /// J, the least energy at which the contact can release.
-    fn release_bound(&self, energy: f64) -> f64 {
+    /// The least energies at which each stop can change its state.
+    fn bounds(&self) -> Bounds {
         let model = self.model;
-        let position = self.at_contact(0.0);
-        if model.build.release == Release::Position {
-            return position;
-        }
+        let reach = self.at_contact(0.0);
         let contact_mass = model.build.blade.map_or(model.m.mass, |b| b.mass);
-        match model.contact {
-            Surface::KelvinVoigt { stiffness, damping } if damping > 0.0 => {
-                // The kinetic energy the release needs at penetration δ.
-                let need = |d: f64| 0.5 * contact_mass * (stiffness * d / damping).powi(2);
-                let global = self.global();
-                let room = (energy - global).max(0.0);
-                let top = damping / stiffness * (2.0 * room / contact_mass).sqrt();
-                if top <= 0.0 {
-                    return position;
+        let release = match model.build.release {
+            Release::Position => reach,
+            Release::Force => {
+                self.by_force(&model.contact, contact_mass, reach, |d| self.at_contact(d))
+            }
+        };
+        let pole = match &model.build.pole_face {
+            None => f64::INFINITY,
+            Some(p) => {
+                let plane = self.at_pole(0.0);
+                match p.release {
+                    Release::Position => plane,
+                    Release::Force => {
+                        self.by_force(&p.surface, model.m.mass, plane, |d| self.at_pole(d))
+                    }
                 }
-                golden(|d| self.at_contact(d) + need(d), 0.0, top)
-                    .1
-                    .min(position)
+            }
+        };
+        Bounds {
+            release,
+            reach,
+            pole,
+        }
+    }
+
+    /// J, the least energy at which a surface released by its force lets
+    /// go of a body of `mass`, `plane` the least potential with the body
+    /// on the surface and `at(δ)` the least at penetration δ.
+    ///
+    /// A Kelvin–Voigt surface lets go where `s0 δ + r0 δ̇ ≤ 0`, i.e. with
+    /// the kinetic energy `½ mass (s0 δ / r0)²` at least: the least over
+    /// `δ ≥ 0` of `at(δ)` plus that, a convex function. Past the δ where
+    /// that kinetic energy alone exceeds `plane` less the least potential
+    /// anywhere, the sum exceeds `plane` (its value at δ = 0), so the
+    /// search stops there and the bound depends on the relay alone. A
+    /// Hunt–Crossley surface lets go only at `δ̇ ≤ −1/χ`: the least
+    /// potential anywhere plus `½ mass/χ²`, or `plane`, the lower.
+    fn by_force(&self, surface: &Surface, mass: f64, plane: f64, at: impl Fn(f64) -> f64) -> f64 {
+        match *surface {
+            Surface::KelvinVoigt { stiffness, damping } if damping > 0.0 => {
+                let need = |d: f64| 0.5 * mass * (stiffness * d / damping).powi(2);
+                let room = (plane - self.global()).max(0.0);
+                let top = damping / stiffness * (2.0 * room / mass).sqrt();
+                if top <= 0.0 {
+                    return plane;
+                }
+                golden(|d| at(d) + need(d), 0.0, top).1.min(plane)
             }
             Surface::HuntCrossley { chi, .. } if chi > 0.0 => {
-                position.min(self.global() + 0.5 * contact_mass / (chi * chi))
+                plane.min(self.global() + 0.5 * mass / (chi * chi))
             }
-            _ => position,
+            _ => plane,
         }
+    }
+
+    /// J, the least potential with the armature at `δ` past the pole face.
+    fn at_pole(&self, delta: f64) -> f64 {
+        let model = self.model;
+        let o = model.build.pole_face.map_or(0.0, |p| p.overtravel);
+        let xa = model.m.gap + o + delta;
+        if model.build.blade.is_none() {
+            return self.potential(xa, xa);
+        }
+        golden(
+            |xb| self.potential(xa, xb),
+            self.lo,
+            self.hi.max(xa) + model.m.gap,
+        )
+        .1
     }
 
     /// J, the least potential anywhere.
@@ -215,12 +337,6 @@ impl<'m, 'a, D: DriveModel> Frozen<'m, 'a, D> {
             .1
         };
         golden(inner, self.lo, self.hi).1
-    }
-
-    /// J, a margin against rounding in the comparison.
-    fn margin(&self, energy: f64, bound: f64) -> f64 {
-        let m = self.model.m;
-        1e-9 * (energy.abs() + bound.abs() + m.stiffness * m.gap * m.gap)
     }
 }
 

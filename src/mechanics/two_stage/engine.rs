@@ -18,7 +18,7 @@
 use super::energy::widest_opening;
 use super::linear::{LinearSystem, propagate};
 use super::model::{RelayModel, StopMode, StopModes, Which, Y, law};
-use super::propagation::{Propagation, Tally, decided, finish, start};
+use super::propagation::{Propagation, Tally, check_closing, finish, start};
 use super::relay::{Release, TwoStage, validate_all};
 pub use super::run::Horizon;
 use super::run::TwoStageRun;
@@ -205,18 +205,19 @@ pub(super) fn advance<D: DriveModel>(
     }
 }
 
-/// A closing that ends closed at `t_end` without its ending decided is
-/// followed on, with the drive as it is, until the energy bound proves it
-/// stuck or the contact opens, up to [`PROOF_SPAN`]` × t_end`: stuck (with
-/// its settle time, the last impact before `t_end`) only when proven
-/// before any further event. What happens after `t_end` is not recorded.
+/// A closing whose contact's ending is not decided at `t_end` is followed
+/// on, with the drive as it is, until the energy bound proves its ending
+/// or the contact changes, up to [`PROOF_SPAN`]` × t_end`: closed there,
+/// `stuck` (with its settle time, the last impact before `t_end`), open,
+/// `ends_open`, each only when proven before the contact changes again.
+/// What happens after `t_end` is not recorded.
 fn prove_ending<D: DriveModel>(
     model: &RelayModel<'_, D>,
     settings: &Settings,
     p: &mut Propagation,
 ) {
     if p.ending.is_some()
-        || p.modes.contact == StopMode::Open
+        || p.modes.contact == StopMode::Pressed
         || p.rec.contact_is_empty()
         || p.t < settings.t_end
     {
@@ -224,21 +225,30 @@ fn prove_ending<D: DriveModel>(
     }
     // Proven where it stands (the run's summary will say so): nothing to
     // follow.
-    if p.modes.contact == StopMode::Pressed || p.bound.cannot_release(model, p.t, &p.y, p.modes) {
+    let (t, y, modes) = (p.t, p.y, p.modes);
+    let (proven, ending) = match modes.contact {
+        StopMode::Open => (p.bound.cannot_reach(model, t, &y, modes), Outcome::EndsOpen),
+        _ => (p.bound.cannot_release(model, t, &y, modes), Outcome::Stuck),
+    };
+    if proven {
         return;
     }
     let mut later = p.fork();
-    let contacts = later.rec.contact_count();
     let span = Settings {
         t_end: settings.t_end * PROOF_SPAN,
         ..*settings
     };
     let followed = advance(model, &span, Horizon::Closing, &mut later);
-    if followed.is_ok()
-        && later.ending == Some(Outcome::Stuck)
-        && later.rec.contact_count() == contacts
-    {
-        p.ending = Some(Outcome::Stuck);
+    if followed.is_err() || later.ending != Some(ending) {
+        return;
+    }
+    // Nothing happened to the contact on the way, but for openings below
+    // resolution merged into a closed one (then it is resolved).
+    if later.rec.changes() == p.rec.changes() {
+        p.ending = Some(ending);
+    } else if ending == Outcome::Stuck && later.rec.same_closure(&p.rec) {
+        p.ending = Some(ending);
+        p.rec.take_resolution(&later.rec);
     }
 }
 
@@ -251,7 +261,7 @@ fn integrate<D: DriveModel>(
 ) -> Result<(), DriveError> {
     let tol = tolerance(model);
     let mut h = 0.05 / fastest(model);
-    while p.t < settings.t_end && p.ending.is_none() {
+    while p.t < settings.t_end && !p.over() {
         let modes = p.modes;
         let f = |t: f64, y: &Y| model.rate(t, y, modes);
         let mut solver = Dop853::new(f, p.t, p.y, h, tol);
@@ -276,11 +286,11 @@ fn integrate<D: DriveModel>(
                     p.pieces.push(Span::dense(dense, step.t1, step.y1, modes));
                     p.t = step.t1;
                     p.y = step.y1;
-                    if horizon == Horizon::Closing
-                        && let Some(end) = decided(model, &mut p.bound, p.t, &p.y, modes, &p.rec)
-                    {
-                        p.ending = Some(end);
-                        return Ok(());
+                    if horizon == Horizon::Closing {
+                        check_closing(model, p);
+                        if p.over() {
+                            return Ok(());
+                        }
                     }
                     if p.t >= settings.t_end {
                         return Ok(());

@@ -39,7 +39,7 @@ use nalgebra::{Matrix4, SMatrix, SVector, Vector4};
 
 use super::linear_mode::{LinearMode, Poly, STEP_NORM, Series, W};
 use super::model::{RelayModel, StopMode, StopModes, Which, Y};
-use super::propagation::{Propagation, decided};
+use super::propagation::{Propagation, check_closing};
 use super::relay::Release;
 use super::run::Horizon;
 use super::span::{Interpolant, Span};
@@ -193,6 +193,9 @@ pub(crate) struct LinearSystem {
     gap: f64,
     /// J, [`LinearSystem::position_bound`], computed once.
     bound: f64,
+    /// J, [`LinearSystem::pole_bound`], computed once (`None`: found by
+    /// the general bound, for a pole face released by force).
+    pole_bound: Option<f64>,
 }
 
 impl LinearSystem {
@@ -240,8 +243,10 @@ impl LinearSystem {
             net: force - m.preload,
             gap: m.gap,
             bound: 0.0,
+            pole_bound: None,
         };
         system.bound = system.position_bound();
+        system.pole_bound = system.pole_bound();
         Some(system)
     }
 
@@ -366,21 +371,60 @@ impl LinearSystem {
         self.potential(xa, g)
     }
 
-    /// Whether the energy bound decides the closing at state `y`.
-    fn decided(&self, y: &Y, modes: StopModes, touched: bool) -> Option<Outcome> {
-        if !touched || self.by_force {
+    /// J, the least potential with the armature on a pole face released
+    /// by position (`x_a = g + o`): the contact point then rests where the
+    /// blade and the contact balance, `x_b − g = s_b o/(s_b + s0)`, and
+    /// the two springs in series store `½ s_b s0/(s_b + s0) o²`. `None`
+    /// without such a pole face.
+    fn pole_bound(&self) -> Option<f64> {
+        let (o, _, _, by_force) = self.pole?;
+        if by_force {
             return None;
         }
-        let e = self.energy(y);
-        let bound = self.bound;
+        let xa = self.gap + o;
+        let series = self.sb * self.s0 / (self.sb + self.s0);
+        Some(0.5 * self.s * xa * xa - self.net * xa + 0.5 * series * o * o)
+    }
+
+    fn below(&self, e: f64, bound: f64) -> bool {
         let margin = 1e-9 * (e.abs() + bound.abs() + self.s * self.gap * self.gap);
-        if e >= bound - margin {
+        e < bound - margin
+    }
+
+    /// The contact's ending, when the energy bound decides it at state
+    /// `y` (a contact released by position).
+    fn decided(&self, y: &Y, modes: StopModes) -> Option<Outcome> {
+        if !self.below(self.energy(y), self.bound) {
             return None;
         }
         match modes.contact {
             StopMode::Open if y[2] < 0.0 => Some(Outcome::EndsOpen),
             StopMode::Open => None,
             _ => Some(Outcome::Stuck),
+        }
+    }
+
+    /// Check the closing at the present state of `p` (every fourth step):
+    /// in closed form for stops released by position, else by the
+    /// general bound.
+    fn check<D: DriveModel>(&self, model: &RelayModel<'_, D>, p: &mut Propagation) {
+        let closed_form = !self.by_force && (self.pole.is_none() || self.pole_bound.is_some());
+        if !closed_form {
+            return check_closing(model, p);
+        }
+        if p.rec.contact_is_empty() || p.steps % 4 != 0 {
+            return;
+        }
+        if p.ending.is_none() {
+            match self.decided(&p.y, p.modes) {
+                Some(ending) => p.decide(ending),
+                None => return,
+            }
+        }
+        if p.follow_pole && !p.pole_settled {
+            p.pole_settled = self
+                .pole_bound
+                .is_none_or(|bound| self.below(self.energy(&p.y), bound));
         }
     }
 }
@@ -505,7 +549,7 @@ pub(crate) fn propagate<D: DriveModel>(
     p: &mut Propagation,
 ) -> Result<(), DriveError> {
     let mut cache: [Option<Arc<ModeKit>>; 4] = [None, None, None, None];
-    while p.t < settings.t_end && p.ending.is_none() {
+    while p.t < settings.t_end && !p.over() {
         let key = usize::from(p.modes.contact != StopMode::Open)
             + 2 * usize::from(p.modes.pole != StopMode::Open);
         let kit = cache[key]
@@ -565,24 +609,16 @@ pub(crate) fn propagate<D: DriveModel>(
             }
             // The energy only falls within a mode, so the bound, once
             // met, stays met: every fourth step is enough to see it.
-            let ending = match horizon {
-                Horizon::Closing if p.steps % 4 == 0 => {
-                    system.decided(&p.y, p.modes, !p.rec.contact_is_empty())
-                }
-                _ => None,
+            if horizon == Horizon::Closing {
+                system.check(model, p);
             }
-            .or_else(|| {
-                (horizon == Horizon::Closing && system.by_force && p.steps % 16 == 0)
-                    .then(|| decided(model, &mut p.bound, p.t, &p.y, p.modes, &p.rec))
-                    .flatten()
-            });
-            if ending.is_some() || p.t >= settings.t_end || held == PIECE_STEPS {
+            let over = p.over();
+            if over || p.t >= settings.t_end || held == PIECE_STEPS {
                 let last = piece(p, t0, w0);
                 p.pieces.push(last);
                 (t0, w0, held) = (p.t, w, 0);
             }
-            if ending.is_some() {
-                p.ending = ending;
+            if over {
                 return Ok(());
             }
             if p.t >= settings.t_end {

@@ -2,7 +2,7 @@
 //! to event: where it is and in which modes ([`Propagation`]), what it has
 //! recorded ([`Tally`]),
 //! how an event changes the modes and the records ([`transition`]), when
-//! a closing's ending is decided ([`decided`]), and the records it
+//! a closing's ending is decided ([`check_closing`]), and the records it
 //! returns.
 
 use super::energy::{EnergyBound, step_energy};
@@ -29,6 +29,15 @@ pub(crate) struct Tally {
     lift_offs: Vec<f64>,
     /// m, the blade's farthest reach before its first touch.
     reach: f64,
+    /// Whether the contact's present closure went through an opening
+    /// below resolution (merged into it), or ended a rigid contact's
+    /// bounces below resolution: closed for good, it is `resolved`.
+    below_resolution: bool,
+    /// s, where a rigid contact's bounces below resolution accumulate.
+    accumulation: Option<f64>,
+    /// The contact's changes of state so far (touches and releases,
+    /// merged ones included).
+    changes: usize,
 }
 
 impl Tally {
@@ -70,9 +79,28 @@ impl Tally {
         changes.chain(pole).filter(|&e| e > t).reduce(f64::min)
     }
 
-    /// Impacts on the contact so far.
-    pub(crate) fn contact_count(&self) -> usize {
-        self.contact.len()
+    /// Whether this record, taken on from `before`, has the same impacts
+    /// and the contact still closed in the last one: whatever changed were
+    /// openings below resolution, merged.
+    pub(crate) fn same_closure(&self, before: &Tally) -> bool {
+        self.contact.len() == before.contact.len()
+            && self
+                .contact
+                .last()
+                .is_some_and(|i| i.release_time.is_none())
+    }
+
+    /// Take on the closure's resolution from `later`, the record followed on.
+    pub(crate) fn take_resolution(&mut self, later: &Tally) {
+        self.below_resolution |= later.below_resolution;
+        if self.accumulation.is_none() {
+            self.accumulation = later.accumulation;
+        }
+    }
+
+    /// The contact's changes of state so far, merged ones included.
+    pub(crate) fn changes(&self) -> usize {
+        self.changes
     }
 
     /// Take in the state `y` in `modes`: the engaged contact's force
@@ -106,6 +134,37 @@ impl Tally {
         }
     }
 
+    /// At a touch at `t`: when the opening since the last release was
+    /// below resolution (shorter than `min_open_time` or narrower than
+    /// `min_gap`), take the contact as closed through it (the release
+    /// undone, no new impact) and say so.
+    fn merge_short_opening(&mut self, settings: &Settings, t: f64) -> bool {
+        let Some(last) = self.contact.last_mut() else {
+            return false;
+        };
+        let Some(released) = last.release_time else {
+            return false;
+        };
+        let opening = last.max_gap_after.unwrap_or(0.0);
+        if t - released >= settings.min_open_time && opening >= settings.min_gap {
+            return false;
+        }
+        last.release_time = None;
+        last.release_velocity = None;
+        last.contact_time = None;
+        last.restitution = None;
+        last.max_gap_after = None;
+        if self
+            .intervals
+            .last()
+            .is_some_and(|iv| iv.state == ContactState::Open)
+        {
+            self.intervals.pop();
+        }
+        self.below_resolution = true;
+        true
+    }
+
     fn switch(intervals: &mut Vec<Interval>, t: f64, state: ContactState) {
         if let Some(last) = intervals.last_mut() {
             if last.state == state {
@@ -137,8 +196,17 @@ pub(crate) struct Propagation {
     pub pieces: Vec<Span>,
     pub steps: usize,
     pub bound: EnergyBound,
-    /// The ending, when one was decided before the horizon.
+    /// The contact's ending, when one was decided before the horizon.
     pub ending: Option<Outcome>,
+    /// s, when the contact's ending was proven.
+    pub proven_at: Option<f64>,
+    /// Whether to run on past the contact's ending until the pole face
+    /// can no longer change (its record complete) or the horizon: the
+    /// run itself; a follow-on that only proves an ending does not.
+    pub follow_pole: bool,
+    /// Whether the pole face can no longer change (after the contact's
+    /// ending).
+    pub pole_settled: bool,
     /// J, the energy at the start, under a constant force with every stop
     /// released by position (when the energy can only fall).
     pub energy0: Option<f64>,
@@ -156,11 +224,31 @@ impl Propagation {
             rec: self.rec.clone(),
             pieces: Vec::new(),
             steps: 0,
-            bound: EnergyBound::new(),
+            bound: self.bound.fresh(),
             ending: None,
+            proven_at: None,
+            follow_pole: false,
+            pole_settled: false,
             energy0: self.energy0,
             violation: None,
         }
+    }
+
+    /// Whether the run is over before its horizon: the event limit, or
+    /// the contact's ending decided and (when followed) the pole face
+    /// settled.
+    pub(crate) fn over(&self) -> bool {
+        match self.ending {
+            None => false,
+            Some(Outcome::EventLimit) => true,
+            Some(_) => !self.follow_pole || self.pole_settled,
+        }
+    }
+
+    /// Take in the contact's ending, proven at the present state.
+    pub(crate) fn decide(&mut self, ending: Outcome) {
+        self.ending = Some(ending);
+        self.proven_at = Some(self.t);
     }
 
     /// Apply the event of `which` at `t` (state `y` there, before it).
@@ -177,6 +265,17 @@ impl Propagation {
         if self.violation.is_none() {
             self.violation = invariants(model, which, before, t, (&arriving, &y), self.energy0);
         }
+        if let (Which::Contact, Some(ending), Some(proven)) = (which, self.ending, self.proven_at)
+            && self.violation.is_none()
+        {
+            self.violation = Some((
+                t,
+                format!(
+                    "the contact changed its state after its ending ({}) was proven at {proven:e} s",
+                    ending.as_str()
+                ),
+            ));
+        }
         if let Some(last) = self.pieces.last_mut() {
             last.y1 = y;
         }
@@ -184,6 +283,7 @@ impl Propagation {
         self.y = y;
         if self.rec.contact.len() >= MAX_EVENTS {
             self.ending = Some(Outcome::EventLimit);
+            self.proven_at = None;
         }
     }
 
@@ -247,6 +347,9 @@ pub(super) fn start<D: DriveModel>(model: &RelayModel<'_, D>, e0: f64) -> Propag
         }],
         lift_offs: Vec::new(),
         reach: x0,
+        below_resolution: false,
+        accumulation: None,
+        changes: 0,
     };
     if modes.rest == StopMode::Pressed {
         rec.back.push(Impact::touch(0.0, 0.0));
@@ -263,6 +366,9 @@ pub(super) fn start<D: DriveModel>(model: &RelayModel<'_, D>, e0: f64) -> Propag
         steps: 0,
         bound: EnergyBound::new(),
         ending: None,
+        proven_at: None,
+        follow_pole: true,
+        pole_settled: false,
         energy0,
         violation: None,
     }
@@ -362,6 +468,12 @@ pub(crate) fn closing_summary<D: DriveModel>(
             }
         }
     };
+    // Closed for good after bounces below resolution.
+    let outcome = if outcome == Outcome::Stuck && rec.below_resolution {
+        Outcome::Resolved
+    } else {
+        outcome
+    };
     let first_impact = impacts.first().map(|i| i.impact_time);
     let settle_time = if outcome.is_closed() {
         impacts.last().map(|i| i.impact_time)
@@ -377,28 +489,30 @@ pub(crate) fn closing_summary<D: DriveModel>(
         impacts,
         intervals,
         shortfall: (outcome == Outcome::NeverCloses).then_some((model.g() - rec.reach).max(0.0)),
-        accumulation_time: None,
+        accumulation_time: rec.accumulation.filter(|_| outcome == Outcome::Resolved),
         t_end,
     }
 }
 
-/// Whether a closing's ending is decided at `t`: the contact closed and
-/// unable to release, or open after touching and unable to reach it again.
-pub(crate) fn decided<D: DriveModel>(
-    model: &RelayModel<'_, D>,
-    bound: &mut EnergyBound,
-    t: f64,
-    y: &Y,
-    modes: StopModes,
-    rec: &Tally,
-) -> Option<Outcome> {
-    if rec.contact.is_empty() || !bound.due() {
-        return None;
+/// Check a closing at the present state of `p` (every fourth accepted
+/// step without an event): the contact's ending, once the energy bound
+/// decides it (closed and unable to release, or open after touching and
+/// unable to reach it again), then whether the pole face is settled.
+pub(crate) fn check_closing<D: DriveModel>(model: &RelayModel<'_, D>, p: &mut Propagation) {
+    if p.rec.contact.is_empty() || !p.bound.due() {
+        return;
     }
-    match modes.contact {
-        StopMode::Engaged if bound.cannot_release(model, t, y, modes) => Some(Outcome::Stuck),
-        StopMode::Open if bound.cannot_reach(model, t, y, modes) => Some(Outcome::EndsOpen),
-        _ => None,
+    if p.ending.is_none() {
+        let (t, y, modes) = (p.t, p.y, p.modes);
+        let ending = match modes.contact {
+            StopMode::Engaged if p.bound.cannot_release(model, t, &y, modes) => Outcome::Stuck,
+            StopMode::Open if p.bound.cannot_reach(model, t, &y, modes) => Outcome::EndsOpen,
+            _ => return,
+        };
+        p.decide(ending);
+    }
+    if p.follow_pole && !p.pole_settled {
+        p.pole_settled = p.bound.pole_settled(model, p.t, &p.y);
     }
 }
 
@@ -475,6 +589,9 @@ pub(crate) fn transition<D: DriveModel>(
 ) -> StopModes {
     let g = model.g();
     let no_blade = model.build.blade.is_none();
+    if which == Which::Contact {
+        rec.changes += 1;
+    }
     match which {
         Which::Contact => match modes.contact {
             StopMode::Open => {
@@ -485,7 +602,14 @@ pub(crate) fn transition<D: DriveModel>(
                     }
                 }
                 let v = y[3];
+                let rigid_contact = matches!(model.contact, Surface::Rigid { .. });
+                if !rigid_contact && rec.merge_short_opening(settings, t) {
+                    modes.contact = StopMode::Engaged;
+                    return modes;
+                }
                 rec.contact.push(Impact::touch(t, v));
+                rec.below_resolution = false;
+                rec.accumulation = None;
                 Tally::switch(&mut rec.intervals, t, ContactState::Closed);
                 modes.contact = match model.contact {
                     Surface::Rigid { restitution } => rigid(
@@ -633,6 +757,12 @@ fn rigid<D: DriveModel>(
     };
     if pressed {
         set_v(y, 0.0);
+        if which == Which::Contact && resolved && w > 0.0 {
+            // The rebounds left, each e times the last, sum to a
+            // geometric series of flights 2w/a, 2ew/a, …
+            rec.below_resolution = true;
+            rec.accumulation = (e < 1.0).then(|| t + 2.0 * w / a / (1.0 - e));
+        }
         StopMode::Pressed
     } else {
         if let Some(last) = list.last_mut() {
