@@ -299,8 +299,7 @@ pub struct SimulatorArgs {
     /// `lock-step`: one ngspice run through its shared library
     /// (libngspice.so.0), the mechanics advanced with every time step;
     /// `passes`: whole ngspice runs repeated until the events stop moving
-    /// [default: lock-step when the library is installed and the contact
-    /// has no [arc], else passes].
+    /// [default: lock-step when the library is installed, else passes].
     #[arg(long, value_name = "SCHEME", value_parser = parse_coupling)]
     pub coupling: Option<chatterspice::pipeline::Coupling>,
 

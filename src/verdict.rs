@@ -186,7 +186,17 @@ fn estimate_life(
         return Ok(None);
     }
     match life::estimate_at(scenario, runner, options, life.phases, life.jobs, own) {
-        Ok(report) => Ok(Some(report)),
+        Ok(report) => {
+            // What the life could not price is said where the run's
+            // warnings are, for the front ends to signal it.
+            warnings.extend(
+                report
+                    .warnings
+                    .iter()
+                    .map(|w| format!("electrical life: {w}")),
+            );
+            Ok(Some(report))
+        }
         Err(e) if !needed && crate::interrupt::stopping().is_none() => {
             warnings.push(format!("the electrical life was not estimated: {e}"));
             Ok(None)

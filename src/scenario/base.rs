@@ -401,13 +401,30 @@ impl Expanded {
     /// deepest table around it, an `unset` entry standing for the key it
     /// removed from the layers below.
     fn source(&self, key: &str) -> Option<Source> {
+        // A layer's key that the merged scenario no longer has was
+        // replaced from above (an array, a table with another law) or
+        // unset: that layer does not give it.
+        let merged: Vec<String> = DeTable::parse(&self.text)
+            .map(|tree| {
+                KeyIndex::new(&tree, &self.text)
+                    .entries
+                    .into_iter()
+                    .map(|e| e.path)
+                    .collect()
+            })
+            .unwrap_or_default();
+        let kept = |path: &str| merged.is_empty() || merged.iter().any(|p| p == path);
         let mut best: Option<(usize, Source)> = None;
         for (i, layer) in self.layers.iter().enumerate().rev() {
             if let Ok(tree) = DeTable::parse(&layer.text) {
                 let index = KeyIndex::new(&tree, &layer.text);
                 let mut probe = key;
                 loop {
-                    if let Some(e) = index.entries.iter().find(|e| e.path == probe) {
+                    if let Some(e) = index
+                        .entries
+                        .iter()
+                        .find(|e| e.path == probe && (i + 1 == self.layers.len() || kept(probe)))
+                    {
                         let depth = probe.len();
                         if best.as_ref().is_none_or(|(d, _)| depth > *d) {
                             let line = line_column(&layer.text, e.key_span.start).0;

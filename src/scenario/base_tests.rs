@@ -377,3 +377,33 @@ fn a_bad_unset_entry_names_the_file_and_its_line() {
         "{text}"
     );
 }
+
+#[test]
+fn a_key_missing_from_what_the_user_wrote_is_named_at_the_users_line() {
+    let case = |text: &str| {
+        Scenario::parse(text, Path::new("mine.toml"))
+            .unwrap_err()
+            .to_string()
+    };
+    // The user's array replaces the base's: a key missing from it is the
+    // user's to add, though the base's array had it.
+    let text = case("base = \"default\"\n\n[[probe]]\nsignal = \"v(out)\"\nhigh = 3.0\n");
+    assert!(
+        text.starts_with("mine.toml:3:") && text.contains("`probe[0].low` is missing"),
+        "{text}"
+    );
+    let text =
+        case("base = \"part:finder-40.52-12vdc\"\n\n\n[[datasheet.dc_breaking]]\nvoltage = 30.0\n");
+    assert!(
+        text.starts_with("mine.toml:4:")
+            && text.contains("`datasheet.dc_breaking[0].current` is missing"),
+        "{text}"
+    );
+    // A table with another law starts afresh: its missing key is the
+    // user's, at the user's table.
+    let text = case("base = \"default\"\n\n[surface]\nlaw = \"hunt-crossley\"\n");
+    assert!(text.starts_with("mine.toml:3:"), "{text}");
+    // A key the base wrote is still named in the base.
+    let text = case("base = \"default\"\n[mechanics]\nmass = -1.0\n");
+    assert!(text.starts_with("mine.toml:3:"), "{text}");
+}
