@@ -6,10 +6,10 @@ use std::time::Instant;
 
 use nalgebra::DMatrix;
 
+use super::problem::{Evaluation, Held, event_residuals};
 use super::{
-    BounceCount, Candidate, DatasheetSection, Determined, Evaluation, Event, EventKind, EventRow,
-    FigureRow, FitReport, FitRequest, Held, ParameterRow, Problem, RELATIVE_SCALE, event_residuals,
-    pick_up_of,
+    BounceCount, Candidate, DatasheetSection, Determined, Event, EventKind, EventRow, FigureRow,
+    FitReport, FitRequest, ParameterRow, Problem, RELATIVE_SCALE, pick_up_of,
 };
 use crate::coil::Coil;
 use crate::scenario::Scenario;
