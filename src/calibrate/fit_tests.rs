@@ -1,6 +1,6 @@
 //! Unit tests of fit.rs.
-use super::*;
 use super::problem::{event_residuals, halton};
+use super::*;
 
 fn ev(kind: EventKind, time: f64) -> Event {
     Event { kind, time }

@@ -319,14 +319,17 @@ fn merge(into: &mut toml::Table, over: toml::Table) {
 /// [`merge`] of the table at `parent` (its key, at the top: `None`). An
 /// `[envelope]` range written in full (its `min` and its `max`) is the
 /// user's range, `log` included: it replaces the base's, never inheriting
-/// a `log = true` the user did not write.
+/// a `log = true` the user did not write. A printed figure of
+/// `[datasheet]` (`making_current = { typ = 10 }`) is the figure as the
+/// user's datasheet prints it: it replaces the base's whole, never keeping
+/// a bound the user did not write.
 fn merge_in(into: &mut toml::Table, over: toml::Table, parent: Option<&str>) {
     for (key, value) in over {
         let full_range = parent == Some("envelope")
             && matches!(&value, toml::Value::Table(t) if t.contains_key("min") && t.contains_key("max"));
         match (into.get_mut(&key), value) {
             (Some(toml::Value::Table(below)), toml::Value::Table(above))
-                if !law_changes(below, &above) && !full_range =>
+                if !law_changes(below, &above) && !full_range && parent != Some("datasheet") =>
             {
                 let at = if parent.is_none() {
                     Some(key.as_str())

@@ -407,3 +407,18 @@ fn a_key_missing_from_what_the_user_wrote_is_named_at_the_users_line() {
     let text = case("base = \"default\"\n[mechanics]\nmass = -1.0\n");
     assert!(text.starts_with("mine.toml:3:"), "{text}");
 }
+
+#[test]
+fn a_printed_figure_over_a_parts_replaces_it_whole() {
+    let part = "base = \"part:finder-40.52-12vdc\"\n";
+    let base = Scenario::parse(part, Path::new("x.toml")).unwrap();
+    let printed = base.datasheet.as_ref().unwrap().making_current.unwrap();
+    assert!(printed.max.is_some() || printed.typ.is_some());
+    let s = Scenario::parse(
+        &format!("{part}[datasheet]\nmaking_current = {{ typ = 10.0 }}\n"),
+        Path::new("x.toml"),
+    )
+    .unwrap();
+    let mine = s.datasheet.as_ref().unwrap().making_current.unwrap();
+    assert_eq!((mine.min, mine.typ, mine.max), (None, Some(10.0), None));
+}
