@@ -281,10 +281,7 @@ pub fn relay_checks(
             .enumerate()
             .filter(|(k, _)| reclosures || !operations.get(*k).is_some_and(Operation::is_reclosure))
             .map(|(k, c)| get(c).ok_or_else(|| numbered(k, what)))
-            .reduce(|a, b| match (a, b) {
-                (Ok(a), Ok(b)) => Ok(a.max(b)),
-                (Err(e), _) | (_, Err(e)) => Err(e),
-            })
+            .reduce(larger_or_why)
             .unwrap_or_else(|| Err(never(what)))
     };
     let debounce = |get: fn(&Debounce) -> f64| {
@@ -295,10 +292,7 @@ pub fn relay_checks(
                     .map(|d| get(&d))
                     .ok_or_else(|| never("never closes for good"))
             })
-            .reduce(|a, b| match (a, b) {
-                (Ok(a), Ok(b)) => Ok(a.max(b)),
-                (Err(e), _) | (_, Err(e)) => Err(e),
-            })
+            .reduce(larger_or_why)
             .unwrap_or_else(|| Err(never("never closes for good")))
     };
     let operate = longest(|c| c.operate_time, "never touches", false);
@@ -317,133 +311,128 @@ pub fn relay_checks(
                     .map(|_| op.stroke.bounces as f64)
                     .ok_or_else(|| numbered(k, "never touches"))
             })
-            .reduce(|a, b| match (a, b) {
-                (Ok(a), Ok(b)) => Ok(a.max(b)),
-                (Err(e), _) | (_, Err(e)) => Err(e),
-            })
+            .reduce(larger_or_why)
             .unwrap_or_else(|| Err(never("never touches")))
     };
-    let mut out = Vec::new();
-    if let Some(limit) = limits.max_bounces {
-        out.push(LimitCheck::new(
-            "limits.max_bounces".into(),
-            "bounces".into(),
+    let nc_bounces = |op: &Operation| op.nc_bounce_time.map(|_| op.stroke.back_bounces as f64);
+    let rows = [
+        (
+            limits.max_bounces.map(|l| l as f64),
+            "max_bounces",
+            "bounces",
             "",
-            Bound::Max,
-            limit as f64,
             bounces,
-        ));
-    }
-    if let Some(limit) = limits.max_bounce_time {
-        out.push(LimitCheck::new(
-            "limits.max_bounce_time".into(),
-            "bounce time".into(),
+        ),
+        (
+            limits.max_bounce_time,
+            "max_bounce_time",
+            "bounce time",
             "s",
-            Bound::Max,
-            limit,
             bounce_time,
-        ));
-    }
-    if let Some(limit) = limits.max_operate_time {
-        out.push(LimitCheck::new(
-            "limits.max_operate_time".into(),
-            "operate time".into(),
+        ),
+        (
+            limits.max_operate_time,
+            "max_operate_time",
+            "operate time",
             "s",
-            Bound::Max,
-            limit,
             operate.clone(),
-        ));
-    }
-    if let Some(limit) = limits.max_first_make {
-        out.push(LimitCheck::new(
-            "limits.max_first_make".into(),
-            "first make".into(),
+        ),
+        (
+            limits.max_first_make,
+            "max_first_make",
+            "first make",
             "s",
-            Bound::Max,
-            limit,
             operate,
-        ));
-    }
-    if let Some(limit) = limits.max_lockout {
-        out.push(LimitCheck::new(
-            "limits.max_lockout".into(),
-            "contact lockout".into(),
+        ),
+        (
+            limits.max_lockout,
+            "max_lockout",
+            "contact lockout",
             "s",
-            Bound::Max,
-            limit,
             debounce(|d| d.lockout),
-        ));
-    }
-    if let Some(limit) = limits.max_stable_for {
-        out.push(LimitCheck::new(
-            "limits.max_stable_for".into(),
-            "contact stable for".into(),
+        ),
+        (
+            limits.max_stable_for,
+            "max_stable_for",
+            "contact stable for",
             "s",
-            Bound::Max,
-            limit,
             debounce(|d| d.stable_for),
-        ));
-    }
-    if let Some(limit) = limits.max_settle_time {
-        out.push(LimitCheck::new(
-            "limits.max_settle_time".into(),
-            "closed for good".into(),
+        ),
+        (
+            limits.max_settle_time,
+            "max_settle_time",
+            "closed for good",
             "s",
-            Bound::Max,
-            limit,
             settle,
-        ));
-    }
-    let worst = |what: &str, get: &dyn Fn(&Operation) -> Option<f64>| {
-        release_unevaluated(operations, what)?;
-        let values: Vec<f64> = operations.iter().filter_map(get).collect();
-        if values.is_empty() {
-            let why = if what == "release" {
-                "the contact never broke after the coil went off"
-            } else {
-                "the armature is not back on its rest stop before the run ends"
-            };
-            Err(format!(
-                "not evaluated: no {what} in the run ({why}; raise `simulation.t_end` and the \
-                 `.tran` stop time)"
-            ))
-        } else {
-            Ok(values.into_iter().fold(f64::NEG_INFINITY, f64::max))
-        }
-    };
-    if let Some(limit) = limits.max_release_time {
-        out.push(LimitCheck::new(
-            "limits.max_release_time".into(),
-            "release time".into(),
+        ),
+        (
+            limits.max_release_time,
+            "max_release_time",
+            "release time",
             "s",
-            Bound::Max,
-            limit,
-            worst("release", &|op| op.release_time),
-        ));
-    }
-    if let Some(limit) = limits.max_nc_bounce_time {
-        out.push(LimitCheck::new(
-            "limits.max_nc_bounce_time".into(),
-            "NC bounce time".into(),
+            worst_release(operations, "release", |op| op.release_time),
+        ),
+        (
+            limits.max_nc_bounce_time,
+            "max_nc_bounce_time",
+            "NC bounce time",
             "s",
-            Bound::Max,
-            limit,
-            worst("NC bounce", &|op| op.nc_bounce_time),
-        ));
-    }
-    if let Some(limit) = limits.max_nc_bounces {
-        out.push(LimitCheck::new(
-            "limits.max_nc_bounces".into(),
-            "NC bounces".into(),
+            worst_release(operations, "NC bounce", |op| op.nc_bounce_time),
+        ),
+        (
+            limits.max_nc_bounces.map(|l| l as f64),
+            "max_nc_bounces",
+            "NC bounces",
             "",
-            Bound::Max,
-            limit as f64,
-            worst("NC bounce", &|op| {
-                op.nc_bounce_time.map(|_| op.stroke.back_bounces as f64)
-            }),
-        ));
+            worst_release(operations, "NC bounce", nc_bounces),
+        ),
+    ];
+    rows.into_iter()
+        .filter_map(|(limit, key, label, unit, value)| {
+            let limit = limit?;
+            Some(LimitCheck::new(
+                format!("limits.{key}"),
+                label.into(),
+                unit,
+                Bound::Max,
+                limit,
+                value,
+            ))
+        })
+        .collect()
+}
+
+/// The larger of two figures, or the first reason one of them has none.
+fn larger_or_why(a: Result<f64, String>, b: Result<f64, String>) -> Result<f64, String> {
+    match (a, b) {
+        (Ok(a), Ok(b)) => Ok(a.max(b)),
+        (Err(e), _) | (_, Err(e)) => Err(e),
     }
-    out
+}
+
+/// The largest of `get` over the operations, for a limit on what happens
+/// at or after a release (`what`: "release", "NC bounce"); why not when
+/// no operation has one.
+fn worst_release(
+    operations: &[Operation],
+    what: &str,
+    get: impl Fn(&Operation) -> Option<f64>,
+) -> Result<f64, String> {
+    release_unevaluated(operations, what)?;
+    let values: Vec<f64> = operations.iter().filter_map(get).collect();
+    if values.is_empty() {
+        let why = if what == "release" {
+            "the contact never broke after the coil went off"
+        } else {
+            "the armature is not back on its rest stop before the run ends"
+        };
+        Err(format!(
+            "not evaluated: no {what} in the run ({why}; raise `simulation.t_end` and the \
+             `.tran` stop time)"
+        ))
+    } else {
+        Ok(values.into_iter().fold(f64::NEG_INFINITY, f64::max))
+    }
 }
 
 /// Why a limit on the releases cannot be held yet: the coil is never

@@ -284,27 +284,7 @@ pub fn estimate_at(
     if figures.is_empty() {
         return Err(LifeError::NoFigures(path));
     }
-    for (k, f) in figures.iter().enumerate() {
-        let problem = if !(f.operations > 0.0 && f.voltage > 0.0 && f.current > 0.0) {
-            Some("operations, voltage and current must be > 0".to_owned())
-        } else if f.load != "resistive" {
-            Some(format!(
-                "load \"{}\": only resistive test loads are simulated",
-                f.load
-            ))
-        } else if f.frequency.is_some_and(|h| h.is_nan() || h <= 0.0) {
-            Some("frequency must be > 0 Hz".to_owned())
-        } else {
-            None
-        };
-        if let Some(problem) = problem {
-            return Err(LifeError::BadFigure {
-                path,
-                index: k + 1,
-                problem,
-            });
-        }
-    }
+    validate(&figures, &path)?;
     let (closing, _) = crate::check::relay_closing(scenario)?;
     let arc = scenario.arc.unwrap_or_default().model();
     let gap = scenario.mechanics.gap;
@@ -314,19 +294,7 @@ pub fn estimate_at(
     let _remove = crate::interrupt::remove_at_stop(dir.path());
     let mut energies = Vec::with_capacity(figures.len());
     for (k, figure) in figures.iter().enumerate() {
-        // A load beyond the breaking capacity at its voltage is never
-        // broken: nothing to simulate.
-        let beyond = (figure.supply == Supply::Dc)
-            .then(|| arc.breaking_current(figure.voltage, gap))
-            .flatten()
-            .filter(|&most| figure.current > most * (1.0 + CAPACITY_TOLERANCE))
-            .map(|most| {
-                format!(
-                    "beyond the breaking capacity: at {} V DC the contact breaks at most {:.3} A \
-                     at its full gap",
-                    figure.voltage, most
-                )
-            });
+        let beyond = beyond_capacity(figure, &arc, gap);
         energies.push(match beyond {
             Some(why) => FigureEnergy::refused(why),
             None => figure_energy(
@@ -390,6 +358,77 @@ pub fn estimate_at(
         })
         .collect();
     let shape = scenario.datasheet.as_ref().and_then(|d| d.weibull_shape);
+    let life = own_life(scenario, runner, options, own, b, shape, &mut warnings)?;
+    Ok(LifeReport {
+        calibrated_on,
+        constant_j: b,
+        figures: rows,
+        life,
+        weibull_shape: shape,
+        warnings,
+    })
+}
+
+/// The endurance figures checked: what a simulated test load needs.
+fn validate(figures: &[EnduranceFigure], path: &std::path::Path) -> Result<(), LifeError> {
+    for (k, f) in figures.iter().enumerate() {
+        let problem = if !(f.operations > 0.0 && f.voltage > 0.0 && f.current > 0.0) {
+            Some("operations, voltage and current must be > 0".to_owned())
+        } else if f.load != "resistive" {
+            Some(format!(
+                "load \"{}\": only resistive test loads are simulated",
+                f.load
+            ))
+        } else if f.frequency.is_some_and(|h| h.is_nan() || h <= 0.0) {
+            Some("frequency must be > 0 Hz".to_owned())
+        } else {
+            None
+        };
+        if let Some(problem) = problem {
+            return Err(LifeError::BadFigure {
+                path: path.to_owned(),
+                index: k + 1,
+                problem,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Why `figure` cannot be priced before any run: a DC load beyond what
+/// `arc` breaks at its voltage over the full gap `gap` (m) is never
+/// broken.
+fn beyond_capacity(
+    figure: &EnduranceFigure,
+    arc: &crate::arc::ArcModel,
+    gap: f64,
+) -> Option<String> {
+    // A load beyond the breaking capacity at its voltage is never
+    // broken: nothing to simulate.
+    (figure.supply == Supply::Dc)
+        .then(|| arc.breaking_current(figure.voltage, gap))
+        .flatten()
+        .filter(|&most| figure.current > most * (1.0 + CAPACITY_TOLERANCE))
+        .map(|most| {
+            format!(
+                "beyond the breaking capacity: at {} V DC the contact breaks at most {:.3} A \
+                 at its full gap",
+                figure.voltage, most
+            )
+        })
+}
+
+/// The life at the scenario's own circuit, from `own` (its run) or a run
+/// of it, with the erosion constant `b` (J); `None` without a circuit.
+fn own_life(
+    scenario: &Scenario,
+    runner: &dyn Runner,
+    options: &RunOptions,
+    own: Option<&pipeline::RunResult>,
+    b: f64,
+    shape: Option<f64>,
+    warnings: &mut Vec<String>,
+) -> Result<Option<OwnLife>, LifeError> {
     let own_energy = |run: &pipeline::RunResult| {
         let totals = run.arcs.as_ref().map(|a| &a.totals);
         let refused = totals.and_then(|t| t.still_burning.as_ref()).map(|b| {
@@ -411,7 +450,7 @@ pub fn estimate_at(
             Some(own_energy(&run))
         }
     };
-    let life = energy.map(|(e, refused)| {
+    Ok(energy.map(|(e, refused)| {
         if let Some(why) = &refused {
             warnings.push(format!("no life at the scenario's circuit: {why}"));
         }
@@ -422,15 +461,7 @@ pub fn estimate_at(
             b10: operations.zip(shape).map(|(n, beta)| b10(n, beta)),
             energy_per_operation: e,
         }
-    });
-    Ok(LifeReport {
-        calibrated_on,
-        constant_j: b,
-        figures: rows,
-        life,
-        weibull_shape: shape,
-        warnings,
-    })
+    }))
 }
 
 /// `life`'s report as a table for people.
@@ -584,23 +615,7 @@ fn figure_energy(
         Supply::Dc => 1,
     };
     let resistance = figure.voltage / figure.current;
-    let mut intervals: Vec<Interval> = closing
-        .intervals
-        .iter()
-        .filter(|i| i.start < t_break)
-        .map(|i| Interval {
-            end: i.end.min(t_break),
-            ..*i
-        })
-        .collect();
-    if let Some(last) = intervals.last_mut() {
-        last.end = t_break;
-    }
-    intervals.push(Interval {
-        state: ContactState::Open,
-        start: t_break,
-        end: t_stop,
-    });
+    let intervals = test_intervals(closing, t_break, t_stop);
     // (energy, the arc still burning at the run's end: how long it had burned)
     let run_phase = |phase: usize| -> PhaseResult {
         let source = match figure.supply {
@@ -650,50 +665,13 @@ fn figure_energy(
             )
         }))
     };
-    // The phases in parallel, `jobs` ngspice runs at a time; the first
-    // error (in phase order) is the answer.
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let results: std::sync::Mutex<Vec<Option<PhaseResult>>> =
-        std::sync::Mutex::new((0..n).map(|_| None).collect());
-    std::thread::scope(|scope| {
-        for _ in 0..jobs.clamp(1, n) {
-            scope.spawn(|| {
-                loop {
-                    let phase = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                    if phase >= n || crate::interrupt::stopping().is_some() {
-                        break;
-                    }
-                    let result = run_phase(phase);
-                    let failed = result.is_err();
-                    results.lock().unwrap_or_else(|e| e.into_inner())[phase] = Some(result);
-                    if failed {
-                        next.store(n, std::sync::atomic::Ordering::Relaxed);
-                    }
-                }
-            });
-        }
-    });
     let mut energies = Vec::with_capacity(n);
     let mut burning: Option<f64> = None;
-    for result in results.into_inner().unwrap_or_else(|e| e.into_inner()) {
-        match result {
-            Some(Ok((e, still))) => {
-                energies.push(e);
-                if let Some(d) = still {
-                    burning = Some(burning.map_or(d, |b: f64| b.max(d)));
-                }
-            }
-            Some(Err(e)) => return Err(e),
-            // A phase not run: an earlier error stopped the others.
-            None => continue,
+    for (e, still) in in_parallel(n, jobs, run_phase)? {
+        energies.push(e);
+        if let Some(d) = still {
+            burning = Some(burning.map_or(d, |b: f64| b.max(d)));
         }
-    }
-    if energies.len() < n {
-        // Only a stop leaves phases unrun without an error.
-        return Err(LifeError::Io(std::io::Error::new(
-            std::io::ErrorKind::Interrupted,
-            "stopped before every phase ran",
-        )));
     }
     let mean = energies.iter().sum::<f64>() / n as f64;
     let half: Vec<f64> = energies.iter().step_by(2).copied().collect();
@@ -718,6 +696,76 @@ fn figure_energy(
         convergence,
         refused,
     })
+}
+
+/// `closing`'s contact record up to `t_break`, held closed to it, then
+/// open to `t_stop`: the test's one operation.
+fn test_intervals(closing: &crate::chatter::Chatter, t_break: f64, t_stop: f64) -> Vec<Interval> {
+    let mut intervals: Vec<Interval> = closing
+        .intervals
+        .iter()
+        .filter(|i| i.start < t_break)
+        .map(|i| Interval {
+            end: i.end.min(t_break),
+            ..*i
+        })
+        .collect();
+    if let Some(last) = intervals.last_mut() {
+        last.end = t_break;
+    }
+    intervals.push(Interval {
+        state: ContactState::Open,
+        start: t_break,
+        end: t_stop,
+    });
+    intervals
+}
+
+/// `run(k)` for k in 0..n, `jobs` at a time, in order; the first error
+/// (in that order) is the answer, and a stop before every one ran is an
+/// error too.
+fn in_parallel<T: Send>(
+    n: usize,
+    jobs: usize,
+    run: impl Fn(usize) -> Result<T, LifeError> + Sync,
+) -> Result<Vec<T>, LifeError> {
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let results: std::sync::Mutex<Vec<Option<Result<T, LifeError>>>> =
+        std::sync::Mutex::new((0..n).map(|_| None).collect());
+    std::thread::scope(|scope| {
+        for _ in 0..jobs.clamp(1, n.max(1)) {
+            scope.spawn(|| {
+                loop {
+                    let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    if k >= n || crate::interrupt::stopping().is_some() {
+                        break;
+                    }
+                    let result = run(k);
+                    let failed = result.is_err();
+                    results.lock().unwrap_or_else(|e| e.into_inner())[k] = Some(result);
+                    if failed {
+                        next.store(n, std::sync::atomic::Ordering::Relaxed);
+                    }
+                }
+            });
+        }
+    });
+    let mut out = Vec::with_capacity(n);
+    for result in results.into_inner().unwrap_or_else(|e| e.into_inner()) {
+        match result {
+            Some(result) => out.push(result?),
+            // Not run: an earlier error stopped the others, or a stop.
+            None => continue,
+        }
+    }
+    if out.len() < n {
+        // Only a stop leaves runs undone without an error.
+        return Err(LifeError::Io(std::io::Error::new(
+            std::io::ErrorKind::Interrupted,
+            "stopped before every phase ran",
+        )));
+    }
+    Ok(out)
 }
 
 #[cfg(test)]

@@ -170,35 +170,7 @@ fn arc_into(
         &mut arc,
         &format!("Cia ia 0 {} IC=0", format_time(STATE_LAG / LAG_RESISTANCE)),
     );
-    // The burning voltage: V_min + E·gap alone, or with Ayrton's
-    // low-current term (C + D·gap)/|i| on the sensed current (at least
-    // I_min, below which the arc is out).
-    let burning = if model.has_low_current_term() {
-        if model.low_current_gap == 0.0 {
-            line(
-                &mut arc,
-                &format!("Vlow lowc 0 DC {}", format_time(model.low_current)),
-            );
-        } else if gap.is_some() {
-            line(&mut arc, "Vlow lowc 0 PWL(");
-            pairs(
-                &mut arc,
-                samples.iter().map(|&(t, g)| (t, model.low_current_term(g))),
-            );
-        } else {
-            line(&mut arc, "Vlow lowc 0 external");
-        }
-        line(
-            &mut arc,
-            &format!(
-                "Bav av 0 V = V(varc) + V(lowc) / max(V(ia), {})",
-                format_time(model.i_min)
-            ),
-        );
-        "V(av)"
-    } else {
-        "V(varc)"
-    };
+    let burning = burning_voltage(&mut arc, model, gap.is_some(), samples);
     line(&mut arc, "Von on 0 1");
     line(&mut arc, "Sst on st ia 0 arc_state");
     line(&mut arc, "Rst st 0 1k");
@@ -259,6 +231,44 @@ fn arc_into(
     text.push_str(&include.text[ends_at + ends.len()..]);
     include.text = text;
     Ok(include)
+}
+
+/// The arc's burning voltage written into `arc`: V_min + E·gap alone
+/// (`V(varc)`), or with Ayrton's low-current term (C + D·gap)/|i| on the
+/// sensed current, at least I_min below which the arc is out (`V(av)`).
+/// `profiled`: the gap is a PWL of `samples`, else an external source.
+fn burning_voltage(
+    arc: &mut String,
+    model: &ArcModel,
+    profiled: bool,
+    samples: &[(f64, f64)],
+) -> &'static str {
+    if model.has_low_current_term() {
+        if model.low_current_gap == 0.0 {
+            line(
+                arc,
+                &format!("Vlow lowc 0 DC {}", format_time(model.low_current)),
+            );
+        } else if profiled {
+            line(arc, "Vlow lowc 0 PWL(");
+            pairs(
+                arc,
+                samples.iter().map(|&(t, g)| (t, model.low_current_term(g))),
+            );
+        } else {
+            line(arc, "Vlow lowc 0 external");
+        }
+        line(
+            arc,
+            &format!(
+                "Bav av 0 V = V(varc) + V(lowc) / max(V(ia), {})",
+                format_time(model.i_min)
+            ),
+        );
+        "V(av)"
+    } else {
+        "V(varc)"
+    }
 }
 
 #[cfg(test)]
