@@ -744,6 +744,77 @@ fn a_dc_break_goes_out_where_the_load_line_leaves_the_arc_characteristic() {
     }
 }
 
+/// 14 V through 2.8 Ω (5 A) with the silver–tin-oxide defaults: an
+/// automotive load whose bounce openings and break arc, as measured on
+/// AgSnO2 contacts opening at 20–200 mm/s (IEICE Trans. Electron.
+/// E98-C(9), 923). A bounce gap of micrometres holds an arc near V_min,
+/// so the 50 µs bounce opening arcs throughout; the break arc burns while
+/// the gap opens and goes out where the model's breaking current at the
+/// gap falls to the load's 5 A.
+#[test]
+fn a_14_v_5_a_automotive_load_arcs_at_its_bounce_and_its_break() {
+    let ng = ngspice_or_skip!();
+    let dir = tempfile::tempdir().unwrap();
+    let netlist = "14 V automotive load\nV1 vcc 0 14\nR1 vcc a 2.8\nX1 a 0 CONTACT\n\
+                   .tran 0.2u 8m 0 1u\n.end\n";
+    let speed = 0.1;
+    let scenario = relay_on(
+        dir.path(),
+        netlist,
+        &format!(
+            "[[probe]]\nsignal = \"i(V1)\"\nlow = -3\nhigh = -1\n\n[arc]\n\
+             material = \"AgSnO2\"\nopening_speed = {speed}\n"
+        ),
+    );
+    let iv = |state, start, end| Interval { state, start, end };
+    let (bounce, t_break) = ((2e-3, 2.05e-3), 5e-3);
+    let record = vec![
+        iv(ContactState::Open, 0.0, 1e-3),
+        iv(ContactState::Closed, 1e-3, bounce.0),
+        iv(ContactState::Open, bounce.0, bounce.1),
+        iv(ContactState::Closed, bounce.1, t_break),
+        iv(ContactState::Open, t_break, 8e-3),
+    ];
+    let result = run_measured(&ng, &scenario, record);
+    let report = result.arcs.as_ref().unwrap();
+    let model = report.model;
+    let all: Vec<(&str, f64, &str)> = report
+        .arcs
+        .iter()
+        .map(|a| (a.opening.as_str(), a.duration, a.ends))
+        .collect();
+    // The bounce opening arcs until the contact closes again.
+    let at_bounce: Vec<_> = all.iter().filter(|a| a.0 != "break").collect();
+    assert_eq!(at_bounce.len(), 1, "{all:?}");
+    assert!(
+        (at_bounce[0].1 / (bounce.1 - bounce.0) - 1.0).abs() < 0.02,
+        "{all:?}"
+    );
+    assert_eq!(at_bounce[0].2, "contact_closed", "{all:?}");
+    // The break arc goes out at the gap where the load is the most the
+    // contact breaks at 14 V.
+    let arcs = arcs_in(&result, "break");
+    assert_eq!(arcs.len(), 1, "{all:?}");
+    let burns = |g: f64| {
+        model
+            .breaking_current(14.0, g)
+            .is_some_and(|most| most < 5.0)
+    };
+    let (mut lo, mut hi) = (0.0, 1e-3);
+    assert!(burns(lo) && !burns(hi));
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if burns(mid) { lo = mid } else { hi = mid }
+    }
+    let expected = lo / speed;
+    let duration = arcs[0].duration;
+    assert!(expected > 10e-6, "{expected}");
+    assert!(
+        (duration / expected - 1.0).abs() < 0.05,
+        "burned {duration} s, the gap reaches {lo} m at {expected} s"
+    );
+}
+
 /// The DC example breaks its 30 V, 5 A: every bounce opening arcs until
 /// the contact closes again (a short arc burns near V_min), and the break
 /// arc burns while the gap opens, from tens of µs to a few ms, going out
