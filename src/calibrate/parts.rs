@@ -208,7 +208,7 @@ pub struct Listing {
     /// The printed electrical endurance figures (operations at a
     /// resistive test load), for `life`.
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub electrical_endurance: Vec<crate::life::EnduranceFigure>,
+    pub electrical_endurance: Vec<crate::scenario::EnduranceFigure>,
 }
 
 /// The listing of `part`: its datasheet figures against its scenario's.
@@ -326,10 +326,10 @@ pub fn table() -> String {
 
 /// A printed endurance figure: `1e5 operations at 8 A, 250 V AC 50 Hz
 /// (resistive)`.
-fn endurance_text(f: &crate::life::EnduranceFigure) -> String {
+fn endurance_text(f: &crate::scenario::EnduranceFigure) -> String {
     let supply = match f.supply {
-        crate::life::Supply::Dc => "DC".to_owned(),
-        crate::life::Supply::Ac => match f.frequency {
+        crate::scenario::Supply::Dc => "DC".to_owned(),
+        crate::scenario::Supply::Ac => match f.frequency {
             Some(hz) => format!("AC {hz} Hz"),
             None => "AC (no frequency printed: 50 Hz)".to_owned(),
         },

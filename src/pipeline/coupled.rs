@@ -20,10 +20,13 @@
 //! between two iterations, and fails when it has not after the allowed
 //! number of iterations, reporting the last change.
 //!
-//! Why waveform relaxation: it uses ngspice as it is, in batch runs, with
-//! the user's driver untouched, and each half keeps its own exact event
-//! handling. A lock-step co-simulation through libngspice was not built
-//! (see docs/coupling.md for the measurements and the reasons).
+//! The passes use ngspice as it is, in batch runs, with the user's driver
+//! untouched, and each half keeps its own exact event handling. Where
+//! ngspice's shared library (libngspice) loads, the default is the
+//! lock-step run instead ([`super::lockstep`]): one ngspice run with the
+//! mechanics advanced at every time step; the passes remain the scheme
+//! wherever the library is missing, and on request (see docs/coupling.md
+//! for both, measured against each other).
 
 use std::path::PathBuf;
 use std::time::Duration;

@@ -49,7 +49,7 @@ pub struct DatasheetSection {
     /// The electrical endurance figures as printed (operations at a
     /// load), for `life`.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub electrical_endurance: Vec<crate::life::EnduranceFigure>,
+    pub electrical_endurance: Vec<super::endurance::EnduranceFigure>,
     /// The Weibull shape β of the printed life, for its B10.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub weibull_shape: Option<f64>,
@@ -238,7 +238,7 @@ impl super::check::Check<'_> {
                 )?;
             }
             if let Some(h) = f.frequency {
-                if f.supply == crate::life::Supply::Dc {
+                if f.supply == super::endurance::Supply::Dc {
                     return Err(self.invalid(
                         &key("frequency"),
                         h,

@@ -26,6 +26,7 @@ mod circuit;
 mod coil;
 mod contact;
 mod document;
+mod endurance;
 mod envelope;
 mod error;
 mod figure;
@@ -55,6 +56,7 @@ pub use calibration::{
 pub use circuit::CircuitSection;
 pub use coil::CoilSection;
 pub use contact::{ContactSection, HolmSection};
+pub use endurance::{EnduranceFigure, Supply};
 pub use envelope::{EnvelopeRange, EnvelopeSection};
 pub use error::{InheritedConflict, Location, ScenarioError};
 pub use figure::{FigureKind, PRINTED_PRECISION, PrintedFigure, TYPICAL_BAND};
