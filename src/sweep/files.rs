@@ -131,7 +131,7 @@ pub enum FilesError {
         path: PathBuf,
         /// Why.
         #[source]
-        source: SweepError,
+        source: Box<SweepError>,
     },
     /// The plot could not be rendered as PNG.
     #[cfg(feature = "png")]
@@ -296,7 +296,7 @@ pub fn write(
                 }
                 return Err(FilesError::Stopped {
                     path: csv_path,
-                    source: outcome.err().unwrap_or(SweepError::Stopped),
+                    source: Box::new(outcome.err().unwrap_or(SweepError::Stopped)),
                 });
             }
         };
