@@ -639,6 +639,48 @@ fn contact_include(
 /// neither, the built-in default itself. Reports are the command line's
 /// JSON (``--format json``) as dicts; waveforms are numpy arrays. Numbers
 /// are in SI units (s, V, A, m, N, kg). Ctrl-C stops any call.
+/// A Ctrl-C that came while numpy loaded.
+static SIGINT_WHILE_LOADING: std::sync::atomic::AtomicBool =
+    std::sync::atomic::AtomicBool::new(false);
+
+/// SIGINT's handler while numpy loads: noted, raised once it has loaded.
+#[pyfunction]
+fn note_sigint(signum: i32, frame: Bound<'_, PyAny>) {
+    let _ = (signum, frame);
+    SIGINT_WHILE_LOADING.store(true, std::sync::atomic::Ordering::SeqCst);
+}
+
+/// numpy and its C API, loaded whole: a KeyboardInterrupt inside numpy's
+/// own import becomes an ImportError there ("Importing the numpy
+/// C-extensions failed"), so on the main thread, under Python's own
+/// SIGINT handler, a Ctrl-C is held until numpy has loaded and then
+/// raised as the KeyboardInterrupt it is.
+fn load_numpy(py: Python<'_>) -> PyResult<()> {
+    let load = || -> PyResult<()> {
+        py.import("numpy")?;
+        drop(numpy::PyArray1::<f64>::zeros(py, 0, false));
+        Ok(())
+    };
+    let signal = py.import("signal")?;
+    let threading = py.import("threading")?;
+    let on_main = threading
+        .call_method0("current_thread")?
+        .is(&threading.call_method0("main_thread")?);
+    let default = signal.getattr("default_int_handler")?;
+    let sigint = signal.getattr("SIGINT")?;
+    if !on_main || !signal.call_method1("getsignal", (&sigint,))?.is(&default) {
+        return load();
+    }
+    signal.call_method1("signal", (&sigint, wrap_pyfunction!(note_sigint, py)?))?;
+    let loaded = load();
+    signal.call_method1("signal", (&sigint, &default))?;
+    loaded?;
+    if SIGINT_WHILE_LOADING.swap(false, std::sync::atomic::Ordering::SeqCst) {
+        return Err(pyo3::exceptions::PyKeyboardInterrupt::new_err(()));
+    }
+    Ok(())
+}
+
 #[pymodule]
 #[pyo3(name = "chatterspice")]
 fn chatterspice_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -646,8 +688,7 @@ fn chatterspice_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // numpy and its C API now, with the package: a Ctrl-C while they load
     // is then a KeyboardInterrupt of the import, never a failure to reach
     // the API inside a call.
-    py.import("numpy")?;
-    drop(numpy::PyArray1::<f64>::zeros(py, 0, false));
+    load_numpy(py)?;
     m.add_function(wrap_pyfunction!(py_bounce, m)?)?;
     m.add_function(wrap_pyfunction!(verdicts::py_run, m)?)?;
     m.add_function(wrap_pyfunction!(verdicts::py_check, m)?)?;
