@@ -22,6 +22,7 @@ from typing import (
     Tuple,
     Union,
     final,
+    overload,
 )
 
 import numpy as np
@@ -45,6 +46,7 @@ __all__ = [
     "pwl",
     "Run",
     "Sweep",
+    "SweepRows",
     "Fit",
     "RawFile",
     "Plot",
@@ -139,6 +141,26 @@ class Run:
     def ideal_workdir(self) -> Optional[str]:
         """With ``keep_workdir=True``, the ideal-contact run's work directory."""
 
+_Row = Dict[str, Union[int, float, str, None]]
+
+@final
+class SweepRows:
+    """The rows of the ``sweep.csv`` a sweep wrote (``sweep(out=DIR)``),
+    read from the file when asked: ``len(rows)``, ``rows[k]``, ``rows[a:b]``
+    and iteration in index order."""
+
+    def __new__(cls, path: str, len: int) -> "SweepRows":
+        """The rows of the file at ``path``, as pickle rebuilds them."""
+    @property
+    def path(self) -> str:
+        """The CSV the rows are read from."""
+    def __len__(self) -> int: ...
+    @overload
+    def __getitem__(self, key: int, /) -> _Row: ...
+    @overload
+    def __getitem__(self, key: slice, /) -> List[_Row]: ...
+    def __iter__(self) -> Iterator[_Row]: ...
+
 @final
 class Sweep:
     """What :func:`sweep` returns: the summary and one row per sample."""
@@ -146,19 +168,24 @@ class Sweep:
     def __new__(
         cls,
         summary: Dict[str, Any],
-        rows: List[Dict[str, Union[int, float, str, None]]],
-        csv: str,
+        rows: Union[List[_Row], SweepRows],
+        csv: Optional[str],
+        out: Optional[str] = None,
     ) -> "Sweep":
         """A sweep from its fields, as pickle rebuilds it."""
     @property
     def summary(self) -> Dict[str, Any]:
         """``summary.json`` of ``chatterspice sweep``."""
     @property
-    def rows(self) -> List[Dict[str, Union[int, float, str, None]]]:
-        """``sweep.csv``, one dict per sample in index order."""
+    def rows(self) -> Union[List[_Row], SweepRows]:
+        """``sweep.csv``, one dict per sample in index order: a list, or
+        with ``out=`` a :class:`SweepRows` reading them from the file."""
     @property
-    def csv(self) -> str:
-        """``sweep.csv`` as text."""
+    def csv(self) -> Optional[str]:
+        """``sweep.csv`` as text; None with ``out=``."""
+    @property
+    def out(self) -> Optional[str]:
+        """With ``out=``, the directory the sweep's files are in."""
 
 @final
 class Fit:
@@ -367,14 +394,25 @@ def sweep(
     samples: Optional[int] = None,
     seed: Optional[int] = None,
     jobs: Optional[int] = None,
+    out: Optional[_Path] = None,
+    force: bool = False,
+    resume: Optional[_Path] = None,
     mechanics_only: bool = False,
     ideal: bool = False,
     timeout: float = 60.0,
+    element: Optional[str] = None,
+    coupling: Optional[str] = None,
+    max_iterations: int = 20,
+    coupling_tolerance: float = 1e-07,
+    ngspice: Optional[_Path] = None,
+    no_spiceinit: bool = False,
     progress: Optional[Callable[[int, int], object]] = None,
 ) -> Sweep:
     """The scenario run many times with the numbers of its ``[sweep]``
-    varied; no files are written. ``progress(done, total)`` is called on the
-    calling thread as samples finish."""
+    varied, as ``chatterspice sweep``: in memory, or with ``out=DIR``
+    written into DIR as ``chatterspice sweep --out DIR`` writes it, the
+    rows read back from there when asked. ``progress(done, total)`` is
+    called on the calling thread as samples finish."""
 
 def fit(
     path: Optional[_Path] = None,

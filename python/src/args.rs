@@ -197,6 +197,18 @@ pub fn mechanics_only_arg(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
     flag(obj, "mechanics_only")
 }
 
+pub fn out_arg(obj: &Bound<'_, PyAny>) -> PyResult<Option<PathBuf>> {
+    path(obj, "out")
+}
+
+pub fn resume_arg(obj: &Bound<'_, PyAny>) -> PyResult<Option<PathBuf>> {
+    path(obj, "resume")
+}
+
+pub fn force_arg(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
+    flag(obj, "force")
+}
+
 pub fn keep_workdir_arg(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
     flag(obj, "keep_workdir")
 }

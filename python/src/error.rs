@@ -18,15 +18,18 @@ use chatterspice::capture::{CaptureError, EdgeError};
 use chatterspice::check::CheckError;
 use chatterspice::envelope::EnvelopeError;
 use chatterspice::life::LifeError;
+use chatterspice::output::WriteError;
 use chatterspice::pipeline::{CouplingError, PassError, RunError};
 use chatterspice::rawfile::RawError;
 use chatterspice::scenario::{Location, ScenarioError};
 use chatterspice::spice::SpiceError;
 use chatterspice::sweep::SweepError;
+use chatterspice::sweep::files::FilesError;
 use chatterspice::verdict::VerdictError;
 use chatterspice::waveform::WaveformError;
 use pyo3::exceptions::{
-    PyFileNotFoundError, PyPermissionError, PyRuntimeError, PyUserWarning, PyValueError,
+    PyFileExistsError, PyFileNotFoundError, PyPermissionError, PyRuntimeError, PyUserWarning,
+    PyValueError,
 };
 use pyo3::prelude::*;
 
@@ -315,6 +318,9 @@ impl From<Failure> for PyErr {
         };
         let err = match (f.kind, f.io) {
             (Kind::Input, Some(io::ErrorKind::NotFound)) => PyFileNotFoundError::new_err(f.message),
+            (Kind::Input, Some(io::ErrorKind::AlreadyExists)) => {
+                PyFileExistsError::new_err(f.message)
+            }
             (Kind::Input, Some(io::ErrorKind::PermissionDenied)) => {
                 PyPermissionError::new_err(f.message)
             }
@@ -396,8 +402,22 @@ impl From<SweepError> for Failure {
     fn from(e: SweepError) -> Failure {
         match e {
             SweepError::Scenario(e) => e.into(),
-            SweepError::Write(_) => Failure::of(Kind::Simulation, &e),
+            SweepError::Write(_) | SweepError::Stopped => Failure::of(Kind::Simulation, &e),
             e => Failure::of(Kind::Input, &e),
+        }
+    }
+}
+
+impl From<FilesError> for Failure {
+    fn from(e: FilesError) -> Failure {
+        match e {
+            FilesError::Sweep(e) => e.into(),
+            FilesError::Exists { .. } | FilesError::Write(WriteError::Exists { .. }) => Failure {
+                io: Some(io::ErrorKind::AlreadyExists),
+                ..Failure::of(Kind::Input, &e)
+            },
+            FilesError::Resume(_) | FilesError::Write(_) => Failure::of(Kind::Input, &e),
+            e => Failure::of(Kind::Simulation, &e),
         }
     }
 }

@@ -16,6 +16,7 @@ mod error;
 mod overlay;
 mod raw;
 mod results;
+mod rows;
 mod verdicts;
 mod work;
 
@@ -28,14 +29,15 @@ use chatterspice::capture::{Capture, Closed, read_capture};
 use chatterspice::chatter::{Chatter, Interval};
 use chatterspice::check;
 use chatterspice::commands;
+use chatterspice::netlist::ContactElement;
+use chatterspice::pipeline::Coupling;
 use chatterspice::pipeline::{self, RunOptions, RunResult};
 use chatterspice::report::{self, Format};
 use chatterspice::scenario::{BUNDLED_PARTS, DEFAULT_SCENARIO_TOML, Scenario, bundled_part};
-use chatterspice::spice::Ngspice;
+use chatterspice::sweep::files::{self, Destination};
 use chatterspice::sweep::{self, Sampler, SweepMode, SweepOptions};
 use chatterspice::waveform::read_state_csv;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
 
 use error::Failure;
 use results::{Fit, Run, Sweep};
@@ -91,12 +93,6 @@ fn read_measured(path: &Path) -> Result<Vec<Interval>, Failure> {
     let text = chatterspice::input::read_to_string(path)
         .map_err(|e| Failure::unreadable(path, "the measured chatter", &e))?;
     Ok(read_state_csv(&text, path)?)
-}
-
-/// ngspice, located (`$CHATTERSPICE_NGSPICE`, else on `PATH`) and probed
-/// within `timeout`.
-fn ngspice(timeout: Duration) -> Result<Ngspice, Failure> {
-    Ok(Ngspice::locate_within(None, timeout)?)
 }
 
 /// `jobs` as the library takes it.
@@ -179,34 +175,54 @@ pub(crate) fn run_result(py: Python<'_>, result: &RunResult, text: &str) -> PyRe
 }
 
 /// The scenario run many times with the numbers of its ``[sweep]``
-/// varied, as ``chatterspice sweep`` (writing no files).
+/// varied, as ``chatterspice sweep``.
 ///
 /// Returns a Sweep: ``summary`` (``summary.json`` as a dict), ``rows``
 /// (``sweep.csv`` as one dict per sample in index order) and ``csv``
-/// (that file's text, byte for byte).
+/// (that file's text, byte for byte). With ``out=DIR`` the sweep writes
+/// the command's files into DIR as ``chatterspice sweep --out DIR`` does
+/// (``sweep.csv`` row by row while it runs, then ``summary.json``,
+/// ``sweep.svg``, ``sweep.png`` and ``sweep.meta.json``), and ``rows``
+/// reads the rows back from ``sweep.csv`` when asked (``len``, indexing,
+/// iteration), so that memory does not grow with the samples; ``csv`` is
+/// then None.
 ///
 /// Parameters:
 ///     path, toml_text, origin: the scenario (see ``bounce``).
 ///     samples: samples of a random sweep (≥ 1); default the scenario's.
 ///     seed: the random sweep's seed; default the scenario's.
 ///     jobs: samples run at once (≥ 1); default one per core.
+///     out: a directory (str, bytes or os.PathLike, created if needed)
+///         to write the sweep's files into. A sweep's files already there
+///         are an error (FileExistsError) unless ``force=True``.
+///     force: replace the sweep's files in ``out``.
+///     resume: the directory of a sweep that was stopped (by Ctrl-C, or a
+///         signal to the command), continued from its finished rows into
+///         the files an uninterrupted sweep writes: the scenario, seed,
+///         samples and options must be the same.
 ///     mechanics_only: the relay alone, no circuit and no ngspice.
 ///     ideal: also run the ideal contact for every sample.
 ///     timeout: the wall-clock limit of each ngspice run, in s.
+///     element, coupling, max_iterations, coupling_tolerance, ngspice,
+///         no_spiceinit: how each sample runs ngspice (see ``run``).
 ///     progress: a callable ``progress(done, total)``, called on the
 ///         calling thread with the samples done so far (at most every
 ///         20 ms, and once at the end); an exception it raises stops the
 ///         sweep and is raised.
 ///
-/// Raises InputError, NgspiceError; KeyboardInterrupt on Ctrl-C, with the
-/// sweep stopped, its ngspice processes killed and work directories
-/// removed.
+/// Raises InputError, NgspiceError, FileExistsError; KeyboardInterrupt on
+/// Ctrl-C, with the sweep stopped, its ngspice processes killed and work
+/// directories removed (with ``out``, its finished rows kept there for
+/// ``resume``).
 #[pyfunction]
 #[pyo3(name = "sweep", signature = (path=None, *, toml_text=None, origin=None, samples=None,
-                                    seed=None, jobs=None, mechanics_only=false, ideal=false,
-                                    timeout=Duration::from_secs(60), progress=None))]
+                                    seed=None, jobs=None, out=None, force=false, resume=None,
+                                    mechanics_only=false, ideal=false,
+                                    timeout=Duration::from_secs(60), element=None, coupling=None,
+                                    max_iterations=20, coupling_tolerance=1e-7, ngspice=None,
+                                    no_spiceinit=false, progress=None))]
 #[pyo3(
-    text_signature = "(path=None, *, toml_text=None, origin=None, samples=None, seed=None, jobs=None, mechanics_only=False, ideal=False, timeout=60.0, progress=None)"
+    text_signature = "(path=None, *, toml_text=None, origin=None, samples=None, seed=None, jobs=None, out=None, force=False, resume=None, mechanics_only=False, ideal=False, timeout=60.0, element=None, coupling=None, max_iterations=20, coupling_tolerance=1e-07, ngspice=None, no_spiceinit=False, progress=None)"
 )]
 #[allow(clippy::too_many_arguments)]
 fn py_sweep<'py>(
@@ -217,18 +233,78 @@ fn py_sweep<'py>(
     #[pyo3(from_py_with = args::samples_arg)] samples: Option<u64>,
     #[pyo3(from_py_with = args::seed_arg)] seed: Option<u64>,
     #[pyo3(from_py_with = args::jobs_arg)] jobs: Option<u64>,
+    #[pyo3(from_py_with = args::out_arg)] out: Option<PathBuf>,
+    #[pyo3(from_py_with = args::force_arg)] force: bool,
+    #[pyo3(from_py_with = args::resume_arg)] resume: Option<PathBuf>,
     #[pyo3(from_py_with = args::mechanics_only_arg)] mechanics_only: bool,
     #[pyo3(from_py_with = args::ideal_arg)] ideal: bool,
     #[pyo3(from_py_with = args::timeout_arg)] timeout: Duration,
+    #[pyo3(from_py_with = args::element_arg)] element: Option<ContactElement>,
+    #[pyo3(from_py_with = args::coupling_arg)] coupling: Option<Coupling>,
+    #[pyo3(from_py_with = args::max_iterations_arg)] max_iterations: usize,
+    #[pyo3(from_py_with = args::coupling_tolerance_arg)] coupling_tolerance: f64,
+    #[pyo3(from_py_with = args::ngspice_arg)] ngspice: Option<PathBuf>,
+    #[pyo3(from_py_with = args::no_spiceinit_arg)] no_spiceinit: bool,
     #[pyo3(from_py_with = args::progress_arg)] progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Sweep> {
+    let simulator = verdicts::Simulator {
+        timeout,
+        element,
+        coupling,
+        max_iterations,
+        coupling_tolerance,
+        ngspice,
+        no_spiceinit,
+    };
+    if mechanics_only && ideal {
+        return Err(Failure::input(
+            "ideal=True runs each sample's circuit with an ideal contact, which \
+             mechanics_only=True leaves out: give one of them",
+        )
+        .into());
+    }
+    let destination = match (out, resume) {
+        (Some(_), Some(_)) => {
+            return Err(Failure::input(
+                "resume= continues the sweep in its own directory: give out= or resume=, \
+                 not both",
+            )
+            .into());
+        }
+        (_, Some(_)) if force => {
+            return Err(Failure::input(
+                "resume= keeps the rows in its directory, which force=True would replace: \
+                 give one of them",
+            )
+            .into());
+        }
+        (Some(dir), None) => Some(Destination {
+            dir,
+            resume: false,
+            force,
+            shard: None,
+        }),
+        (None, Some(dir)) => Some(Destination {
+            dir,
+            resume: true,
+            force: false,
+            shard: None,
+        }),
+        (None, None) if force => {
+            return Err(
+                Failure::input("force=True replaces the files of out=DIR: give out= too").into(),
+            );
+        }
+        (None, None) => None,
+    };
     let jobs = self::jobs(jobs);
     let loaded = load_scenario(path, toml_text, origin)?;
-    let scenario = loaded.scenario;
-    let (summary, csv) =
+    let Loaded { scenario, text } = loaded;
+    let to = destination.clone();
+    let (summary, kept) =
         work::interruptible(py, progress.as_ref(), move |ticker| -> Result<_, Failure> {
             let sampler = Sampler::new(&scenario, samples, seed)?;
-            let ngspice = (!mechanics_only).then(|| ngspice(timeout)).transpose()?;
+            let ngspice = (!mechanics_only).then(|| simulator.locate()).transpose()?;
             let mut options = SweepOptions::new(match &ngspice {
                 Some(n) => SweepMode::Circuit(n),
                 None => SweepMode::Mechanics,
@@ -237,47 +313,50 @@ fn py_sweep<'py>(
                 options.jobs = j;
             }
             options.run = RunOptions {
-                timeout,
                 compare_ideal: ideal,
                 ideal_alongside: false,
-                ..RunOptions::default()
+                ..simulator.run_options()
             };
+            if let Some(to) = &to {
+                let written =
+                    files::write(&scenario, &text, &sampler, &options, to, &*ticker, |_| {})?;
+                return Ok((
+                    written.summary.to_json(),
+                    Kept::File(written.files[0].clone(), written.rows),
+                ));
+            }
             let mut sink = work::Sink::new(Arc::clone(&ticker));
             let collected = sweep::run(&scenario, &sampler, &options, &mut sink, &*ticker)?;
             let summary = collected.summary(&sampler)?.to_json();
-            Ok((summary, String::from_utf8_lossy(&sink.bytes).into_owned()))
+            Ok((
+                summary,
+                Kept::Text(String::from_utf8_lossy(&sink.bytes).into_owned()),
+            ))
         })?;
-    Ok(Sweep {
-        summary: json(py, &summary)?.unbind(),
-        rows: csv_rows(py, &csv)?.unbind(),
-        csv,
+    let summary = json(py, &summary)?.unbind();
+    Ok(match kept {
+        Kept::Text(csv) => Sweep {
+            summary,
+            rows: rows::all(py, &csv)?.into_any().unbind(),
+            csv: Some(csv),
+            out: None,
+        },
+        Kept::File(csv, len) => Sweep {
+            summary,
+            rows: Bound::new(py, rows::SweepRows::new(csv, len))?
+                .into_any()
+                .unbind(),
+            csv: None,
+            out: destination.map(|d| d.dir.display().to_string()),
+        },
     })
 }
 
-/// The rows of the sweep's CSV as dicts.
-fn csv_rows<'py>(py: Python<'py>, text: &str) -> PyResult<Bound<'py, PyList>> {
-    let bad = |e: csv::Error| Failure::input(format!("the sweep's CSV: {e}"));
-    let mut reader = csv::Reader::from_reader(text.as_bytes());
-    let header = reader.headers().map_err(bad)?.clone();
-    let rows = PyList::empty(py);
-    for record in reader.records() {
-        let record = record.map_err(bad)?;
-        let row = PyDict::new(py);
-        for (name, cell) in header.iter().zip(record.iter()) {
-            let value = if cell.is_empty() {
-                py.None().into_bound(py)
-            } else if let Ok(i) = cell.parse::<i64>() {
-                i.into_pyobject(py)?.into_any()
-            } else if let Ok(f) = cell.parse::<f64>() {
-                f.into_pyobject(py)?.into_any()
-            } else {
-                cell.into_pyobject(py)?.into_any()
-            };
-            row.set_item(name, value)?;
-        }
-        rows.append(row)?;
-    }
-    Ok(rows)
+/// Where a sweep's rows are: its CSV text, or the file it wrote and its
+/// row count.
+enum Kept {
+    Text(String),
+    File(PathBuf, u64),
 }
 
 /// Fit the scenario's free keys to a record of the contact (a scope
@@ -560,6 +639,48 @@ fn contact_include(
 /// neither, the built-in default itself. Reports are the command line's
 /// JSON (``--format json``) as dicts; waveforms are numpy arrays. Numbers
 /// are in SI units (s, V, A, m, N, kg). Ctrl-C stops any call.
+/// A Ctrl-C that came while numpy loaded.
+static SIGINT_WHILE_LOADING: std::sync::atomic::AtomicBool =
+    std::sync::atomic::AtomicBool::new(false);
+
+/// SIGINT's handler while numpy loads: noted, raised once it has loaded.
+#[pyfunction]
+fn note_sigint(signum: i32, frame: Bound<'_, PyAny>) {
+    let _ = (signum, frame);
+    SIGINT_WHILE_LOADING.store(true, std::sync::atomic::Ordering::SeqCst);
+}
+
+/// numpy and its C API, loaded whole: a KeyboardInterrupt inside numpy's
+/// own import becomes an ImportError there ("Importing the numpy
+/// C-extensions failed"), so on the main thread, under Python's own
+/// SIGINT handler, a Ctrl-C is held until numpy has loaded and then
+/// raised as the KeyboardInterrupt it is.
+fn load_numpy(py: Python<'_>) -> PyResult<()> {
+    let load = || -> PyResult<()> {
+        py.import("numpy")?;
+        drop(numpy::PyArray1::<f64>::zeros(py, 0, false));
+        Ok(())
+    };
+    let signal = py.import("signal")?;
+    let threading = py.import("threading")?;
+    let on_main = threading
+        .call_method0("current_thread")?
+        .is(&threading.call_method0("main_thread")?);
+    let default = signal.getattr("default_int_handler")?;
+    let sigint = signal.getattr("SIGINT")?;
+    if !on_main || !signal.call_method1("getsignal", (&sigint,))?.is(&default) {
+        return load();
+    }
+    signal.call_method1("signal", (&sigint, wrap_pyfunction!(note_sigint, py)?))?;
+    let loaded = load();
+    signal.call_method1("signal", (&sigint, &default))?;
+    loaded?;
+    if SIGINT_WHILE_LOADING.swap(false, std::sync::atomic::Ordering::SeqCst) {
+        return Err(pyo3::exceptions::PyKeyboardInterrupt::new_err(()));
+    }
+    Ok(())
+}
+
 #[pymodule]
 #[pyo3(name = "chatterspice")]
 fn chatterspice_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -567,8 +688,7 @@ fn chatterspice_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // numpy and its C API now, with the package: a Ctrl-C while they load
     // is then a KeyboardInterrupt of the import, never a failure to reach
     // the API inside a call.
-    py.import("numpy")?;
-    drop(numpy::PyArray1::<f64>::zeros(py, 0, false));
+    load_numpy(py)?;
     m.add_function(wrap_pyfunction!(py_bounce, m)?)?;
     m.add_function(wrap_pyfunction!(verdicts::py_run, m)?)?;
     m.add_function(wrap_pyfunction!(verdicts::py_check, m)?)?;
@@ -583,6 +703,7 @@ fn chatterspice_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(py_pwl, m)?)?;
     m.add_class::<Run>()?;
     m.add_class::<Sweep>()?;
+    m.add_class::<rows::SweepRows>()?;
     m.add_class::<Fit>()?;
     m.add_class::<raw::RawFile>()?;
     m.add_class::<raw::Plot>()?;
@@ -598,5 +719,7 @@ fn chatterspice_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let mapping = py.import("collections.abc")?.getattr("Mapping")?;
     mapping.call_method1("register", (py.get_type::<raw::Plot>(),))?;
     mapping.call_method1("register", (py.get_type::<raw::RawFile>(),))?;
+    let sequence = py.import("collections.abc")?.getattr("Sequence")?;
+    sequence.call_method1("register", (py.get_type::<rows::SweepRows>(),))?;
     Ok(())
 }

@@ -197,27 +197,38 @@ pub struct Sweep {
     /// `summary.json` of `chatterspice sweep`, as a dict.
     #[pyo3(get)]
     pub summary: Py<PyAny>,
-    /// `sweep.csv` as a list of dicts, one per sample in index order:
-    /// numbers as int or float, empty cells as None, the rest as str.
+    /// `sweep.csv`, one dict per sample in index order: numbers as int or
+    /// float, empty cells as None, the rest as str. A list; with `out=`,
+    /// a SweepRows that reads them from the file when asked.
     #[pyo3(get)]
-    pub rows: Py<PyList>,
-    /// `sweep.csv` as text, byte for byte the file the command writes.
+    pub rows: Py<PyAny>,
+    /// `sweep.csv` as text, byte for byte the file the command writes;
+    /// None with `out=` (the file is in `out`).
     #[pyo3(get)]
-    pub csv: String,
+    pub csv: Option<String>,
+    /// With `out=`: the directory the sweep's files were written to.
+    #[pyo3(get)]
+    pub out: Option<String>,
 }
 
 #[pymethods]
 impl Sweep {
     /// A sweep from its fields, as pickle rebuilds it.
     #[new]
-    fn new(summary: Py<PyAny>, rows: Py<PyList>, csv: String) -> Sweep {
-        Sweep { summary, rows, csv }
+    #[pyo3(signature = (summary, rows, csv, out=None))]
+    fn new(summary: Py<PyAny>, rows: Py<PyAny>, csv: Option<String>, out: Option<String>) -> Sweep {
+        Sweep {
+            summary,
+            rows,
+            csv,
+            out,
+        }
     }
 
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
         let py = slf.py();
         let s = slf.get();
-        let fields = (s.summary.bind(py), s.rows.bind(py), &s.csv).into_pyobject(py)?;
+        let fields = (s.summary.bind(py), s.rows.bind(py), &s.csv, &s.out).into_pyobject(py)?;
         PyTuple::new(py, [slf.get_type().into_any(), fields.into_any()])
     }
 
@@ -227,7 +238,7 @@ impl Sweep {
         };
         let (a, b) = (slf.get(), other.get());
         let py = slf.py();
-        Ok(a.csv == b.csv
+        Ok((&a.csv, &a.out) == (&b.csv, &b.out)
             && same(a.summary.bind(py), b.summary.bind(py))?
             && same(a.rows.bind(py), b.rows.bind(py))?)
     }
@@ -235,9 +246,13 @@ impl Sweep {
     fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
         let summary = self.summary.bind(py);
         let keys: Vec<String> = summary.get_item("keys")?.extract()?;
+        let written = match &self.out {
+            Some(dir) => format!(" (written to {dir})"),
+            None => String::new(),
+        };
         Ok(format!(
-            "<chatterspice.Sweep: {} samples of {}; {} failing a limit, {} errors>",
-            self.rows.bind(py).len(),
+            "<chatterspice.Sweep: {} samples of {}; {} failing a limit, {} errors{written}>",
+            self.rows.bind(py).len()?,
             if keys.is_empty() {
                 "no keys".to_owned()
             } else {

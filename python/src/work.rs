@@ -78,6 +78,10 @@ impl chatterspice::sweep::Progress for Ticker {
     fn advance(&self, done: u64) {
         Ticker::advance(self, done);
     }
+
+    fn stopped(&self) -> bool {
+        self.cancelled()
+    }
 }
 
 /// A byte sink that refuses writes once the call is cancelled, so that a

@@ -240,6 +240,7 @@ FUNCTIONS = [
     chatterspice.run,
     chatterspice.check,
     chatterspice.envelope,
+    chatterspice.life,
     chatterspice.sweep,
     chatterspice.fit,
     chatterspice.capture,
@@ -263,12 +264,14 @@ def test_every_function_documents_each_of_its_parameters(function):
     [
         chatterspice.Run,
         chatterspice.Sweep,
+        chatterspice.SweepRows,
         chatterspice.Fit,
         chatterspice.RawFile,
         chatterspice.Plot,
         chatterspice.InputError,
         chatterspice.NgspiceError,
         chatterspice.SimulationError,
+        chatterspice.ChatterspiceWarning,
     ],
 )
 def test_every_class_is_documented(cls):
@@ -276,3 +279,17 @@ def test_every_class_is_documented(cls):
     for name, member in vars(cls).items():
         if not name.startswith("_") and (inspect.isgetsetdescriptor(member) or callable(member)):
             assert inspect.getdoc(member), f"{cls.__name__}.{name} has no docstring"
+
+
+def test_help_shows_no_rust_link_or_path():
+    """help() of every public name reads as Python: no leaked Rust link
+    such as "[`run`](crate)" or a `crate::` path."""
+    import pydoc
+
+    for name in chatterspice.__all__:
+        obj = getattr(chatterspice, name)
+        if not (callable(obj) or inspect.isclass(obj)):
+            continue
+        text = pydoc.render_doc(obj, renderer=pydoc.plaintext)
+        for leak in ("](", "`crate", "crate::", "[`"):
+            assert leak not in text, f"help({name}) shows {leak!r}"

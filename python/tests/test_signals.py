@@ -96,3 +96,48 @@ def test_twenty_first_call_interrupts_raise_no_panic():
     assert all(
         o in ("interrupted", "finished") or o.endswith("KeyboardInterrupt") for o in outcomes
     ), outcomes
+
+
+OTHER_USER_FIRST = """
+import ctypes, json, sys, warnings
+library = ctypes.CDLL("libngspice.so.0")
+# What PySpice does first: ngspice's shared library initialised by
+# another user of this process.
+library.ngSpice_Init(None, None, None, None, None, None, None)
+import chatterspice
+with warnings.catch_warnings(record=True) as said:
+    warnings.simplefilter("always")
+    result = chatterspice.run(sys.argv[1], ideal=False, timeout=600)
+print(json.dumps({
+    "warned": [str(w.message) for w in said
+               if issubclass(w.category, chatterspice.ChatterspiceWarning)],
+    "report": result.report["warnings"],
+    "schemes": [i["scheme"] for i in result.report["coupling"]],
+}))
+"""
+
+
+def test_lock_step_falling_back_to_passes_is_a_python_warning():
+    """After another user (PySpice, ctypes) has initialised libngspice in
+    the process, the lock-step run is found inconsistent and the coupling
+    runs as passes: the caller is told so by a ChatterspiceWarning."""
+    import ctypes
+    import json
+
+    try:
+        ctypes.CDLL("libngspice.so.0")
+    except OSError:
+        pytest.skip("ngspice's shared library (libngspice.so.0) is not installed")
+    scenario = ROOT / "examples" / "scenarios" / "relay-driver.toml"
+    done = subprocess.run(
+        [sys.executable, "-c", OTHER_USER_FIRST, str(scenario)],
+        capture_output=True,
+        text=True,
+        timeout=900,
+    )
+    assert done.returncode == 0, done.stderr
+    said = json.loads(done.stdout.strip().splitlines()[-1])
+    assert said["schemes"] and set(said["schemes"]) == {"passes"}
+    fallbacks = [w for w in said["warned"] if "run again as passes" in w]
+    assert fallbacks, said
+    assert fallbacks == [w for w in said["report"] if "run again as passes" in w]

@@ -2,11 +2,11 @@
 //! `--out` (written row by row, kept at a signal for `--resume`) and the
 //! shards joined.
 
-use std::io::{self, IsTerminal, Read, Write};
+use std::io::{self, IsTerminal, Read};
 use std::num::NonZeroUsize;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::Args;
 
 use chatterspice::pipeline::RunOptions;
@@ -112,19 +112,6 @@ fn parse_shard(text: &str) -> Result<Shard, String> {
     text.parse::<Shard>().map_err(|e| e.to_string())
 }
 
-/// The sweep's file names in `--out`: a shard writes its CSV alone.
-fn sweep_files(shard: Option<Shard>) -> Vec<String> {
-    match shard {
-        Some(s) => vec![format!("sweep.{}-of-{}.csv", s.index, s.count)],
-        None => vec![
-            "sweep.csv".to_owned(),
-            "summary.json".to_owned(),
-            "sweep.svg".to_owned(),
-            "sweep.png".to_owned(),
-        ],
-    }
-}
-
 /// An indicatif bar on a terminal's stderr.
 struct Bar(indicatif::ProgressBar);
 
@@ -141,11 +128,9 @@ impl sweep::Progress for Bar {
 }
 
 /// Exit status 1 when a sample failed a limit or could not run: the
-/// sweep's files are written either way.
-///
-/// The CSV is written under a temporary name in the output directory and
-/// renamed into place at the end; a signal puts its whole rows in place
-/// with `sweep.meta.json` marked incomplete, for `--resume`.
+/// sweep's files are written either way (by the library's
+/// [`sweep::files::write`], which keeps the finished rows at a signal for
+/// `--resume`).
 pub fn sweep(args: &SweepArgs) -> Result<Status> {
     let (scenario, text) = load_scenario_text(&args.scenario)?;
     let sampler = Sampler::new(&scenario, args.samples, args.seed)?;
@@ -155,129 +140,43 @@ pub fn sweep(args: &SweepArgs) -> Result<Status> {
         .clone()
         .or_else(|| args.out.clone())
         .unwrap_or_else(|| PathBuf::from("."));
-    let names = sweep_files(args.shard);
-    let csv_path = dir.join(&names[0]);
-    let meta_path = sweep::resume::meta_path(&csv_path);
-    let _lock = chatterspice::output::OutputLock::acquire(&dir, &names[0])?;
-    if !resume {
-        refuse_existing_sweep(&dir, &names, &meta_path, args.force)?;
-    }
     let ngspice = if args.mechanics_only {
         None
     } else {
         Some(args.simulator.ngspice()?)
     };
     let options = sweep_options(args, ngspice.as_ref());
-    let identity = sweep_identity(args, &scenario, &text, &sampler);
-
-    let (partial_csv, partial_meta) = (
-        sweep::resume::partial(&csv_path),
-        sweep::resume::partial(&meta_path),
-    );
-    // What a run killed outright left, else what a signal left.
-    let (from_csv, from_meta) = if partial_csv.exists() && partial_meta.exists() {
-        (partial_csv.clone(), partial_meta.clone())
-    } else {
-        (csv_path.clone(), meta_path.clone())
+    let destination = sweep::files::Destination {
+        dir,
+        resume,
+        force: args.force,
+        shard: args.shard,
     };
-    let kept = if resume {
-        sweep::resume::check_meta(&from_meta, &identity)?;
-        let (header, signals, columns) = sweep::run::layout(&scenario, &sampler, &options)?;
-        Some(sweep::resume::finished_rows(
-            &from_csv,
-            &header,
-            sampler.keys().len(),
-            signals.len(),
-            columns,
-            options.shard,
-        )?)
-    } else {
-        if partial_csv.exists() {
-            eprintln!(
-                "note: {} holds the rows of an interrupted sweep; this new sweep replaces it \
-                 (--resume {} would have continued it)",
-                partial_csv.display(),
-                dir.display()
-            );
-        }
-        None
-    };
-    let mut staged =
-        chatterspice::output::Staged::with_name(&csv_path, &partial_csv, args.force || resume)?;
-    let partial_meta_text = sweep::resume::Meta {
-        identity: identity.clone(),
-        complete: false,
-        rows: 0,
-    }
-    .to_json();
-    std::fs::write(&partial_meta, partial_meta_text)
-        .with_context(|| format!("{}: cannot write it", partial_meta.display()))?;
-    // Gone with the partial CSV when the sweep fails; kept beside it when
-    // the process is killed.
-    let _partial_meta = tempfile::TempPath::try_from_path(&partial_meta)
-        .with_context(|| format!("{}: cannot hold it", partial_meta.display()))?;
-    let done = match kept {
-        Some((bytes, done)) => {
-            staged.file().write_all(&bytes).with_context(|| {
-                format!("{}: cannot write the sweep's CSV", partial_csv.display())
-            })?;
-            eprintln!(
-                "resuming {}: {} of {} samples done",
-                from_csv.display(),
-                done.len(),
-                options.shard.len(sampler.count())
-            );
-            done
-        }
-        None => Vec::new(),
-    };
-    let at_stop = keep_rows_at_stop(
-        &partial_csv,
-        &csv_path,
-        &meta_path,
-        &partial_meta,
-        &identity,
-    );
-
     let bar = progress_bar();
     let progress: &dyn sweep::Progress = match &bar {
         Some(b) => b,
         None => &sweep::NoProgress,
     };
-    let collected = sweep::run_from(&scenario, &sampler, &options, staged.file(), progress, done)
-        .with_context(|| format!("{}: the sweep stopped", csv_path.display()))?;
-    let summary = collected.summary(&sampler)?;
-    let rows = collected.len() as u64;
-    let mut files = Vec::new();
-    if args.shard.is_none() {
-        let svg = sweep::plot::render(&collected, &sampler)?;
-        let png = report::png::render(&svg)?;
-        files.push((names[1].clone(), summary.to_json().into_bytes()));
-        files.push((names[2].clone(), svg.into_bytes()));
-        files.push((names[3].clone(), png.bytes));
-    }
-    let meta = sweep::resume::Meta {
-        identity,
-        complete: true,
-        rows,
-    };
-    let meta_name = meta_path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    files.push((meta_name, meta.to_json().into_bytes()));
-    drop(at_stop);
-    staged.commit()?;
-    report::write_bundle(&dir, &files, true)?;
+    let written = sweep::files::write(
+        &scenario,
+        &text,
+        &sampler,
+        &options,
+        &destination,
+        progress,
+        |note| eprintln!("{note}"),
+    )?;
     if args.shard.is_none() {
         warn_if_no_fonts();
     }
+    let summary = written.summary;
     let mut text = summary.render_table();
     text.push_str(&format!(
         "\nwritten: {}\n",
-        names
+        written
+            .files
             .iter()
-            .map(|n| dir.join(n).display().to_string())
+            .map(|f| f.display().to_string())
             .collect::<Vec<_>>()
             .join(", ")
     ));
@@ -287,35 +186,6 @@ pub fn sweep(args: &SweepArgs) -> Result<Status> {
     } else {
         Status::Success
     })
-}
-
-/// Fail before any work if the sweep's files exist (unless `force`), or
-/// something is in the way of one.
-fn refuse_existing_sweep(
-    dir: &Path,
-    names: &[String],
-    meta_path: &Path,
-    force: bool,
-) -> Result<()> {
-    let csv_path = dir.join(&names[0]);
-    for path in names
-        .iter()
-        .map(|n| dir.join(n))
-        .chain([meta_path.to_path_buf()])
-    {
-        if let Err(e) = chatterspice::output::check_target(&path, force) {
-            if matches!(e, report::WriteError::Exists { .. }) && path == csv_path {
-                bail!(
-                    "{}: already exists; pass --force to overwrite the sweep's files, \
-                         --resume {} to continue an interrupted sweep, or choose another --out",
-                    path.display(),
-                    dir.display()
-                );
-            }
-            return Err(e.into());
-        }
-    }
-    Ok(())
 }
 
 /// How the sweep runs, from the command line.
@@ -336,73 +206,6 @@ fn sweep_options<'n>(args: &SweepArgs, ngspice: Option<&'n Ngspice>) -> SweepOpt
         ..args.simulator.run_options()
     };
     options
-}
-
-/// Which sweep this is, for `sweep.meta.json` and `--resume`.
-fn sweep_identity(
-    args: &SweepArgs,
-    scenario: &Scenario,
-    text: &str,
-    sampler: &Sampler,
-) -> sweep::resume::Identity {
-    let netlist_text = match scenario.netlist() {
-        Some(Ok((_, netlist))) => netlist,
-        _ => String::new(),
-    };
-    sweep::resume::Identity {
-        tool: format!("chatterspice {}", env!("CARGO_PKG_VERSION")),
-        scenario_digest: sweep::resume::digest(&[text.as_bytes(), netlist_text.as_bytes()]),
-        seed: sampler.seed(),
-        samples: sampler.count(),
-        shard: args.shard.map(|s| s.to_string()),
-        mode: if args.mechanics_only {
-            "mechanics"
-        } else {
-            "circuit"
-        }
-        .to_owned(),
-        ideal: args.ideal,
-    }
-}
-
-/// At a signal: the rows written so far into `partial_csv`, whole, moved
-/// to `csv`, and `meta` saying they are incomplete, where `--resume`
-/// finds them.
-fn keep_rows_at_stop(
-    partial_csv: &Path,
-    csv: &Path,
-    meta: &Path,
-    partial_meta: &Path,
-    identity: &sweep::resume::Identity,
-) -> chatterspice::interrupt::Registered {
-    let (tmp, csv, meta, tmp_meta, identity) = (
-        partial_csv.to_path_buf(),
-        csv.to_path_buf(),
-        meta.to_path_buf(),
-        partial_meta.to_path_buf(),
-        identity.clone(),
-    );
-    chatterspice::interrupt::finish_at_stop(move || {
-        if sweep::resume::truncate_to_whole_lines(&tmp).is_err() {
-            return;
-        }
-        let rows = std::fs::read(&tmp).map_or(0, |b| sweep::resume::row_count(&b));
-        if std::fs::rename(&tmp, &csv).is_ok() {
-            let record = sweep::resume::Meta {
-                identity,
-                complete: false,
-                rows,
-            };
-            if std::fs::write(&meta, record.to_json()).is_ok() {
-                let _ = std::fs::remove_file(&tmp_meta);
-            }
-            eprintln!(
-                "sweep interrupted: {rows} finished rows kept in {}; continue with --resume {}",
-                csv.display(),
-                csv.parent().unwrap_or(Path::new(".")).display()
-            );
-        }
-    })
 }
 
 /// A progress bar on stderr when it is a terminal.

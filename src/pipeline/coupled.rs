@@ -579,12 +579,22 @@ pub fn run_coupled_plan(
                     fallback: None,
                 });
             }
-            Some(format!(
-                "the lock-step run's own events and the mechanics under its flux differ by \
-                 {change:e} s, more than the coupling tolerance ({:e} s): the coupling was \
-                 run again as passes",
-                options.tolerance
-            ))
+            Some(if change.is_finite() {
+                format!(
+                    "the lock-step run's own events and the mechanics under its flux differ \
+                     by {change:e} s, more than the coupling tolerance ({:e} s): the coupling \
+                     was run again as passes",
+                    options.tolerance
+                )
+            } else {
+                // Seen when another user of the library in this process
+                // (PySpice, a ctypes binding) initialised it before us.
+                "the lock-step run's own events and the mechanics under its flux do not have \
+                 the same contact changes (another user of ngspice's shared library in this \
+                 process, such as PySpice, can cause this): the coupling was run again as \
+                 passes"
+                    .to_owned()
+            })
         }
         Err(note) => note,
     };

@@ -134,6 +134,9 @@ pub enum SweepError {
         /// The shard as given.
         text: String,
     },
+    /// The caller stopped the sweep ([`super::Progress::stopped`]).
+    #[error("the sweep was stopped")]
+    Stopped,
     /// The CSV header or rows could not be written.
     #[error("cannot write the sweep's rows")]
     Write(#[source] std::io::Error),

@@ -16,7 +16,9 @@
 //! - [`table`]: the records as `sweep.csv`, one row per sample in index
 //!   order, and [`table::merge`] that joins the CSVs of shards;
 //! - [`summary`]: distributions, the worst case and the failures, as
-//!   `summary.json`, a table for people, and a plot ([`plot`]).
+//!   `summary.json`, a table for people, and a plot ([`plot`]);
+//! - [`files`]: all of them written into a directory, the CSV row by row
+//!   while the sweep runs (`sweep --out DIR`).
 //!
 //! # Determinism
 //! Sample `i`'s values depend only on the seed and `i`, never on `--jobs`
@@ -28,6 +30,7 @@
 //! byte.
 
 mod error;
+pub mod files;
 pub mod merge;
 pub mod plot;
 mod record;

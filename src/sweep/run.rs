@@ -104,6 +104,12 @@ pub trait Progress {
     }
     /// Every sample is written.
     fn finish(&self) {}
+    /// Whether the caller wants the sweep stopped (an embedding that goes
+    /// on running, where a signal does not end the process): the sweep
+    /// then writes no more rows and fails with [`SweepError::Stopped`].
+    fn stopped(&self) -> bool {
+        false
+    }
 }
 
 /// No progress reporting.
@@ -230,6 +236,10 @@ pub fn run_from(
         for (c, rows, records) in rx {
             pending.insert(c, (rows, records));
             while let Some((rows, records)) = pending.remove(&expected) {
+                if progress.stopped() {
+                    stop.store(true, Ordering::Relaxed);
+                    return Err(SweepError::Stopped);
+                }
                 // Excluding a stop's finisher, which counts the rows
                 // written and keeps them for `--resume`.
                 let written = crate::interrupt::unless_stopping(|| {
