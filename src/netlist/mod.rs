@@ -20,6 +20,7 @@ pub mod arc;
 pub mod coil;
 pub mod contact;
 pub mod deck;
+pub mod elements;
 mod error;
 pub mod inline;
 mod lexical;

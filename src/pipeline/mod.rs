@@ -18,6 +18,7 @@
 //! reports to write wherever the caller wants.
 
 pub mod coupled;
+pub mod ledger;
 pub mod lockstep;
 pub mod make_force;
 pub mod pass;
@@ -206,6 +207,14 @@ pub enum RunError {
         #[source]
         source: MissingArcVector,
     },
+    /// The arcs and breakdowns took more energy than the circuit gave.
+    #[error("{}: {message}", netlist.display())]
+    Energy {
+        /// The user's netlist.
+        netlist: PathBuf,
+        /// What was taken and what was given.
+        message: String,
+    },
     /// A `[[probe]]` could not be analysed in a run's transient plot.
     #[error("{}: probe `{signal}` ({run} run)", origin.display())]
     Probe {
@@ -270,6 +279,10 @@ pub struct RunResult {
     pub coil_levels: Option<crate::coil::CoilLevels>,
     /// With `[arc]`: every arc and breakdown at the contact.
     pub arcs: Option<ArcReport>,
+    /// The run's energy ledger: what the sources delivered and where it
+    /// went (arcs and breakdowns taking more than the circuit gave is an
+    /// error, never a result).
+    pub energy: ledger::EnergyLedger,
     /// With `[pole_face]`: the armature's impacts on the pole face (the
     /// contact's record is then the blade's).
     pub pole_face: Option<Vec<crate::chatter::Impact>>,
@@ -629,6 +642,13 @@ fn run_chatter(
             )
         })
         .transpose()?;
+    let energy = energy_ledger(
+        &simulation.plot,
+        &deck.text,
+        circuit,
+        arcs.as_ref(),
+        &netlist_path,
+    )?;
 
     let mut warnings: Vec<String> = deck.warnings.iter().map(ToString::to_string).collect();
     warnings.extend(simulation.warnings.iter().cloned());
@@ -658,6 +678,7 @@ fn run_chatter(
         pole_face: None,
         makes,
         arcs,
+        energy,
         netlist: netlist_path,
         chatter,
         waveform,
@@ -780,6 +801,13 @@ fn run_coil(plan: &Plan, runner: &dyn Runner, options: &RunOptions) -> Result<Ru
             )
         })
         .transpose()?;
+    let energy = energy_ledger(
+        &coupled.plot,
+        &coupled.deck.text,
+        circuit,
+        arcs.as_ref(),
+        &circuit.netlist,
+    )?;
     let elapsed: f64 = coupled.iterations.iter().map(|i| i.ngspice_elapsed).sum();
     let netlist_path = circuit.netlist.clone();
     let mut warnings: Vec<String> = coupled
@@ -852,6 +880,7 @@ fn run_coil(plan: &Plan, runner: &dyn Runner, options: &RunOptions) -> Result<Ru
             .is_some()
             .then_some(coupled.pole_face),
         arcs,
+        energy,
     })
 }
 
@@ -925,6 +954,29 @@ struct ArcSetup {
     model: ArcModel,
     vectors: ArcVectors,
     instance: String,
+}
+
+/// The energy ledger of `plot`, the run of deck `deck` for `circuit`,
+/// with the run's `arcs`; an error when the arcs and breakdowns took more
+/// than the circuit gave.
+fn energy_ledger(
+    plot: &Plot,
+    deck: &str,
+    circuit: &crate::scenario::CircuitSection,
+    arcs: Option<&ArcReport>,
+    netlist: &std::path::Path,
+) -> Result<ledger::EnergyLedger, RunError> {
+    let mut ours = vec![circuit.subckt.as_str(), circuit.coil_subckt.as_str()];
+    ours.extend(circuit.nc_subckt.as_deref());
+    let elements = netlist::elements::top_level(deck, &ours);
+    let energy = ledger::ledger(plot, &elements, arcs);
+    match energy.violation() {
+        Some(message) => Err(RunError::Energy {
+            netlist: netlist.to_owned(),
+            message,
+        }),
+        None => Ok(energy),
+    }
 }
 
 /// `None` without `[arc]`, or when the netlist has no contact instance

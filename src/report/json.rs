@@ -165,6 +165,9 @@ pub struct RunJson<'a> {
     arc_model: Option<&'a ArcModel>,
     /// Every make: its peak current, the force then and the spot.
     makes: &'a [crate::arc::making::Make],
+    /// The run's energy ledger: the sources, the stores, the resistors,
+    /// the arcs and breakdowns, the rest.
+    energy: &'a crate::pipeline::ledger::EnergyLedger,
     /// With `[datasheet] electrical_endurance`: the electrical life at
     /// this circuit (the `life` document).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -253,6 +256,7 @@ impl<'a> RunJson<'a> {
             breakdowns: run.arcs.as_ref().map(|a| a.breakdowns.as_slice()),
             arc_model: run.arcs.as_ref().map(|a| &a.model),
             makes: &run.makes,
+            energy: &run.energy,
             life: None,
         }
     }

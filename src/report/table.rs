@@ -198,7 +198,39 @@ fn run_lines(run: &RunResult) -> Vec<(&'static str, String)> {
     for (k, op) in run.operations.iter().enumerate() {
         lines.push(("", operation_line(k + 1, op)));
     }
+    lines.push(("energy", energy_line(&run.energy)));
     lines
+}
+
+/// The energy ledger in one line: what the sources delivered and where it
+/// went.
+fn energy_line(e: &crate::pipeline::ledger::EnergyLedger) -> String {
+    let mut text = format!("{} delivered", engineering(e.delivered, "J"));
+    if e.stored_start != 0.0 || e.stored_end != 0.0 {
+        text.push_str(&format!(
+            ", stored {} at the start and {} at the end",
+            engineering(e.stored_start, "J"),
+            engineering(e.stored_end, "J")
+        ));
+    }
+    if let Some(r) = e.resistors {
+        text.push_str(&format!(", {} in resistors", engineering(r, "J")));
+    }
+    text.push_str(&format!(
+        ", {} in arcs, {} in breakdowns",
+        engineering(e.arcs, "J"),
+        engineering(e.breakdowns, "J")
+    ));
+    if let Some(rest) = e.elsewhere {
+        text.push_str(&format!(", {} elsewhere", engineering(rest, "J")));
+    }
+    if !e.complete() {
+        text.push_str(&format!(
+            " (not balanced: {} not accounted for)",
+            e.unaccounted.join(", ")
+        ));
+    }
+    text
 }
 
 /// The relay in one line: its bounces and outcome, and the first

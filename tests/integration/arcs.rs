@@ -193,6 +193,14 @@ fn a_24_v_12_a_resistive_load_arcs_at_every_bounce_near_v_min() {
             );
             assert_eq!(arc.ends, "contact_closed");
         }
+        // The ledger adds up: the source's energy went into the load,
+        // the arcs and the closed contact (50 mΩ against 2 Ω: 2.4 %).
+        let e = &result.energy;
+        assert!(e.complete(), "{:?}", e.unaccounted);
+        assert_eq!(e.arcs, report.totals.energy);
+        let rest = e.elsewhere.unwrap();
+        assert!(rest >= 0.0 && rest < 0.03 * e.delivered, "{e:?}");
+        assert!(e.violation().is_none());
         // The load current never stops after the first make.
         let probe = &result.probes[0].analysis;
         assert!(probe.max > -5.9, "the current reached {} A", probe.max);
