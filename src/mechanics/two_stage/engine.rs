@@ -234,6 +234,14 @@ fn prove_ending<D: DriveModel>(
         return;
     }
     let mut later = p.fork();
+    // Past a new impact (or, open, any change) the ending followed can no
+    // longer be proven: the follow-on stops there instead of running on
+    // to its span for nothing.
+    let impacts = p.rec.contact_count();
+    later.give_up_past = Some(match ending {
+        Outcome::EndsOpen => (impacts, p.rec.changes()),
+        _ => (impacts, usize::MAX),
+    });
     let span = Settings {
         t_end: settings.t_end * PROOF_SPAN,
         ..*settings
