@@ -210,10 +210,14 @@ impl Bernstein {
         for (k, s) in scaled.iter_mut().enumerate().take(n) {
             *s = f.a[k] * INVERSE_BINOMIAL[d][k];
         }
+        // Summed over k in order for each j, as the sum's definition
+        // reads, but with j innermost: the n sums are independent chains,
+        // not one chain after another.
         let mut b = [0.0; MAX_COEFFS];
-        for (j, bj) in b.iter_mut().enumerate().take(n) {
-            let row = &BINOMIAL[j];
-            *bj = (0..=j).map(|k| row[k] * scaled[k]).sum();
+        for (k, &s) in scaled.iter().enumerate().take(n) {
+            for (j, bj) in b.iter_mut().enumerate().take(n).skip(k) {
+                *bj += BINOMIAL[j][k] * s;
+            }
         }
         Bernstein {
             b,

@@ -47,7 +47,9 @@ impl Surface {
                 exponent,
                 chi,
             } => {
-                let spring = stiffness * delta.max(0.0).powf(exponent);
+                // x¹ is x to the last bit, and no power function to call.
+                let d = delta.max(0.0);
+                let spring = stiffness * if exponent == 1.0 { d } else { d.powf(exponent) };
                 (spring * (1.0 + chi * delta_dot)).max(0.0)
             }
         }

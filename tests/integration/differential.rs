@@ -811,3 +811,45 @@ fn endings_are_proven_whatever_t_end() {
     }
     assert!(proven > 60, "{proven} endings checked");
 }
+
+/// The engine's time on each relay of the random families (both horizons
+/// the comparison runs), the slowest printed: a survey, not a check (speed
+/// is held by `cargo bench --bench mechanics`). Run it optimised:
+/// `CHATTERSPICE_DIFFERENTIAL=3000 cargo test --release --test integration
+/// slowest_relays -- --ignored --nocapture`.
+#[test]
+#[ignore = "a timing survey; run it by name, optimised"]
+fn slowest_relays() {
+    let (n, first) = (count(), first_seed());
+    let mut times: Vec<(f64, u64, usize, Outcome)> = Vec::new();
+    for seed in first..first + n {
+        let relay = relay(seed);
+        let t_end = if seed % 3 == 0 {
+            1.5e-3 + 8.5e-3 * Draw::new(seed ^ 0x7E7D).unit()
+        } else {
+            0.02
+        };
+        for horizon in [t_end, 2.0 * t_end] {
+            let start = std::time::Instant::now();
+            let run = relay.engine(horizon);
+            let took = start.elapsed().as_secs_f64();
+            let (impacts, ending) = run.map_or((0, Outcome::EndOfTime), |r| {
+                (r.contact.impacts.len(), r.contact.outcome)
+            });
+            times.push((took, seed, impacts, ending));
+        }
+    }
+    times.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let total: f64 = times.iter().map(|t| t.0).sum();
+    println!(
+        "{} runs of {n} relays from seed {first}: {total:.3} s",
+        times.len()
+    );
+    for (took, seed, impacts, ending) in times.iter().take(10) {
+        println!(
+            "{took:.4} s  seed {seed}  {:?}  {impacts} impacts  {ending:?}",
+            relay(*seed).contact
+        );
+    }
+    assert!(total > 0.0);
+}

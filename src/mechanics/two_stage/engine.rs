@@ -67,18 +67,16 @@ impl<D: DriveModel> RelayModel<'_, D> {
                 Some(None) => None,
                 Some(Some(guard)) => {
                     let mono = mono.get_or_insert_with(|| dense.monomial());
-                    let forms: Vec<StepForm> = guard.forms[..guard.count]
-                        .iter()
-                        .map(|f| {
-                            let a: [f64; 8] = std::array::from_fn(|k| {
-                                let c = &mono[k];
-                                let v: f64 = (0..5).map(|i| f.c[i] * c[i]).sum();
-                                if k == 0 { v + f.d } else { v }
-                            });
-                            StepForm::new(&a)
-                        })
-                        .collect();
-                    locate::first_zero(&forms, guard.combine, resolution / h)
+                    let forms: [StepForm; 2] = std::array::from_fn(|j| {
+                        let f = &guard.forms[j];
+                        let a: [f64; 8] = std::array::from_fn(|k| {
+                            let c = &mono[k];
+                            let v: f64 = (0..5).map(|i| f.c[i] * c[i]).sum();
+                            if k == 0 { v + f.d } else { v }
+                        });
+                        StepForm::new(&a)
+                    });
+                    locate::first_zero(&forms[..guard.count], guard.combine, resolution / h)
                         .map(|(lo, hi)| (t0 + lo * h, t0 + hi * h))
                 }
                 None => self.sampled(which, dense, t1, modes),
@@ -234,6 +232,14 @@ fn prove_ending<D: DriveModel>(
         return;
     }
     let mut later = p.fork();
+    // Past a new impact (or, open, any change) the ending followed can no
+    // longer be proven: the follow-on stops there instead of running on
+    // to its span for nothing.
+    let impacts = p.rec.contact_count();
+    later.give_up_past = Some(match ending {
+        Outcome::EndsOpen => (impacts, p.rec.changes()),
+        _ => (impacts, usize::MAX),
+    });
     let span = Settings {
         t_end: settings.t_end * PROOF_SPAN,
         ..*settings

@@ -140,13 +140,22 @@ impl ModeKit {
         }
     }
 
-    /// The forms' values and rates at `w`.
+    /// The forms' values and rates at `w` (zero for forms the mode has
+    /// not: a relay without a pole face reads two, not four).
     fn read(&self, w: &W) -> Reading {
-        let v = self.readout * w + self.offset;
-        Reading {
-            value: [v[0], v[1], v[2], v[3]],
-            rate: [v[4], v[5], v[6], v[7]],
+        let mut at = Reading {
+            value: [0.0; 4],
+            rate: [0.0; 4],
+        };
+        let row = |i: usize| {
+            let r = &self.readout;
+            r[(i, 0)] * w[0] + r[(i, 1)] * w[1] + r[(i, 2)] * w[2] + r[(i, 3)] * w[3]
+        };
+        for i in 0..self.forms.len() {
+            at.value[i] = row(i) + self.offset[i];
+            at.rate[i] = row(4 + i);
         }
+        at
     }
 }
 
@@ -505,13 +514,24 @@ fn first_event(
             *slot = Some(polys.of(t));
         }
         let step_polys = step_polys.iter().flatten();
-        let mut forms = [StepForm::new(&[0.0]); 2];
-        let mut count = 0;
-        for (form, p) in forms.iter_mut().zip(step_polys.clone()) {
-            *form = StepForm::scaled(&p.p, h);
-            count += 1;
-        }
-        let Some((lo, hi)) = locate::first_zero(&forms[..count], combine, resolution / h) else {
+        // The common event: one form, one zero, nothing before it; the
+        // locator would bracket the whole step.
+        let isolated = match guard {
+            Guard::One(t) if h == kit.mode.h => kit.forms[t.form].isolated_over_step(w0, t.negated),
+            _ => false,
+        };
+        let bracket = if isolated {
+            Some((0.0, 1.0))
+        } else {
+            let mut forms = [StepForm::new(&[0.0]); 2];
+            let mut count = 0;
+            for (form, p) in forms.iter_mut().zip(step_polys.clone()) {
+                *form = StepForm::scaled(&p.p, h);
+                count += 1;
+            }
+            locate::first_zero(&forms[..count], combine, resolution / h)
+        };
+        let Some((lo, hi)) = bracket else {
             continue;
         };
         let (lo, hi) = (lo * h, hi * h);
@@ -526,7 +546,7 @@ fn first_event(
             if lo == 0.0 && v_lo.abs() <= poly.noise(hi) {
                 return Some(hi);
             }
-            Some(poly.root(lo, hi))
+            Some(poly.root_from((lo, hi), (v_lo, v_hi)))
         });
         let tau = match combine {
             Combine::Max => crossings.reduce(f64::max),

@@ -122,6 +122,15 @@ pub(super) struct Series {
     /// step on its zero (the event that began the mode): the Bernstein
     /// coefficients of its first `LOW_TERMS − 1` terms.
     pub(super) bern_after_zero: [W; LOW_TERMS - 1],
+    /// The Bernstein coefficients of the whole series (degree
+    /// `TERMS − 1`, over the mode's full step) as rows to dot with `w0`:
+    /// `b_j = k + full_j·w0`, the same polynomial the locator converts.
+    /// Built at the mode's first event, with `Σ_k ‖r_k‖₁ h^k` (the rows'
+    /// magnitude before their terms cancel, for the rounding of
+    /// `full_j·w0`).
+    full: std::sync::OnceLock<(Box<[W; TERMS]>, f64)>,
+    /// s, the mode's full step.
+    h: f64,
 }
 
 /// Terms of a form's series in its cheap sign test: the polynomial of
@@ -192,7 +201,68 @@ impl Series {
             bern,
             bern_norm,
             bern_after_zero,
+            full: std::sync::OnceLock::new(),
+            h: mode.h,
         }
+    }
+
+    /// The Bernstein rows of the whole series over the mode's full step,
+    /// `b_j = Σ_{k ≤ j} C(j, k)/C(n, k) r_k h^k` (n = `TERMS − 1`), and
+    /// their magnitude.
+    fn full(&self) -> &(Box<[W; TERMS]>, f64) {
+        self.full.get_or_init(|| {
+            let n = TERMS - 1;
+            let mut full = Box::new([W::zeros(); TERMS]);
+            let mut hk = 1.0;
+            let mut inv_binom = 1.0;
+            let mut magnitude = 0.0;
+            for (k, rk) in self.r.iter().enumerate() {
+                if k > 0 {
+                    hk *= self.h;
+                    inv_binom *= k as f64 / (n - k + 1) as f64;
+                }
+                magnitude += rk.abs().sum() * hk;
+                let mut ratio = inv_binom;
+                for (j, b) in full.iter_mut().enumerate().skip(k) {
+                    if j > k {
+                        ratio *= j as f64 / (j - k) as f64;
+                    }
+                    *b += rk * (ratio * hk);
+                }
+            }
+            (full, magnitude)
+        })
+    }
+
+    /// Whether the form, negated when `negated`, has exactly one zero over
+    /// a whole step of the mode from `w0`, with nothing before it to find:
+    /// its Bernstein coefficients, every one clear of its rounding, are
+    /// positive at the start, negative at the end and change sign once
+    /// (Descartes' rule of signs in that basis). This is the locator's
+    /// first test on a step ([`crate::mechanics::locate::first_zero`]
+    /// returns the whole step then), for 28 dot products instead of a
+    /// conversion to the Bernstein form; anything less clear goes to the
+    /// locator.
+    pub(super) fn isolated_over_step(&self, w0: &W, negated: bool) -> bool {
+        let sign = if negated { -1.0 } else { 1.0 };
+        let (rows, magnitude) = self.full();
+        let noise = 256.0 * f64::EPSILON * (self.k.abs() + magnitude * w0.amax());
+        let mut changes = 0;
+        let mut last = 1.0;
+        for row in rows.iter() {
+            let b = sign * (self.k + row.dot(w0));
+            if b.abs() <= noise {
+                return false;
+            }
+            if (b > 0.0) != (last > 0.0) {
+                changes += 1;
+                if changes > 1 {
+                    return false;
+                }
+            }
+            last = b;
+        }
+        changes == 1 && last < 0.0
     }
 
     /// Whether the form, negated when `negated`, starts on its zero and
@@ -335,8 +405,8 @@ impl Poly {
     /// between the ends: Newton's method from the secant's zero, kept
     /// inside the bracket, bisection where it would leave it, to where
     /// the value is lost in its rounding or the bracket is two floats wide.
-    pub(super) fn root(&self, lo: f64, hi: f64) -> f64 {
-        let (v_lo, v_hi) = evaluate_pair(&self.p, lo, &self.p, hi);
+    /// The values at the ends are given (as [`Poly::value`] has them).
+    pub(super) fn root_from(&self, (lo, hi): (f64, f64), (v_lo, v_hi): (f64, f64)) -> f64 {
         let floor = self.noise(lo.abs().max(hi.abs()));
         self.root_between((lo, hi), (v_lo, v_hi), floor, ROOT_TOLERANCE)
     }

@@ -46,6 +46,11 @@ impl Tally {
         self.contact.is_empty()
     }
 
+    /// The contact's impacts so far.
+    pub(crate) fn contact_count(&self) -> usize {
+        self.contact.len()
+    }
+
     /// Each release's time and the widest opening after it (m).
     pub(crate) fn openings(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
         self.contact
@@ -212,6 +217,12 @@ pub(crate) struct Propagation {
     pub energy0: Option<f64>,
     /// The first broken invariant: (time, what).
     pub violation: Option<(f64, String)>,
+    /// A follow-on that only proves an ending gives up once what it
+    /// follows has changed for good: (impacts, changes), the most the
+    /// contact may have and still be proven as it was.
+    pub give_up_past: Option<(usize, usize)>,
+    /// Whether it gave up: the contact's ending cannot be proven from here.
+    pub gave_up: bool,
 }
 
 impl Propagation {
@@ -231,6 +242,8 @@ impl Propagation {
             pole_settled: false,
             energy0: self.energy0,
             violation: None,
+            give_up_past: None,
+            gave_up: false,
         }
     }
 
@@ -238,6 +251,9 @@ impl Propagation {
     /// the contact's ending decided and (when followed) the pole face
     /// settled.
     pub(crate) fn over(&self) -> bool {
+        if self.gave_up {
+            return true;
+        }
         match self.ending {
             None => false,
             Some(Outcome::EventLimit) => true,
@@ -281,6 +297,11 @@ impl Propagation {
         }
         self.t = t;
         self.y = y;
+        if let Some((impacts, changes)) = self.give_up_past
+            && (self.rec.contact.len() > impacts || self.rec.changes > changes)
+        {
+            self.gave_up = true;
+        }
         if self.rec.contact.len() >= MAX_EVENTS {
             self.ending = Some(Outcome::EventLimit);
             self.proven_at = None;
@@ -371,6 +392,8 @@ pub(super) fn start<D: DriveModel>(model: &RelayModel<'_, D>, e0: f64) -> Propag
         pole_settled: false,
         energy0,
         violation: None,
+        give_up_past: None,
+        gave_up: false,
     }
 }
 
