@@ -14,11 +14,21 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use std::time::Duration;
 
+mod bounce;
 mod calibrate;
 mod capture;
+mod checking;
+mod life;
+mod pwl;
 mod raw;
+mod run;
 mod sweeping;
 
+use bounce::bounce;
+use checking::check;
+use life::life;
+use pwl::pwl;
+use run::run;
 pub use sweeping::{MergeArgs, SweepArgs};
 use sweeping::{merge, sweep};
 
@@ -502,177 +512,6 @@ fn parse_phases(text: &str) -> Result<usize, String> {
     }
 }
 
-fn life(args: &LifeArgs) -> Result<()> {
-    let scenario = load_scenario(args.scenario.as_deref())?;
-    let ngspice = args.simulator.ngspice()?;
-    let options = chatterspice::verdict::LifeOptions {
-        phases: args.phases,
-        jobs: args
-            .jobs
-            .map_or_else(verdict::cpus, std::num::NonZeroUsize::get),
-        ..chatterspice::verdict::LifeOptions::default()
-    };
-    let report =
-        chatterspice::verdict::life(&scenario, &ngspice, &args.simulator.run_options(), &options)?;
-    let text = match args.format {
-        RunFormat::Json => chatterspice::verdict::life_json(&report),
-        RunFormat::Table => chatterspice::life::render(&report),
-    };
-    emit(&text, None, false)
-}
-
-fn bounce(args: &BounceArgs) -> Result<()> {
-    refuse_existing(args.output.as_deref(), args.force)?;
-    if let Some(csv) = &args.measured {
-        let chatter = Chatter::from_intervals(read_measured(csv)?);
-        let text = report::render(args.format.into(), &chatter, None);
-        return emit(&text, args.output.as_deref(), args.force);
-    }
-    let scenario = load_scenario(args.scenario.as_deref())?;
-    let text = chatterspice::commands::bounce(&scenario, args.format.into())?;
-    emit(&text, args.output.as_deref(), args.force)
-}
-
-fn run(args: &RunArgs) -> Result<()> {
-    let scenario = load_scenario(args.scenario.as_deref())?;
-    if let Some(csv) = &args.measured {
-        report::protect_input(csv);
-    }
-    if args.envelope.envelope && args.measured.is_some() {
-        bail!("--envelope samples the relay's mechanics, which --measured replaces");
-    }
-    let _lock = match &args.out {
-        Some(dir) => {
-            let lock = chatterspice::output::OutputLock::acquire(dir, "run")?;
-            refuse_existing_bundle(dir, args.force)?;
-            Some(lock)
-        }
-        None => None,
-    };
-    let ngspice = args.simulator.ngspice()?;
-    let options = RunOptions {
-        keep_workdir: args.keep_workdir,
-        compare_ideal: !args.no_ideal,
-        ..args.simulator.run_options()
-    };
-    let measured = args.measured.as_deref().map(read_measured).transpose()?;
-    let outcome = verdict::run(
-        &scenario,
-        &ngspice,
-        &options,
-        measured,
-        &args.life.options(),
-    )?;
-    let result = &outcome.result;
-    for sim in std::iter::once(&result.simulation).chain(&result.ideal) {
-        if let Some(dir) = &sim.workdir {
-            eprintln!("ngspice work directory kept: {}", dir.display());
-        }
-    }
-    let mut text = match args.format {
-        RunFormat::Json => outcome.json(),
-        RunFormat::Table => report::table::render_run_with_life(result, outcome.life.as_ref()),
-    };
-    if args.envelope.envelope {
-        let env = verdict::run_envelope(&scenario, &ngspice, &args.envelope.options(options))?;
-        text = match args.format {
-            RunFormat::Json => envelope::json_with_envelope(&text, &env.report),
-            RunFormat::Table => format!("{text}\n{}", envelope::band_table(&env.report)),
-        };
-    }
-    for warning in &outcome.warnings {
-        eprintln!("warning: {warning}");
-    }
-    if let Some(dir) = &args.out {
-        let files = report::bundle::run_files_with_life(
-            result,
-            outcome.dimensionless.as_ref(),
-            outcome.life.as_ref(),
-        )
-        .context("the run succeeded, but its files could not be made")?;
-        report::write_bundle(dir, &files, args.force)?;
-        warn_if_no_fonts();
-    }
-    emit(&text, None, false)
-}
-
-fn check(args: &CheckArgs) -> Result<Status> {
-    let scenario = load_scenario(args.scenario.as_deref())?;
-    let options = args.simulator.run_options();
-    let ngspice = args.simulator.lazy();
-    if args.envelope.envelope {
-        let env = verdict::check_envelope(&scenario, &ngspice, &args.envelope.options(options))?;
-        return check_envelope(args, &env);
-    }
-    let measured = args.measured.as_deref().map(read_measured).transpose()?;
-    let outcome = verdict::check(
-        &scenario,
-        &ngspice,
-        &options,
-        measured,
-        &args.life.options(),
-    )?;
-    for note in &outcome.notes {
-        eprintln!("note: {note}");
-    }
-    let text = match args.format {
-        RunFormat::Json => outcome.json(),
-        RunFormat::Table => {
-            let evidence = &outcome.evidence;
-            let mut text = report::table::render_check(
-                &outcome.verdict,
-                evidence.chatter(),
-                evidence.operations(),
-            );
-            if let Some(life) = &outcome.life {
-                text.push_str("\nelectrical life\n");
-                text.push_str(&chatterspice::life::render(life));
-            }
-            text
-        }
-    };
-    for warning in &outcome.warnings {
-        eprintln!("warning: {warning}");
-    }
-    emit(&text, None, false)?;
-    Ok(if outcome.verdict.passed {
-        Status::Success
-    } else {
-        Status::CheckFailed
-    })
-}
-
-/// `check --envelope`: every limit against the worst relay the envelope
-/// keeps.
-fn check_envelope(args: &CheckArgs, env: &envelope::Envelope) -> Result<Status> {
-    let worst = env
-        .worst()
-        .expect("an envelope that kept a relay has a worst one");
-    let verdict = &env.verdict;
-    let text = match args.format {
-        RunFormat::Json => verdict::envelope_check_json(env),
-        RunFormat::Table => format!(
-            "{}\n{}",
-            report::table::render_check_of(
-                &format!(
-                    "worst relay (index {} of {} drawn)",
-                    worst.index, env.report.samples
-                ),
-                verdict,
-                worst.evidence.chatter(),
-                worst.evidence.operations()
-            ),
-            envelope::band_table(&env.report)
-        ),
-    };
-    emit(&text, None, false)?;
-    Ok(if verdict.passed {
-        Status::Success
-    } else {
-        Status::CheckFailed
-    })
-}
-
 /// A measured chatter record (`--measured CSV`): its open/closed intervals.
 fn read_measured(csv: &Path) -> Result<Vec<chatterspice::chatter::Interval>> {
     report::protect_input(csv);
@@ -716,78 +555,6 @@ fn refuse_existing_bundle(dir: &Path, force: bool) -> Result<()> {
         }
     }
     Ok(())
-}
-
-fn pwl(args: &PwlArgs) -> Result<()> {
-    refuse_existing(args.output.as_deref(), args.force)?;
-    let scenario = load_scenario(args.scenario.as_deref())?;
-    let model = ContactModel::from(&scenario.contact);
-    let (waveform, gap) = match &args.measured {
-        Some(csv) => {
-            let intervals = read_measured(csv)?;
-            let gap = pipeline::record_gap(&scenario, &intervals);
-            (Waveform::from_intervals(&intervals, &model)?, gap)
-        }
-        None if scenario.coil.is_some() => {
-            let (chatter, _) = check::dc_step(&scenario).with_context(|| {
-                format!(
-                    "{}: the mechanics simulation failed",
-                    scenario.origin.display()
-                )
-            })?;
-            let gap = pipeline::record_gap(&scenario, &chatter.intervals);
-            (pipeline::contact_waveform(&scenario, &chatter)?.0, gap)
-        }
-        None => {
-            let (mechanics, surface, settings) = (
-                scenario.mechanics()?,
-                scenario.surface(),
-                scenario.settings(),
-            );
-            let trajectory = chatterspice::mechanics::two_stage::step_closing(
-                &mechanics,
-                &scenario.two_stage(),
-                &surface,
-                &settings,
-            )
-            .with_context(|| {
-                format!(
-                    "{}: the mechanics simulation failed",
-                    scenario.origin.display()
-                )
-            })?;
-            let gap = GapProfile::from_trajectory(&trajectory);
-            let chatter = trajectory.into_chatter();
-            (pipeline::contact_waveform(&scenario, &chatter)?.0, gap)
-        }
-    };
-    let subckt = scenario
-        .circuit
-        .as_ref()
-        .map_or("CONTACT", |c| c.subckt.as_str());
-    let element = args
-        .element
-        .unwrap_or_else(|| ContactElement::for_waveform(&waveform));
-    let mut include = netlist::contact_include(&waveform, subckt, element)?;
-    if let Some(arc) = &scenario.arc {
-        include = chatterspice::netlist::arc::with_arc(include, &arc.model(), &gap)?;
-    }
-    if !include.data_files.is_empty() {
-        let Some(output) = &args.output else {
-            bail!(
-                "the {} element reads data files next to the include; give -o FILE so they can be written",
-                include.element
-            );
-        };
-        let dir = output
-            .parent()
-            .filter(|d| !d.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
-        for (name, contents) in &include.data_files {
-            report::write_new_file(&dir.join(name), contents.as_bytes(), args.force)?;
-        }
-    }
-    emit(&include.text, args.output.as_deref(), args.force)
 }
 
 /// The named scenario file, stdin for `-`, or the built-in default.
