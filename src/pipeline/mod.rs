@@ -548,10 +548,6 @@ fn run_chatter(
         .circuit
         .as_ref()
         .expect("netlist() returned Some, so there is a [circuit]");
-    let waveform_error = |source| RunError::Waveform {
-        path: origin.clone(),
-        source,
-    };
     let element = options
         .element
         .unwrap_or_else(|| ContactElement::for_waveform(&waveform));
@@ -586,14 +582,14 @@ fn run_chatter(
         &circuit.param_list(),
     )?;
 
-    let ideal_include = match (options.compare_ideal, chatter.first_impact) {
-        (true, Some(first_impact)) => {
-            let ideal =
-                ideal_waveform(first_impact, chatter.t_end, model).map_err(waveform_error)?;
-            Some(netlist::contact_include(&ideal, &circuit.subckt, element)?)
-        }
-        _ => None,
-    };
+    let ideal_include = ideal_include(
+        origin,
+        options.compare_ideal,
+        &chatter,
+        model,
+        &circuit.subckt,
+        element,
+    )?;
 
     let pass = |run: &'static str, include: &ContactInclude| {
         let mut includes = vec![(INCLUDE_FILE.to_owned(), include.text.clone())];
@@ -609,19 +605,8 @@ fn run_chatter(
     };
     let bounced_pass = pass("bounced", &include);
     let ideal_pass = ideal_include.as_ref().map(|i| pass("ideal", i));
-    let (simulation, ideal) = if options.ideal_alongside {
-        std::thread::scope(|scope| {
-            let ideal = ideal_pass.map(|p| scope.spawn(move || circuit_pass(runner, p)));
-            let bounced = circuit_pass(runner, bounced_pass);
-            let ideal = ideal.map(|handle| handle.join().expect("the ideal run does not panic"));
-            (bounced, ideal)
-        })
-    } else {
-        let bounced = circuit_pass(runner, bounced_pass);
-        (bounced, ideal_pass.map(|p| circuit_pass(runner, p)))
-    };
-    let simulation = simulation?;
-    let ideal = ideal.transpose()?;
+    let (simulation, ideal) =
+        bounced_and_ideal(runner, options.ideal_alongside, bounced_pass, ideal_pass)?;
 
     let probes = probe_results(
         scenario,
@@ -954,6 +939,49 @@ struct ArcSetup {
     model: ArcModel,
     vectors: ArcVectors,
     instance: String,
+}
+
+/// The ideal contact's include (closed for good from the first impact)
+/// to compare the run with, when `compare` and the contact closes.
+fn ideal_include(
+    origin: &std::path::Path,
+    compare: bool,
+    chatter: &Chatter,
+    model: &ContactModel,
+    subckt: &str,
+    element: ContactElement,
+) -> Result<Option<ContactInclude>, RunError> {
+    let Some(first) = chatter.first_impact.filter(|_| compare) else {
+        return Ok(None);
+    };
+    let ideal =
+        ideal_waveform(first, chatter.t_end, model).map_err(|source| RunError::Waveform {
+            path: origin.to_owned(),
+            source,
+        })?;
+    Ok(Some(netlist::contact_include(&ideal, subckt, element)?))
+}
+
+/// The bounced run and, when asked, the ideal contact's beside it (in
+/// parallel when `alongside`), the bounced run's error first.
+fn bounced_and_ideal(
+    runner: &dyn Runner,
+    alongside: bool,
+    bounced: Pass<'_>,
+    ideal: Option<Pass<'_>>,
+) -> Result<(Simulation, Option<Simulation>), PassError> {
+    let (simulation, ideal) = if alongside {
+        std::thread::scope(|scope| {
+            let ideal = ideal.map(|p| scope.spawn(move || circuit_pass(runner, p)));
+            let bounced = circuit_pass(runner, bounced);
+            let ideal = ideal.map(|handle| handle.join().expect("the ideal run does not panic"));
+            (bounced, ideal)
+        })
+    } else {
+        let simulation = circuit_pass(runner, bounced);
+        (simulation, ideal.map(|p| circuit_pass(runner, p)))
+    };
+    Ok((simulation?, ideal.transpose()?))
 }
 
 /// The energy ledger of `plot`, the run of deck `deck` for `circuit`,
