@@ -26,6 +26,10 @@ pub fn engineering(value: f64, unit: &str) -> String {
     if value == 0.0 || !value.is_finite() {
         return format!("0 {unit}");
     }
+    // Below the smallest prefix (f): an exponent, not fifteen zeros.
+    if value.abs() < 0.9995e-15 {
+        return format!("{value:.2e} {unit}");
+    }
     let mut exponent = (3.0 * (value.abs().log10() / 3.0).floor()).clamp(-15.0, 12.0) as i32;
     // 999.96 µs rounds to three digits as 1000 µs: that is 1 ms.
     let scaled = value.abs() / 10f64.powi(exponent);
@@ -68,5 +72,12 @@ mod tests {
         assert_eq!(engineering(0.000_999_4, "s"), "999 µs");
         assert_eq!(engineering(12.5e-6, "s"), "12.5 µs");
         assert_eq!(engineering(-0.000_999_96, "s"), "-1 ms");
+    }
+
+    #[test]
+    fn below_the_smallest_prefix_an_exponent() {
+        assert_eq!(engineering(1.16e-25, "J"), "1.16e-25 J");
+        assert_eq!(engineering(-3.0e-18, "s"), "-3.00e-18 s");
+        assert_eq!(engineering(2.0e-15, "J"), "2 fJ");
     }
 }
