@@ -157,12 +157,13 @@ impl Tran {
 
 /// One card: its physical lines and its text with continuations joined
 /// and comments removed.
-struct Card {
+pub(super) struct Card {
     /// 0-based index of the first physical line.
     first: usize,
     /// 0-based index of the last physical line.
     last: usize,
-    text: String,
+    /// The card's text, continuations joined, comments removed.
+    pub(super) text: String,
 }
 
 impl Card {
@@ -800,7 +801,7 @@ fn is_blank_or_comment(line: &str) -> bool {
 
 /// The cards among the live lines: `+` lines join the card before them,
 /// across comment and blank lines.
-fn cards(lines: &[&str], live: &[bool]) -> Vec<Card> {
+pub(super) fn cards(lines: &[&str], live: &[bool]) -> Vec<Card> {
     let mut out: Vec<Card> = Vec::new();
     for (i, line) in lines.iter().enumerate() {
         if !live[i] || is_blank_or_comment(line) {
@@ -878,21 +879,27 @@ pub fn instance_nodes_of(netlist_text: &str, subckt: &str) -> Vec<(String, Strin
 /// Whether an `X` card's subcircuit is `subckt`: the last token that is
 /// not a `name=value` parameter (nor `params:`).
 fn instantiates(card: &str, subckt: &str) -> bool {
+    subckt_of(card).is_some_and(|m| m.eq_ignore_ascii_case(subckt))
+}
+
+/// The subcircuit an `X` card instantiates (the last word before its
+/// parameters), as written; `None` for any other card.
+pub(super) fn subckt_of(card: &str) -> Option<String> {
     let mut tokens = card.split_whitespace();
     if !tokens
         .next()
         .is_some_and(|t| t.starts_with('x') || t.starts_with('X'))
     {
-        return false;
+        return None;
     }
     // `w = 1` and `w=1` alike: glue the `=` to its neighbours first.
     let glued = card.replace(" =", "=").replace("= ", "=");
-    let model = glued
+    glued
         .split_whitespace()
         .skip(1)
         .filter(|t| !t.contains('=') && !t.eq_ignore_ascii_case("params:"))
-        .last();
-    model.is_some_and(|m| m.eq_ignore_ascii_case(subckt))
+        .last()
+        .map(str::to_owned)
 }
 
 /// The file an include card names and, for `.lib FILE SECTION`, the

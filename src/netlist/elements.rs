@@ -6,7 +6,8 @@
 //! source, a subcircuit with a source of its own), so that it says so
 //! rather than balance a circuit it does not know.
 
-use super::lexical::{physical_lines, strip_comment};
+use super::deck;
+use super::lexical::physical_lines;
 use super::number::parse_number;
 
 /// One top-level element card.
@@ -34,35 +35,30 @@ pub struct Elements {
     pub unaccounted: Vec<String>,
 }
 
-/// The cards of `text` (continuations joined, comments removed), each
-/// with whether it lies inside a `.subckt` … `.ends` block and that
-/// block's name.
+/// The cards of deck `text` (its title left out), lower case, each with
+/// the `.subckt` block it lies in, if any.
 fn cards(text: &str) -> Vec<(Option<String>, String)> {
-    let mut out: Vec<(Option<String>, String)> = Vec::new();
+    let lines = physical_lines(text);
+    let mut live = vec![true; lines.len()];
+    if let Some(title) = live.first_mut() {
+        *title = false;
+    }
+    let mut out = Vec::new();
     let mut inside: Vec<String> = Vec::new();
-    for line in physical_lines(text).into_iter().skip(1) {
-        let line = strip_comment(line).trim();
-        if line.is_empty() {
-            continue;
-        }
-        if let Some(rest) = line.strip_prefix('+') {
-            if let Some(last) = out.last_mut() {
-                last.1.push(' ');
-                last.1.push_str(rest.trim());
-            }
-            continue;
-        }
-        let lower = line.to_ascii_lowercase();
+    for card in deck::cards(&lines, &live) {
+        let lower = card.text.to_ascii_lowercase();
         if let Some(rest) = lower.strip_prefix(".subckt") {
-            let name = rest.split_whitespace().next().unwrap_or_default();
-            inside.push(name.to_owned());
-            continue;
-        }
-        if lower.starts_with(".ends") {
+            inside.push(
+                rest.split_whitespace()
+                    .next()
+                    .unwrap_or_default()
+                    .to_owned(),
+            );
+        } else if lower.starts_with(".ends") {
             inside.pop();
-            continue;
+        } else {
+            out.push((inside.last().cloned(), lower));
         }
-        out.push((inside.last().cloned(), lower));
     }
     out
 }
@@ -102,15 +98,8 @@ pub fn top_level(text: &str, ours: &[&str]) -> Elements {
                 });
             }
             'X' => {
-                // The subcircuit's name is the last word before any
-                // `name=value` parameter.
-                let sub = words[1..]
-                    .iter()
-                    .rev()
-                    .find(|w| !w.contains('=') && !w.eq_ignore_ascii_case("params:"))
-                    .copied()
-                    .unwrap_or_default();
-                if !ours.iter().any(|o| o == sub) && sourcing.iter().any(|s| s == sub) {
+                let sub = deck::subckt_of(card).unwrap_or_default();
+                if !ours.contains(&sub) && sourcing.contains(&sub) {
                     found
                         .unaccounted
                         .push(format!("{} (subcircuit {sub} has a source)", words[0]));

@@ -205,24 +205,24 @@ fn run_lines(run: &RunResult) -> Vec<(&'static str, String)> {
 /// The energy ledger in one line: what the sources delivered and where it
 /// went.
 fn energy_line(e: &crate::pipeline::ledger::EnergyLedger) -> String {
-    let mut text = format!("{} delivered", joules(e.delivered));
-    if e.stored_start.max(e.stored_end) >= NEGLIGIBLE_ENERGY {
+    let mut text = format!("{} delivered", engineering(e.delivered, "J"));
+    if e.stored_start != 0.0 || e.stored_end != 0.0 {
         text.push_str(&format!(
             ", stored {} at the start and {} at the end",
-            joules(e.stored_start),
-            joules(e.stored_end)
+            engineering(e.stored_start, "J"),
+            engineering(e.stored_end, "J")
         ));
     }
     if let Some(r) = e.resistors {
-        text.push_str(&format!(", {} in resistors", joules(r)));
+        text.push_str(&format!(", {} in resistors", engineering(r, "J")));
     }
     text.push_str(&format!(
         ", {} in arcs, {} in breakdowns",
-        joules(e.arcs),
-        joules(e.breakdowns)
+        engineering(e.arcs, "J"),
+        engineering(e.breakdowns, "J")
     ));
     if let Some(rest) = e.elsewhere {
-        text.push_str(&format!(", {} elsewhere", joules(rest)));
+        text.push_str(&format!(", {} elsewhere", engineering(rest, "J")));
     }
     if !e.complete() {
         text.push_str(&format!(
@@ -231,18 +231,6 @@ fn energy_line(e: &crate::pipeline::ledger::EnergyLedger) -> String {
         ));
     }
     text
-}
-
-/// J, below this an energy is shown as 0 (rounding in the integrals).
-const NEGLIGIBLE_ENERGY: f64 = 1e-15;
-
-/// An energy in engineering notation, 0 below [`NEGLIGIBLE_ENERGY`].
-fn joules(value: f64) -> String {
-    if value.abs() < NEGLIGIBLE_ENERGY {
-        "0 J".to_owned()
-    } else {
-        engineering(value, "J")
-    }
 }
 
 /// The relay in one line: its bounces and outcome, and the first
