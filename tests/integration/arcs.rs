@@ -51,6 +51,18 @@ fn make_and_break(make: f64, brk: f64, end: f64) -> Vec<Interval> {
     ]
 }
 
+/// m, the widest gap below 1 mm at which `burns` still holds (bisection;
+/// it must hold at 0 and not at 1 mm).
+fn widest_burning_gap(burns: &dyn Fn(f64) -> bool) -> f64 {
+    let (mut lo, mut hi) = (0.0, 1e-3);
+    assert!(burns(lo) && !burns(hi));
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if burns(mid) { lo = mid } else { hi = mid }
+    }
+    lo
+}
+
 fn arcs_in<'a>(result: &'a RunResult, opening: &str) -> Vec<&'a ArcEvent> {
     result
         .arcs
@@ -733,12 +745,7 @@ fn a_dc_break_goes_out_where_the_load_line_leaves_the_arc_characteristic() {
         assert_eq!(arcs[0].ends, "current_below_i_min");
         // d* by bisection: below it the arc can burn, above it cannot.
         let burns = |g: f64| v_min + field * g + 2.0 * ((c + d * g) * r).sqrt() <= v;
-        let (mut lo, mut hi) = (0.0, 1e-3);
-        assert!(burns(lo) && !burns(hi));
-        for _ in 0..60 {
-            let mid = 0.5 * (lo + hi);
-            if burns(mid) { lo = mid } else { hi = mid }
-        }
+        let lo = widest_burning_gap(&burns);
         let expected = lo / speed;
         let duration = arcs[0].duration;
         assert!(
@@ -808,12 +815,7 @@ fn a_14_v_5_a_automotive_load_arcs_at_its_bounce_and_its_break() {
             .breaking_current(14.0, g)
             .is_some_and(|most| most < 5.0)
     };
-    let (mut lo, mut hi) = (0.0, 1e-3);
-    assert!(burns(lo) && !burns(hi));
-    for _ in 0..60 {
-        let mid = 0.5 * (lo + hi);
-        if burns(mid) { lo = mid } else { hi = mid }
-    }
+    let lo = widest_burning_gap(&burns);
     let expected = lo / speed;
     let duration = arcs[0].duration;
     assert!(expected > 10e-6, "{expected}");
