@@ -347,17 +347,13 @@ impl SimulatorArgs {
 
     /// The run options these arguments set; the rest default.
     fn run_options(&self) -> RunOptions {
-        RunOptions {
-            timeout: Duration::from_secs_f64(self.timeout),
-            element: self.element,
-            coupling: CouplingOptions {
-                tolerance: self.coupling_tolerance,
-                max_iterations: self.max_iterations,
-                coupling: self.coupling,
-                ..CouplingOptions::default()
-            },
-            ..RunOptions::default()
-        }
+        RunOptions::simulator(
+            self.timeout(),
+            self.element,
+            self.coupling,
+            self.max_iterations,
+            self.coupling_tolerance,
+        )
     }
 }
 

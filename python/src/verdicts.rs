@@ -10,7 +10,7 @@ use std::time::Duration;
 
 use chatterspice::envelope::{self, EnvelopeOptions};
 use chatterspice::netlist::ContactElement;
-use chatterspice::pipeline::{Coupling, CouplingOptions, RunOptions};
+use chatterspice::pipeline::{Coupling, RunOptions};
 use chatterspice::spice::{Ngspice, SpiceError};
 use chatterspice::verdict::{self, LazyNgspice, LifeOptions};
 use pyo3::prelude::*;
@@ -44,17 +44,13 @@ impl Simulator {
 
     /// The run options these arguments set; the rest default.
     pub fn run_options(&self) -> RunOptions {
-        RunOptions {
-            timeout: self.timeout,
-            element: self.element,
-            coupling: CouplingOptions {
-                tolerance: self.coupling_tolerance,
-                max_iterations: self.max_iterations,
-                coupling: self.coupling,
-                ..CouplingOptions::default()
-            },
-            ..RunOptions::default()
-        }
+        RunOptions::simulator(
+            self.timeout,
+            self.element,
+            self.coupling,
+            self.max_iterations,
+            self.coupling_tolerance,
+        )
     }
 }
 

@@ -93,6 +93,31 @@ impl Default for RunOptions {
     }
 }
 
+impl RunOptions {
+    /// The options a front end's simulator settings give (`--timeout`,
+    /// `--element`, `--coupling`, `--max-iterations`,
+    /// `--coupling-tolerance` and their Python keywords); the rest default.
+    pub fn simulator(
+        timeout: Duration,
+        element: Option<ContactElement>,
+        coupling: Option<Coupling>,
+        max_iterations: usize,
+        tolerance: f64,
+    ) -> RunOptions {
+        RunOptions {
+            timeout,
+            element,
+            coupling: CouplingOptions {
+                tolerance,
+                max_iterations,
+                coupling,
+                ..CouplingOptions::default()
+            },
+            ..RunOptions::default()
+        }
+    }
+}
+
 /// Why a run failed. Each variant names the file, key or run to look at.
 #[derive(Debug, Error)]
 #[non_exhaustive]
