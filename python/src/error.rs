@@ -402,7 +402,9 @@ impl From<SweepError> for Failure {
     fn from(e: SweepError) -> Failure {
         match e {
             SweepError::Scenario(e) => e.into(),
-            SweepError::Write(_) | SweepError::Stopped => Failure::of(Kind::Simulation, &e),
+            SweepError::Write(_) | SweepError::Scratch(_) | SweepError::Stopped => {
+                Failure::of(Kind::Simulation, &e)
+            }
             e => Failure::of(Kind::Input, &e),
         }
     }

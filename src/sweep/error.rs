@@ -140,6 +140,13 @@ pub enum SweepError {
     /// The CSV header or rows could not be written.
     #[error("cannot write the sweep's rows")]
     Write(#[source] std::io::Error),
+    /// The per-sample numbers behind the summary and the plot could not be
+    /// kept in, or read back from, their temporary file.
+    #[error(
+        "cannot keep the sweep's per-sample numbers in a temporary file (the system's \
+         temporary directory, TMPDIR): is it full or not writable?"
+    )]
+    Scratch(#[source] std::io::Error),
     /// The scenario cannot be used, or cannot take a sweep's values (or
     /// its netlist cannot be read, for a circuit sweep).
     #[error(transparent)]

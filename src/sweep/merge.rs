@@ -137,7 +137,9 @@ fn write_merged_summary(
     let records = super::resume::all_rows(output, header, keys.len(), signals.len(), columns)?;
     let mut collected = super::summary::Collected::new(keys, signals);
     for r in &records {
-        collected.add(r);
+        collected
+            .add(r)
+            .map_err(|e| MergeFilesError::Summary(e.to_string()))?;
     }
     let seed = identity.as_ref().and_then(|i| i.seed);
     let grid = identity.as_ref().is_some_and(|i| i.seed.is_none());

@@ -16,7 +16,10 @@
 //! - [`table`]: the records as `sweep.csv`, one row per sample in index
 //!   order, and [`table::merge`] that joins the CSVs of shards;
 //! - [`summary`]: distributions, the worst case and the failures, as
-//!   `summary.json`, a table for people, and a plot ([`plot`]);
+//!   `summary.json`, a table for people, and a plot ([`plot`]), from a
+//!   few numbers per sample kept in bounded memory (a temporary file
+//!   beyond 65 536 samples), so that 10⁷ samples need no more memory
+//!   than 10⁵;
 //! - [`files`]: all of them written into a directory, the CSV row by row
 //!   while the sweep runs (`sweep --out DIR`).
 //!
@@ -37,6 +40,7 @@ mod record;
 pub mod resume;
 pub mod run;
 pub mod sample;
+mod spill;
 pub mod summary;
 pub mod table;
 pub mod verdict;

@@ -7,6 +7,10 @@
 //!   one. A sample without a bounce time (the contact did not end closed)
 //!   breaks the line.
 //!
+//! A grid of more than 20 000 points is drawn thinned (every k-th value
+//! of the first key, at most 16 lines), as its title says; the summary
+//! still counts every sample.
+//!
 //! Coordinates have one decimal, labels the digits their tick step needs:
 //! the same sweep gives the same bytes.
 
@@ -14,7 +18,7 @@ use std::fmt::Write as _;
 
 use super::error::SweepError;
 use super::sample::Sampler;
-use super::summary::Collected;
+use super::summary::{Collected, column};
 use crate::report::svg::escape;
 
 const WIDTH: f64 = 760.0;
@@ -29,9 +33,16 @@ const COLORS: [&str; 8] = [
 ];
 /// Histogram bars of a continuous value.
 const BINS: usize = 30;
+/// The most points a grid plot draws; a larger grid is thinned.
+const MAX_POINTS: u64 = 20_000;
+/// The most lines a thinned grid plot draws.
+const MAX_SERIES: u64 = 16;
 
-/// A named polyline of (x, y) points; a `None` y breaks the line.
-type Series = (String, Vec<(f64, Option<f64>)>);
+/// (x, y) points of a line; a `None` y breaks it.
+type Points = Vec<(f64, Option<f64>)>;
+
+/// A named line.
+type Series = (String, Points);
 
 /// One panel's content.
 enum Content {
@@ -52,7 +63,7 @@ pub fn render(collected: &Collected, sampler: &Sampler) -> Result<String, SweepE
     let panels = if sampler.is_grid() {
         grid_panels(collected, sampler)?
     } else {
-        random_panels(collected)
+        random_panels(collected)?
     };
     let height = TOP + panels.len() as f64 * (PANEL + GAP) + 10.0;
     let mut out = String::new();
@@ -75,99 +86,150 @@ pub fn render(collected: &Collected, sampler: &Sampler) -> Result<String, SweepE
     Ok(out)
 }
 
-fn random_panels(c: &Collected) -> Vec<Panel> {
-    let times: Vec<f64> = c.bounce_time.iter().flatten().map(|t| t * 1e3).collect();
+fn random_panels(c: &Collected) -> Result<Vec<Panel>, SweepError> {
     let mut panels = vec![Panel {
-        title: format!("bounce time ({} closed samples)", times.len()),
+        title: format!(
+            "bounce time ({} closed samples)",
+            c.count(column::BOUNCE_TIME)
+        ),
         x_label: "bounce time (ms)".to_owned(),
         y_label: "samples".to_owned(),
-        content: Content::Bars(histogram(&times)),
+        content: Content::Bars(histogram(c)?),
     }];
     for (p, signal) in c.signals.iter().enumerate() {
-        let edges: Vec<u32> = c.edges[p].iter().flatten().copied().collect();
-        let (lo, hi) = (
-            edges.iter().min().copied().unwrap_or(0),
-            edges.iter().max().copied().unwrap_or(0),
-        );
-        let bars = (lo..=hi)
-            .map(|e| {
-                let n = edges.iter().filter(|&&x| x == e).count() as u64;
-                (f64::from(e) - 0.4, f64::from(e) + 0.4, n)
-            })
-            .collect();
+        let counts = c.edge_counts(p);
+        let bars = match (counts.keys().next(), counts.keys().next_back()) {
+            (Some(&lo), Some(&hi)) => (lo..=hi)
+                .map(|e| {
+                    let n = counts.get(&e).copied().unwrap_or(0);
+                    (f64::from(e) - 0.4, f64::from(e) + 0.4, n)
+                })
+                .collect(),
+            _ => Vec::new(),
+        };
         panels.push(Panel {
             title: format!("{signal}: Schmitt edges"),
             x_label: "edges".to_owned(),
             y_label: "samples".to_owned(),
-            content: Content::Bars(if edges.is_empty() { Vec::new() } else { bars }),
+            content: Content::Bars(bars),
         });
     }
-    panels
+    Ok(panels)
 }
 
-fn histogram(values: &[f64]) -> Vec<(f64, f64, u64)> {
-    let (Some(lo), Some(hi)) = (
-        values.iter().copied().reduce(f64::min),
-        values.iter().copied().reduce(f64::max),
-    ) else {
-        return Vec::new();
+/// [`BINS`] bars of the bounce times, in ms, from the smallest to the
+/// largest.
+fn histogram(c: &Collected) -> Result<Vec<(f64, f64, u64)>, SweepError> {
+    let Some((lo, hi)) = c.range(column::BOUNCE_TIME) else {
+        return Ok(Vec::new());
     };
+    let (lo, hi) = (lo * 1e3, hi * 1e3);
     let width = if hi > lo {
         (hi - lo) / BINS as f64
     } else {
         1e-3
     };
     let mut counts = vec![0u64; BINS];
-    for v in values {
-        let bin = (((v - lo) / width) as usize).min(BINS - 1);
-        counts[bin] += 1;
-    }
-    counts
+    c.for_each_row(|row| {
+        let t = row[column::BOUNCE_TIME];
+        if t.is_finite() {
+            let bin = (((t * 1e3 - lo) / width) as usize).min(BINS - 1);
+            counts[bin] += 1;
+        }
+    })?;
+    Ok(counts
         .iter()
         .enumerate()
         .map(|(i, &n)| (lo + i as f64 * width, lo + (i + 1) as f64 * width, n))
-        .collect()
+        .collect())
 }
 
 fn grid_panels(c: &Collected, sampler: &Sampler) -> Result<Vec<Panel>, SweepError> {
     let keys = sampler.keys();
     let steps = sampler.grid_steps();
-    let inner = steps.get(1).copied().unwrap_or(1) as usize;
-    // Series j: the samples whose second-key position is j.
-    let mut xs = Vec::with_capacity(c.len());
-    let mut series_names = vec![String::new(); inner];
-    for &index in &c.index {
-        let values = sampler.values_vec(index)?;
-        if let Some(&b) = values.get(1) {
-            series_names[(index % inner as u64) as usize] = format!("{} = {b:?}", keys[1]);
-        }
-        xs.push(values[0]);
-    }
-    let lines = |y: &dyn Fn(usize) -> Option<f64>| -> Vec<Series> {
-        let mut out: Vec<Series> = series_names
-            .iter()
-            .map(|n| (n.clone(), Vec::new()))
-            .collect();
-        for (i, &index) in c.index.iter().enumerate() {
-            out[(index % inner as u64) as usize].1.push((xs[i], y(i)));
-        }
-        out
+    let inner = u64::from(steps.get(1).copied().unwrap_or(1));
+    let outer = u64::from(steps.first().copied().unwrap_or(1));
+    // A large grid is drawn thinned to at most MAX_POINTS points: at most
+    // MAX_SERIES lines, each with every `stride`-th value of the first key.
+    let (series_stride, stride) = if c.len() as u64 > MAX_POINTS {
+        let series_stride = inner.div_ceil(MAX_SERIES);
+        let series = inner.div_ceil(series_stride);
+        (series_stride, (outer * series).div_ceil(MAX_POINTS).max(1))
+    } else {
+        (1, 1)
     };
+    let kept = inner.div_ceil(series_stride) as usize;
+    let mut series_names = vec![String::new(); kept];
+    // Per series, per probe (0: the bounce time, 1 + p: probe p's edges).
+    let probes = c.signals.len();
+    let mut lines: Vec<Vec<Points>> = vec![vec![Vec::new(); kept]; 1 + probes];
+    let mut failed = None;
+    c.for_each_row(|row| {
+        let index = row[column::INDEX] as u64;
+        let (a, b) = (index / inner, index % inner);
+        if a % stride != 0 || b % series_stride != 0 || failed.is_some() {
+            return;
+        }
+        let values = match sampler.values_vec(index) {
+            Ok(v) => v,
+            Err(e) => {
+                failed = Some(e);
+                return;
+            }
+        };
+        let s = (b / series_stride) as usize;
+        if let Some(&v) = values.get(1) {
+            series_names[s] = format!("{} = {v:?}", keys[1]);
+        }
+        let value = |x: f64| x.is_finite().then_some(x);
+        lines[0][s].push((values[0], value(row[column::BOUNCE_TIME] * 1e3)));
+        for p in 0..probes {
+            lines[1 + p][s].push((values[0], value(row[column::EDGES + p])));
+        }
+    })?;
+    if let Some(e) = failed {
+        return Err(e);
+    }
+    let thinned = if stride > 1 || series_stride > 1 {
+        format!(" (every {})", thinning(stride, series_stride, keys))
+    } else {
+        String::new()
+    };
+    let named =
+        |points: Vec<Points>| -> Vec<Series> { series_names.iter().cloned().zip(points).collect() };
+    let mut lines = lines.into_iter();
     let mut panels = vec![Panel {
-        title: format!("bounce time against {}", keys[0]),
+        title: format!("bounce time against {}{thinned}", keys[0]),
         x_label: keys[0].clone(),
         y_label: "bounce time (ms)".to_owned(),
-        content: Content::Lines(lines(&|i| c.bounce_time[i].map(|t| t * 1e3))),
+        content: Content::Lines(named(lines.next().unwrap_or_default())),
     }];
-    for (p, signal) in c.signals.iter().enumerate() {
+    for (signal, points) in c.signals.iter().zip(lines) {
         panels.push(Panel {
-            title: format!("{signal}: Schmitt edges against {}", keys[0]),
+            title: format!("{signal}: Schmitt edges against {}{thinned}", keys[0]),
             x_label: keys[0].clone(),
             y_label: "edges".to_owned(),
-            content: Content::Lines(lines(&|i| c.edges[p][i].map(f64::from))),
+            content: Content::Lines(named(points)),
         });
     }
     Ok(panels)
+}
+
+/// "2nd value of a, 4th of b": what a thinned grid plot shows.
+fn thinning(stride: u64, series_stride: u64, keys: &[String]) -> String {
+    let nth = |k: u64| match k {
+        1 => "".to_owned(),
+        2 => "2nd ".to_owned(),
+        3 => "3rd ".to_owned(),
+        k => format!("{k}th "),
+    };
+    let mut parts = vec![format!("{}value of {}", nth(stride), keys[0])];
+    if series_stride > 1 {
+        if let Some(b) = keys.get(1) {
+            parts.push(format!("{}of {b}", nth(series_stride)));
+        }
+    }
+    parts.join(", ")
 }
 
 fn draw(out: &mut String, panel: &Panel, top: f64) {

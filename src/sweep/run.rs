@@ -198,7 +198,7 @@ pub fn run_from(
     let mut collected = Collected::new(sampler.keys().to_vec(), signals);
     progress.start(total);
     for record in &done {
-        collected.add(record);
+        collected.add(record)?;
     }
     progress.advance(first);
 
@@ -257,7 +257,10 @@ pub fn run_from(
                     }
                 }
                 for record in &records {
-                    collected.add(record);
+                    if let Err(e) = collected.add(record) {
+                        stop.store(true, Ordering::Relaxed);
+                        return Err(e);
+                    }
                 }
                 progress.advance(records.len() as u64);
                 expected += 1;

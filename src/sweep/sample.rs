@@ -38,9 +38,9 @@ use super::error::SweepError;
 pub const DEFAULT_SAMPLES: u64 = 100;
 
 /// The most samples one sweep runs: a hundred million (about ten minutes
-/// and 15 GB of CSV for the mechanics alone; the summary keeps about 50
-/// bytes per sample in memory, 5 GB at the cap). Larger studies are
-/// several sweeps.
+/// and 15 GB of CSV for the mechanics alone; the summary keeps 48 bytes
+/// per sample, plus 16 per probe, in a temporary file, 5 GB at the cap,
+/// and a few megabytes of memory). Larger studies are several sweeps.
 pub const MAX_SAMPLES: u64 = 100_000_000;
 
 /// The seed when neither the scenario nor the caller says.

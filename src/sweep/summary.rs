@@ -2,13 +2,15 @@
 //! bounce times and probe edges and peaks (min, median, p95, max, mean),
 //! the worst sample and its values, and how many samples failed.
 //!
-//! [`Collected`] keeps a few numbers per sample as rows are written (not
-//! the rows themselves), in index order; [`Collected::summary`] reduces
-//! them. Quantiles are nearest-rank: the p-quantile of n sorted values is
-//! the value at rank ⌈p·n⌉, so it is always one of the samples. The worst
-//! sample is the one with the highest (could not run, failed a limit, did
-//! not end closed, edges over all probes, bounce time), the lowest index
-//! on a tie: a sample that errored outranks any that ran.
+//! [`Collected`] takes each sample as its row is written (not the rows
+//! themselves): counts, sums and the worst sample as it goes, and a few
+//! numbers per sample in a [`Spill`] (bounded memory, a temporary file
+//! beyond it) for the quantiles and the plot; [`Collected::summary`]
+//! reduces them. Quantiles are nearest-rank: the p-quantile of n sorted
+//! values is the value at rank ⌈p·n⌉, so it is always one of the samples.
+//! The worst sample is the one with the highest (could not run, failed a
+//! limit, did not end closed, edges over all probes, bounce time), the
+//! lowest index on a tie: a sample that errored outranks any that ran.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -21,6 +23,7 @@ use crate::report::units::prefix;
 use super::error::SweepError;
 use super::record::SampleRecord;
 use super::sample::Sampler;
+use super::spill::Spill;
 use super::verdict::SampleVerdict;
 
 /// How bad a sample is, compared field by field: (could not run, failed a
@@ -30,70 +33,167 @@ type Badness = (bool, bool, bool, u64, f64);
 /// How many error messages the summary quotes.
 const QUOTED_ERRORS: usize = 5;
 
-/// Per-sample numbers for the summary and the plot, in index order.
-#[derive(Debug, Clone, PartialEq, Default)]
+/// The columns of a sample's row in the spill; a missing value is NaN.
+pub(super) mod column {
+    /// The sample's index in the sweep.
+    pub const INDEX: usize = 0;
+    /// Openings after the first make.
+    pub const BOUNCES: usize = 1;
+    /// s
+    pub const BOUNCE_TIME: usize = 2;
+    /// s
+    pub const SETTLE_TIME: usize = 3;
+    /// s
+    pub const RELEASE_TIME: usize = 4;
+    /// J
+    pub const ARC_ENERGY: usize = 5;
+    /// Probe `p`'s edges are at `EDGES + p`, its peak at `EDGES + probes + p`.
+    pub const EDGES: usize = 6;
+}
+
+/// Running count, sum, min and max of a column's finite values.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Moments {
+    count: u64,
+    sum: f64,
+    min: f64,
+    max: f64,
+}
+
+impl Moments {
+    const NONE: Moments = Moments {
+        count: 0,
+        sum: 0.0,
+        min: f64::INFINITY,
+        max: f64::NEG_INFINITY,
+    };
+
+    fn add(&mut self, x: f64) {
+        if !x.is_finite() {
+            return;
+        }
+        self.count += 1;
+        self.sum += x;
+        // total_cmp: -0 below +0, as a sort puts them.
+        if x.total_cmp(&self.min).is_lt() {
+            self.min = x;
+        }
+        if x.total_cmp(&self.max).is_gt() {
+            self.max = x;
+        }
+    }
+}
+
+/// The worst sample so far, with what the summary quotes of it.
+#[derive(Debug, Clone, PartialEq)]
+struct WorstSoFar {
+    badness: Badness,
+    index: u64,
+    outcome: Option<Outcome>,
+    bounce_count: Option<u32>,
+    bounce_time: Option<f64>,
+    edges: Vec<Option<u32>>,
+    verdict: SampleVerdict,
+}
+
+/// What a sweep's samples gave, for the summary and the plot, taken in
+/// index order.
+#[derive(Debug)]
 pub struct Collected {
     /// The varied keys, in [`Sampler::keys`] order.
     pub keys: Vec<String>,
     /// The probes' signals, in `[[probe]]` order; empty for a
     /// mechanics-only sweep.
     pub signals: Vec<String>,
-    /// Each sample's index in the sweep.
-    pub index: Vec<u64>,
-    /// Each sample's chatter outcome; `None` when it failed before the
-    /// mechanics ran.
-    pub outcome: Vec<Option<Outcome>>,
-    /// Each sample's openings after the first make.
-    pub bounce_count: Vec<Option<u32>>,
-    /// s
-    pub bounce_time: Vec<Option<f64>>,
-    /// s
-    pub settle_time: Vec<Option<f64>>,
-    /// s, a coil-driven relay's longest release time.
-    pub release_time: Vec<Option<f64>>,
-    /// J, with `[arc]`: all arcs of the sample.
-    pub arc_energy: Vec<Option<f64>>,
-    /// `[probe][sample]`
-    pub edges: Vec<Vec<Option<u32>>>,
-    /// `[probe][sample]`, max |value|.
-    pub peak: Vec<Vec<Option<f64>>>,
-    /// Each sample's verdict.
-    pub verdict: Vec<SampleVerdict>,
+    /// Per sample, the [`column`]s.
+    rows: Spill,
+    moments: Vec<Moments>,
+    outcomes: BTreeMap<&'static str, u64>,
+    verdicts: BTreeMap<&'static str, u64>,
+    /// Samples per number of edges, per probe.
+    edge_counts: Vec<BTreeMap<u32, u64>>,
+    worst: Option<WorstSoFar>,
     /// Samples that failed each limit, by limit key.
-    pub failed_limits: BTreeMap<String, u64>,
+    failed_limits: BTreeMap<String, u64>,
     /// The first errors, with their sample index.
-    pub first_errors: Vec<(u64, String)>,
+    first_errors: Vec<(u64, String)>,
 }
 
 impl Collected {
     /// Nothing yet, for a sweep of `keys` with probes `signals`.
     pub fn new(keys: Vec<String>, signals: Vec<String>) -> Collected {
-        let n = signals.len();
+        let width = column::EDGES + 2 * signals.len();
         Collected {
+            rows: Spill::new(width),
+            moments: vec![Moments::NONE; width],
+            edge_counts: vec![BTreeMap::new(); signals.len()],
             keys,
             signals,
-            edges: vec![Vec::new(); n],
-            peak: vec![Vec::new(); n],
-            ..Collected::default()
+            outcomes: BTreeMap::new(),
+            verdicts: BTreeMap::new(),
+            worst: None,
+            failed_limits: BTreeMap::new(),
+            first_errors: Vec::new(),
         }
     }
 
-    /// Add the next sample.
-    pub fn add(&mut self, r: &SampleRecord) {
-        self.index.push(r.index);
-        self.outcome.push(r.outcome);
-        self.bounce_count
-            .push(r.bounce_count.map(|n| u32::try_from(n).unwrap_or(u32::MAX)));
-        self.bounce_time.push(r.bounce_time);
-        self.settle_time.push(r.settle_time);
-        self.release_time.push(r.release_time);
-        self.arc_energy.push(r.arc_energy);
-        for (p, (edges, peak)) in self.edges.iter_mut().zip(&mut self.peak).enumerate() {
-            let probe = r.probes.get(p);
-            edges.push(probe.map(|x| u32::try_from(x.edges).unwrap_or(u32::MAX)));
-            peak.push(probe.map(|x| x.peak));
+    /// Add the next sample; an error when its numbers cannot be kept (the
+    /// temporary file cannot be written).
+    pub fn add(&mut self, r: &SampleRecord) -> Result<(), SweepError> {
+        let probes = self.signals.len();
+        let count = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
+        let edges: Vec<Option<u32>> = (0..probes)
+            .map(|p| r.probes.get(p).map(|x| count(x.edges)))
+            .collect();
+        let bounce_count = r.bounce_count.map(count);
+        let mut row = vec![f64::NAN; self.rows.width()];
+        row[column::INDEX] = r.index as f64;
+        row[column::BOUNCES] = bounce_count.map_or(f64::NAN, f64::from);
+        row[column::BOUNCE_TIME] = r.bounce_time.unwrap_or(f64::NAN);
+        row[column::SETTLE_TIME] = r.settle_time.unwrap_or(f64::NAN);
+        row[column::RELEASE_TIME] = r.release_time.unwrap_or(f64::NAN);
+        row[column::ARC_ENERGY] = r.arc_energy.unwrap_or(f64::NAN);
+        for p in 0..probes {
+            row[column::EDGES + p] = edges[p].map_or(f64::NAN, f64::from);
+            row[column::EDGES + probes + p] = r.probes.get(p).map_or(f64::NAN, |x| x.peak);
+            if let Some(e) = edges[p] {
+                *self.edge_counts[p].entry(e).or_insert(0) += 1;
+            }
         }
-        self.verdict.push(r.verdict);
+        for (m, &x) in self.moments.iter_mut().zip(&row).skip(column::BOUNCES) {
+            m.add(x);
+        }
+        self.rows.push(&row).map_err(SweepError::Scratch)?;
+        *self
+            .outcomes
+            .entry(r.outcome.map_or("none", Outcome::as_str))
+            .or_insert(0) += 1;
+        *self.verdicts.entry(r.verdict.as_str()).or_insert(0) += 1;
+        let badness = (
+            r.verdict == SampleVerdict::Error,
+            r.verdict == SampleVerdict::Fail,
+            !r.outcome.is_some_and(Outcome::is_closed),
+            edges.iter().map(|e| u64::from(e.unwrap_or(0))).sum(),
+            r.bounce_time.unwrap_or(0.0),
+        );
+        let worse = self.worst.as_ref().is_none_or(|w| {
+            let b = &w.badness;
+            (badness.0, badness.1, badness.2, badness.3)
+                .cmp(&(b.0, b.1, b.2, b.3))
+                .then(badness.4.total_cmp(&b.4))
+                .is_gt()
+        });
+        if worse {
+            self.worst = Some(WorstSoFar {
+                badness,
+                index: r.index,
+                outcome: r.outcome,
+                bounce_count,
+                bounce_time: r.bounce_time,
+                edges,
+                verdict: r.verdict,
+            });
+        }
         for key in &r.failed_limits {
             *self.failed_limits.entry(key.clone()).or_insert(0) += 1;
         }
@@ -102,16 +202,38 @@ impl Collected {
                 self.first_errors.push((r.index, e.clone()));
             }
         }
+        Ok(())
     }
 
     /// Samples collected.
     pub fn len(&self) -> usize {
-        self.index.len()
+        self.rows.len() as usize
     }
 
     /// Whether none were.
     pub fn is_empty(&self) -> bool {
-        self.index.is_empty()
+        self.rows.is_empty()
+    }
+
+    /// Call `f` with each sample's [`column`]s, in index order.
+    pub(super) fn for_each_row(&self, f: impl FnMut(&[f64])) -> Result<(), SweepError> {
+        self.rows.for_each(f).map_err(SweepError::Scratch)
+    }
+
+    /// How many samples have a finite value in `column`.
+    pub(super) fn count(&self, column: usize) -> u64 {
+        self.moments[column].count
+    }
+
+    /// The smallest and largest finite value in `column`, if any.
+    pub(super) fn range(&self, column: usize) -> Option<(f64, f64)> {
+        let m = &self.moments[column];
+        (m.count > 0).then_some((m.min, m.max))
+    }
+
+    /// Samples per number of edges of probe `p`.
+    pub(super) fn edge_counts(&self, p: usize) -> &BTreeMap<u32, u64> {
+        &self.edge_counts[p]
     }
 
     /// The summary; `sampler` gives the worst sample's values.
@@ -130,42 +252,20 @@ impl Collected {
         values: impl Fn(u64) -> Result<Vec<f64>, SweepError>,
     ) -> Result<Summary, SweepError> {
         let n = self.len() as u64;
-        let mut outcomes = BTreeMap::new();
-        for o in &self.outcome {
-            *outcomes
-                .entry(o.map_or("none", Outcome::as_str))
-                .or_insert(0) += 1;
-        }
-        let mut verdicts = BTreeMap::new();
-        for v in &self.verdict {
-            *verdicts.entry(v.as_str()).or_insert(0) += 1;
-        }
-        let count = |v: SampleVerdict| self.verdict.iter().filter(|&&x| x == v).count() as u64;
+        let distributions = self.distributions()?;
+        let count = |v: SampleVerdict| self.verdicts.get(v.as_str()).copied().unwrap_or(0);
         let (failing, errors) = (count(SampleVerdict::Fail), count(SampleVerdict::Error));
-        let probes = self
-            .signals
-            .iter()
-            .enumerate()
-            .map(|(p, signal)| ProbeSummary {
-                signal: signal.clone(),
-                edges: Distribution::of(self.edges[p].iter().flatten().map(|&e| f64::from(e))),
-                peak: Distribution::of(self.peak[p].iter().flatten().copied()),
-            })
-            .collect();
-        let worst = match self.worst() {
-            Some(i) => {
-                let index = self.index[i];
-                let values = values(index)?;
-                Some(Worst {
-                    index,
-                    outcome: self.outcome[i].map(Outcome::as_str),
-                    bounce_count: self.bounce_count[i],
-                    bounce_time: self.bounce_time[i],
-                    edges: self.edges.iter().map(|e| e[i]).collect(),
-                    values: self.keys.iter().cloned().zip(values).collect(),
-                    verdict: self.verdict[i].as_str(),
-                })
-            }
+        let probes = self.signals.len();
+        let worst = match &self.worst {
+            Some(w) => Some(Worst {
+                index: w.index,
+                outcome: w.outcome.map(Outcome::as_str),
+                bounce_count: w.bounce_count,
+                bounce_time: w.bounce_time,
+                edges: w.edges.clone(),
+                values: self.keys.iter().cloned().zip(values(w.index)?).collect(),
+                verdict: w.verdict.as_str(),
+            }),
             None => None,
         };
         Ok(Summary {
@@ -173,8 +273,8 @@ impl Collected {
             kind: if grid { "grid" } else { "random" },
             seed,
             keys: self.keys.clone(),
-            outcomes,
-            verdicts,
+            outcomes: self.outcomes.clone(),
+            verdicts: self.verdicts.clone(),
             failing,
             errors,
             limits: self
@@ -190,14 +290,21 @@ impl Collected {
             } else {
                 (failing + errors) as f64 / n as f64
             },
-            bounce_count: Distribution::of(
-                self.bounce_count.iter().flatten().map(|&b| f64::from(b)),
-            ),
-            bounce_time: Distribution::of(self.bounce_time.iter().flatten().copied()),
-            settle_time: Distribution::of(self.settle_time.iter().flatten().copied()),
-            release_time: Distribution::of(self.release_time.iter().flatten().copied()),
-            arc_energy: Distribution::of(self.arc_energy.iter().flatten().copied()),
-            probes,
+            bounce_count: distributions[column::BOUNCES],
+            bounce_time: distributions[column::BOUNCE_TIME],
+            settle_time: distributions[column::SETTLE_TIME],
+            release_time: distributions[column::RELEASE_TIME],
+            arc_energy: distributions[column::ARC_ENERGY],
+            probes: self
+                .signals
+                .iter()
+                .enumerate()
+                .map(|(p, signal)| ProbeSummary {
+                    signal: signal.clone(),
+                    edges: distributions[column::EDGES + p],
+                    peak: distributions[column::EDGES + probes + p],
+                })
+                .collect(),
             worst,
             first_errors: self
                 .first_errors
@@ -211,37 +318,43 @@ impl Collected {
         })
     }
 
-    /// The position of the worst sample (see the module overview).
-    fn worst(&self) -> Option<usize> {
-        let key = |i: usize| {
-            let edges: u64 = self
-                .edges
-                .iter()
-                .map(|e| u64::from(e[i].unwrap_or(0)))
-                .sum();
-            (
-                self.verdict[i] == SampleVerdict::Error,
-                self.verdict[i] == SampleVerdict::Fail,
-                !self.outcome[i].is_some_and(Outcome::is_closed),
-                edges,
-                self.bounce_time[i].unwrap_or(0.0),
-            )
-        };
-        let mut best: Option<(usize, Badness)> = None;
-        for i in 0..self.len() {
-            let k = key(i);
-            let better = best.as_ref().is_none_or(|(_, b)| {
-                (k.0, k.1, k.2, k.3)
-                    .cmp(&(b.0, b.1, b.2, b.3))
-                    .then(k.4.total_cmp(&b.4))
-                    == std::cmp::Ordering::Greater
-            });
-            if better {
-                best = Some((i, k));
+    /// Each column's distribution (`None` for the index and for a column
+    /// without values).
+    fn distributions(&self) -> Result<Vec<Option<Distribution>>, SweepError> {
+        let counts: Vec<u64> = self.moments.iter().map(|m| m.count).collect();
+        let mut wanted = Vec::new();
+        for (c, &count) in counts.iter().enumerate().skip(column::BOUNCES) {
+            if count > 0 {
+                wanted.push((c, nearest_rank(0.5, count)));
+                wanted.push((c, nearest_rank(0.95, count)));
             }
         }
-        best.map(|(i, _)| i)
+        let found = self
+            .rows
+            .quantiles(&counts, &wanted)
+            .map_err(SweepError::Scratch)?;
+        let mut out = vec![None; counts.len()];
+        for (pair, ranks) in found.chunks_exact(2).zip(wanted.chunks_exact(2)) {
+            let c = ranks[0].0;
+            let m = &self.moments[c];
+            if let [Some(median), Some(p95)] = *pair {
+                out[c] = Some(Distribution {
+                    count: m.count,
+                    min: m.min,
+                    median,
+                    p95,
+                    max: m.max,
+                    mean: m.sum / m.count as f64,
+                });
+            }
+        }
+        Ok(out)
     }
+}
+
+/// The 1-based nearest rank of the p-quantile of `n` values, ⌈p·n⌉.
+fn nearest_rank(p: f64, n: u64) -> u64 {
+    ((p * n as f64).ceil() as u64).clamp(1, n)
 }
 
 /// min, median, p95, max and mean of some samples' values.
@@ -270,7 +383,7 @@ impl Distribution {
         }
         let mean = v.iter().sum::<f64>() / v.len() as f64;
         v.sort_by(f64::total_cmp);
-        let rank = |p: f64| v[((p * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1];
+        let rank = |p: f64| v[(nearest_rank(p, v.len() as u64) - 1) as usize];
         Some(Distribution {
             count: v.len() as u64,
             min: v[0],
@@ -527,6 +640,7 @@ fn eng(value: f64, unit: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sweep::ProbeRecord;
 
     #[test]
     fn nearest_rank_quantiles() {
@@ -536,6 +650,109 @@ mod tests {
         let one = Distribution::of([3.0].into_iter()).unwrap();
         assert_eq!((one.median, one.p95), (3.0, 3.0));
         assert!(Distribution::of(std::iter::empty()).is_none());
+    }
+
+    /// A sample with numbers from `i`, some missing, some failing.
+    fn record(i: u64) -> SampleRecord {
+        let u = ((i.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 11) as f64) / (1u64 << 53) as f64;
+        let closed = i % 17 != 3;
+        SampleRecord {
+            index: i,
+            values: vec![u],
+            outcome: Some(if closed {
+                Outcome::Stuck
+            } else {
+                Outcome::EndOfTime
+            }),
+            bounce_count: Some((i % 9) as usize),
+            first_impact: Some(1e-3),
+            settle_time: closed.then_some(1e-3 + u * 1e-3),
+            bounce_time: closed.then_some(u * 1e-3),
+            release_time: None,
+            nc_bounce_time: None,
+            arc_count: None,
+            arc_energy: (i % 5 == 0).then_some(-u),
+            breakdowns: None,
+            probes: vec![ProbeRecord {
+                edges: (i % 13) as usize,
+                peak: 3.0 + u,
+                ideal_edges: None,
+                lockout: None,
+                stable_for: None,
+            }],
+            verdict: if i % 11 == 0 {
+                SampleVerdict::Fail
+            } else {
+                SampleVerdict::Pass
+            },
+            failed_limits: if i % 11 == 0 {
+                vec!["max_bounces".to_owned()]
+            } else {
+                Vec::new()
+            },
+            error: None,
+        }
+    }
+
+    #[test]
+    fn a_summary_beyond_memory_is_the_summary_of_every_value() {
+        // More samples than stay in memory: the quantiles come from the
+        // temporary file, and must be those of sorting every value.
+        let n = 3 * super::super::spill::RESIDENT_ROWS as u64 + 7;
+        let mut c = Collected::new(vec!["k".to_owned()], vec!["v(out)".to_owned()]);
+        let records: Vec<SampleRecord> = (0..n).map(record).collect();
+        for r in &records {
+            c.add(r).unwrap();
+        }
+        let s = c
+            .summary_with(false, Some(1), |i| Ok(records[i as usize].values.clone()))
+            .unwrap();
+        let of = |f: &dyn Fn(&SampleRecord) -> Option<f64>| {
+            Distribution::of(records.iter().filter_map(f))
+        };
+        assert_eq!(s.samples, n);
+        assert_eq!(s.bounce_time, of(&|r| r.bounce_time));
+        assert_eq!(s.settle_time, of(&|r| r.settle_time));
+        assert_eq!(s.arc_energy, of(&|r| r.arc_energy));
+        assert_eq!(s.bounce_count, of(&|r| r.bounce_count.map(|b| b as f64)));
+        assert_eq!(s.release_time, None);
+        assert_eq!(s.probes[0].edges, of(&|r| Some(r.probes[0].edges as f64)));
+        assert_eq!(s.probes[0].peak, of(&|r| Some(r.probes[0].peak)));
+        // The worst: failing first, then not closed, then edges, then
+        // bounce time; the lowest index on a tie.
+        let worst = (0..n as usize)
+            .max_by(|&a, &b| {
+                let key = |r: &SampleRecord| {
+                    (
+                        r.verdict == SampleVerdict::Fail,
+                        !r.closed(),
+                        r.probes[0].edges,
+                    )
+                };
+                key(&records[a])
+                    .cmp(&key(&records[b]))
+                    .then(
+                        records[a]
+                            .bounce_time
+                            .unwrap_or(0.0)
+                            .total_cmp(&records[b].bounce_time.unwrap_or(0.0)),
+                    )
+                    .then(b.cmp(&a))
+            })
+            .unwrap();
+        assert_eq!(s.worst.as_ref().map(|w| w.index), Some(worst as u64));
+        assert_eq!(
+            s.failing,
+            records
+                .iter()
+                .filter(|r| r.verdict == SampleVerdict::Fail)
+                .count() as u64
+        );
+        assert_eq!(s.limits["max_bounces"].failing, s.failing);
+        assert_eq!(
+            s.outcomes["end_of_time"],
+            records.iter().filter(|r| !r.closed()).count() as u64
+        );
     }
 
     #[test]
