@@ -210,6 +210,32 @@ impl Staged {
         })
     }
 
+    /// [`Staged::with_name`] continuing the temporary file `partial` that
+    /// a stopped run left: its first `keep` bytes stay, the rest is cut,
+    /// and writing goes on after them.
+    pub fn continuing(
+        target: &Path,
+        partial: &Path,
+        keep: u64,
+        overwrite: bool,
+    ) -> Result<Staged, WriteError> {
+        check_target(target, overwrite)?;
+        let mut file = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(partial)
+            .map_err(io_error(partial))?;
+        file.set_len(keep)
+            .and_then(|()| std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0)))
+            .map_err(io_error(partial))?;
+        let path = tempfile::TempPath::try_from_path(partial).map_err(io_error(partial))?;
+        Ok(Staged {
+            tmp: tempfile::NamedTempFile::from_parts(file, path),
+            target: target.to_owned(),
+            overwrite,
+        })
+    }
+
     /// The file to write to.
     pub fn file(&mut self) -> &mut File {
         self.tmp.as_file_mut()

@@ -13,7 +13,6 @@
 //! Existing files of a sweep are an error unless `force`; the same
 //! files are the place a resume continues from.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use thiserror::Error;
@@ -226,14 +225,17 @@ pub fn write(
     let kept = if to.resume {
         resume::check_meta(&from_meta, &identity)?;
         let (header, signals, columns) = super::run::layout(scenario, sampler, options)?;
-        Some(resume::finished_rows(
+        let mut done = super::summary::Collected::new(sampler.keys().to_vec(), signals.clone());
+        let end = resume::finished_rows(
             &from_csv,
             &header,
             sampler.keys().len(),
             signals.len(),
             columns,
             options.shard,
-        )?)
+            |record| done.add(&record).map_err(FilesError::from),
+        )?;
+        Some((end, done))
     } else {
         if partial_csv.exists() {
             note(&Note::ReplacingPartial {
@@ -243,7 +245,16 @@ pub fn write(
         }
         None
     };
-    let mut staged = Staged::with_name(&csv_path, &partial_csv, to.force || to.resume)?;
+    // Resuming from the partial CSV continues it in place; from a CSV
+    // elsewhere, its finished rows are copied first (below).
+    let in_place = kept
+        .as_ref()
+        .filter(|_| from_csv == partial_csv)
+        .map(|k| k.0);
+    let mut staged = match in_place {
+        Some(end) => Staged::continuing(&csv_path, &partial_csv, end, true)?,
+        None => Staged::with_name(&csv_path, &partial_csv, to.force || to.resume)?,
+    };
     let partial_meta_text = Meta {
         identity: identity.clone(),
         complete: false,
@@ -260,19 +271,32 @@ pub fn write(
     let _partial_meta =
         tempfile::TempPath::try_from_path(&partial_meta).map_err(cannot_write(&partial_meta))?;
     let done = match kept {
-        Some((bytes, done)) => {
-            staged
-                .file()
-                .write_all(&bytes)
-                .map_err(cannot_write(&partial_csv))?;
+        Some((end, done)) => {
+            if in_place.is_none() {
+                // The header and the finished rows, copied as they are.
+                let copied = crate::input::open_regular(&from_csv).and_then(|file| {
+                    std::io::copy(&mut std::io::Read::take(file, end), staged.file())
+                });
+                match copied {
+                    Ok(n) if n == end => {}
+                    Ok(_) => {
+                        return Err(cannot_write(&partial_csv)(std::io::Error::new(
+                            std::io::ErrorKind::UnexpectedEof,
+                            format!("{} was cut while it was copied", from_csv.display()),
+                        ))
+                        .into());
+                    }
+                    Err(e) => return Err(cannot_write(&partial_csv)(e).into()),
+                }
+            }
             note(&Note::Resuming {
                 from: from_csv.clone(),
                 done: done.len() as u64,
                 total: options.shard.len(sampler.count()),
             });
-            done
+            Some(done)
         }
-        None => Vec::new(),
+        None => None,
     };
     let stop = Stop {
         partial_csv: partial_csv.clone(),

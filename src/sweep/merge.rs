@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use csv::ReaderBuilder;
 use thiserror::Error;
 
+use super::error::SweepError;
 use super::table::{
     ARC_COLUMNS, Columns, MergeError, MergeReport, OUTCOME_COLUMNS, RELEASE_COLUMNS, merge,
 };
@@ -121,37 +122,42 @@ fn write_merged_summary(
     verified: &'static str,
     overwrite: bool,
 ) -> Result<(), MergeFilesError> {
-    let bytes =
-        crate::input::read_limited(output, u64::MAX).map_err(|source| MergeFilesError::Output {
+    // The header only: the rows are read one at a time below.
+    let mut header = Vec::new();
+    crate::input::open_regular(output)
+        .and_then(|file| {
+            std::io::BufRead::read_until(&mut std::io::BufReader::new(file), b'\n', &mut header)
+        })
+        .map_err(|source| MergeFilesError::Output {
             path: output.to_owned(),
             source,
         })?;
-    let header_len = bytes
-        .iter()
-        .position(|&b| b == b'\n')
-        .map_or(bytes.len(), |i| i + 1);
-    let header = &bytes[..header_len];
+    let header = &header[..];
     let Some((keys, signals, columns)) = layout_of(header) else {
         return Ok(());
     };
-    let records = super::resume::all_rows(output, header, keys.len(), signals.len(), columns)?;
-    let mut collected = super::summary::Collected::new(keys, signals);
-    for r in &records {
-        collected
-            .add(r)
-            .map_err(|e| MergeFilesError::Summary(e.to_string()))?;
-    }
+    let summary_error = |e: SweepError| MergeFilesError::Summary(e.to_string());
+    let mut collected = super::summary::Collected::new(keys.clone(), signals.clone());
+    super::resume::all_rows(output, header, keys.len(), signals.len(), columns, |r| {
+        collected.add(&r).map_err(summary_error)
+    })?;
     let seed = identity.as_ref().and_then(|i| i.seed);
     let grid = identity.as_ref().is_some_and(|i| i.seed.is_none());
-    let mut summary = collected
-        .summary_with(grid, seed, |index| {
-            Ok(records
-                .iter()
-                .find(|r| r.index == index)
-                .map(|r| r.values.clone())
-                .unwrap_or_default())
+    // The worst sample's values: a second pass over the rows.
+    let values_of = |index: u64| -> Result<Vec<f64>, SweepError> {
+        let mut found = None;
+        super::resume::all_rows(output, header, keys.len(), signals.len(), columns, |r| {
+            if found.is_none() && r.index == index {
+                found = Some(r.values);
+            }
+            Ok::<_, super::resume::ResumeError>(())
         })
-        .map_err(|e| MergeFilesError::Summary(e.to_string()))?;
+        .map_err(|e| SweepError::Write(std::io::Error::other(e.to_string())))?;
+        Ok(found.unwrap_or_default())
+    };
+    let mut summary = collected
+        .summary_with(grid, seed, values_of)
+        .map_err(summary_error)?;
     summary.identity = Some(verified);
     let path = output.with_file_name("summary.json");
     crate::output::write_new_file(&path, summary.to_json().as_bytes(), overwrite)?;

@@ -14,6 +14,8 @@
 //! sweep, reads its rows back ([`finished_rows`]) and runs the rest, to
 //! the same files an uninterrupted run writes.
 
+use std::fs::File;
+use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
 use csv::{ByteRecord, ReaderBuilder};
@@ -247,73 +249,87 @@ pub fn check_meta(path: &Path, ours: &Identity) -> Result<Meta, ResumeError> {
     Ok(meta)
 }
 
-/// The finished rows of an interrupted sweep CSV: its bytes up to the last
-/// whole row that continues the sequence of `shard`'s samples, and those
-/// rows as records. `header` is the header this sweep writes; `keys` and
-/// `probes` its widths; `columns` its optional columns.
-pub fn finished_rows(
+/// The finished rows of an interrupted sweep CSV, read as a stream: each
+/// whole row that continues the sequence of `shard`'s samples goes to
+/// `each`, in file order. Returns the length of the file's header and
+/// those rows, in bytes (what a resumed sweep keeps). `header` is the
+/// header this sweep writes; `keys` and `probes` its widths; `columns` its
+/// optional columns.
+pub fn finished_rows<E: From<ResumeError>>(
     path: &Path,
     header: &[u8],
     keys: usize,
     signals: usize,
     columns: super::table::Columns,
     shard: Shard,
-) -> Result<(Vec<u8>, Vec<SampleRecord>), ResumeError> {
-    read_rows(path, header, keys, signals, columns, Some(shard))
+    each: impl FnMut(SampleRecord) -> Result<(), E>,
+) -> Result<u64, E> {
+    read_rows(path, header, keys, signals, columns, Some(shard), each)
 }
 
-/// Every whole row of sweep CSV `path`, in file order, whatever their
-/// indices (a merge that allowed missing samples).
-pub fn all_rows(
+/// Every whole row of sweep CSV `path` to `each`, in file order, whatever
+/// their indices (a merge that allowed missing samples).
+pub fn all_rows<E: From<ResumeError>>(
     path: &Path,
     header: &[u8],
     keys: usize,
     signals: usize,
     columns: super::table::Columns,
-) -> Result<Vec<SampleRecord>, ResumeError> {
-    read_rows(path, header, keys, signals, columns, None).map(|(_, records)| records)
+    each: impl FnMut(SampleRecord) -> Result<(), E>,
+) -> Result<u64, E> {
+    read_rows(path, header, keys, signals, columns, None, each)
 }
 
-/// The rows of `path`; with `shard`, only while they continue its
-/// sequence of samples.
-fn read_rows(
+/// The rows of `path`, one at a time, a buffer's worth in memory; with
+/// `shard`, only while they continue its sequence of samples.
+fn read_rows<E: From<ResumeError>>(
     path: &Path,
     header: &[u8],
     keys: usize,
     signals: usize,
     columns: super::table::Columns,
     shard: Option<Shard>,
-) -> Result<(Vec<u8>, Vec<SampleRecord>), ResumeError> {
-    let bytes =
-        crate::input::read_limited(path, u64::MAX).map_err(|source| ResumeError::ReadCsv {
-            path: path.to_owned(),
-            source,
-        })?;
+    mut each: impl FnMut(SampleRecord) -> Result<(), E>,
+) -> Result<u64, E> {
+    let cannot = |source| ResumeError::ReadCsv {
+        path: path.to_owned(),
+        source,
+    };
     let bad = |line: u64, problem: String| ResumeError::BadRow {
         path: path.to_owned(),
         line,
         problem,
     };
-    if !bytes.starts_with(header) {
+    let mut file = crate::input::open_regular(path).map_err(cannot)?;
+    let mut start = Vec::with_capacity(header.len());
+    (&mut file)
+        .take(header.len() as u64)
+        .read_to_end(&mut start)
+        .map_err(cannot)?;
+    if start != header {
         return Err(bad(
             1,
             "its header is not the one this sweep writes (other keys, probes or options)".into(),
-        ));
+        )
+        .into());
     }
     // Only whole lines: a row cut by the stop is run again.
-    let whole = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
-    let body = &bytes[header.len()..whole.max(header.len())];
+    let whole = last_newline_end(&mut file).map_err(cannot)?;
+    file.seek(SeekFrom::Start(header.len() as u64))
+        .map_err(cannot)?;
+    let body =
+        BufReader::with_capacity(1 << 16, file).take(whole.saturating_sub(header.len() as u64));
     let mut reader = ReaderBuilder::new().has_headers(false).from_reader(body);
     let width = super::table::width(keys, signals, columns);
-    let mut records = Vec::new();
     let mut row = ByteRecord::new();
-    let mut end = header.len();
+    let mut end = header.len() as u64;
     let mut line = 1;
+    let mut rows = 0;
     loop {
         match reader.read_byte_record(&mut row) {
             Ok(false) => break,
             Ok(true) => {}
-            Err(e) => return Err(bad(line + 1, e.to_string())),
+            Err(e) => return Err(bad(line + 1, e.to_string()).into()),
         }
         line += 1;
         if row.len() != width {
@@ -322,18 +338,39 @@ fn read_rows(
         }
         let record = parse_row(&row, keys, signals, columns).map_err(|p| bad(line, p))?;
         if let Some(shard) = shard {
-            let expected = shard.sample(records.len() as u64);
+            let expected = shard.sample(rows);
             if record.index != expected {
                 return Err(bad(
                     line,
                     format!("sample {} where {expected} was due", record.index),
-                ));
+                )
+                .into());
             }
         }
-        records.push(record);
-        end = header.len() + reader.position().byte() as usize;
+        each(record)?;
+        rows += 1;
+        end = header.len() as u64 + reader.position().byte();
     }
-    Ok((bytes[..end].to_vec(), records))
+    Ok(end)
+}
+
+/// The length of `file` up to and including its last newline (0 without
+/// one), read from its end backwards.
+fn last_newline_end(file: &mut File) -> std::io::Result<u64> {
+    let len = file.seek(SeekFrom::End(0))?;
+    let mut block = vec![0u8; 1 << 16];
+    let mut to = len;
+    while to > 0 {
+        let from = to.saturating_sub(block.len() as u64);
+        let chunk = &mut block[..(to - from) as usize];
+        file.seek(SeekFrom::Start(from))?;
+        file.read_exact(chunk)?;
+        if let Some(i) = chunk.iter().rposition(|&b| b == b'\n') {
+            return Ok(from + i as u64 + 1);
+        }
+        to = from;
+    }
+    Ok(0)
 }
 
 /// The record of a row that [`super::table::rows`] wrote.
@@ -509,16 +546,24 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("sweep.csv");
         std::fs::write(&path, &bytes).unwrap();
-        let (kept, back) = finished_rows(&path, &header, 2, 1, columns, Shard::WHOLE).unwrap();
+        let mut back = Vec::new();
+        let kept = finished_rows(&path, &header, 2, 1, columns, Shard::WHOLE, |r| {
+            back.push(r);
+            Ok::<_, ResumeError>(())
+        })
+        .unwrap();
         assert_eq!(back, records);
-        assert_eq!(kept, bytes[..whole]);
+        assert_eq!(kept, whole as u64);
         truncate_to_whole_lines(&path).unwrap();
         assert_eq!(std::fs::read(&path).unwrap(), bytes[..whole]);
         assert_eq!(row_count(&bytes[..whole]), 3);
 
         // Rows of another shard's sequence are not this sweep's.
         let shard: Shard = "2/3".parse().unwrap();
-        let err = finished_rows(&path, &header, 2, 1, columns, shard).unwrap_err();
+        let err = finished_rows(&path, &header, 2, 1, columns, shard, |_| {
+            Ok::<_, ResumeError>(())
+        })
+        .unwrap_err();
         assert!(
             err.to_string().contains("sample 0 where 1 was due"),
             "{err}"

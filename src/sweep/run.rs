@@ -138,7 +138,7 @@ pub fn run(
     out: &mut dyn Write,
     progress: &dyn Progress,
 ) -> Result<Collected, SweepError> {
-    run_from(scenario, sampler, options, out, progress, Vec::new())
+    run_from(scenario, sampler, options, out, progress, None)
 }
 
 /// The CSV header and columns of `scenario`'s sweep with `sampler`'s keys
@@ -168,15 +168,16 @@ fn columns(scenario: &Scenario, options: &SweepOptions<'_>) -> table::Columns {
 
 /// [`run`], continuing a sweep whose first `done.len()` samples of the
 /// shard have their rows already (read back by
-/// [`super::resume::finished_rows`]): `out` already holds the header and
-/// those rows, and gets the rest.
+/// [`super::resume::finished_rows`] into `done`): `out` already holds the
+/// header and those rows, and gets the rest. `None`: a sweep from its
+/// start, as [`run`].
 pub fn run_from(
     scenario: &Scenario,
     sampler: &Sampler,
     options: &SweepOptions<'_>,
     out: &mut dyn Write,
     progress: &dyn Progress,
-    done: Vec<SampleRecord>,
+    done: Option<Collected>,
 ) -> Result<Collected, SweepError> {
     let signals = signals(scenario, options)?;
     // Resolved once, the netlist read once (a netlist that cannot be read
@@ -185,21 +186,18 @@ pub fn run_from(
     let base = &base;
     let columns = columns(scenario, options);
     let probes = signals.len();
-    if done.is_empty() {
+    if done.is_none() {
         let header = table::header(sampler.keys(), &signals, columns);
         out.write_all(&header)
             .and_then(|()| out.flush())
             .map_err(SweepError::Write)?;
     }
     let total = options.shard.len(sampler.count());
-    let first = (done.len() as u64).min(total);
+    let first = done.as_ref().map_or(0, |d| d.len() as u64).min(total);
     let chunk = chunk_len(options.mode);
     let chunks = (total - first).div_ceil(chunk);
-    let mut collected = Collected::new(sampler.keys().to_vec(), signals);
+    let mut collected = done.unwrap_or_else(|| Collected::new(sampler.keys().to_vec(), signals));
     progress.start(total);
-    for record in &done {
-        collected.add(record)?;
-    }
     progress.advance(first);
 
     let next = AtomicU64::new(0);
