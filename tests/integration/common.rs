@@ -160,3 +160,18 @@ pub fn all<'a>(s: &'a Sexp, name: &str, out: &mut Vec<&'a Sexp>) {
         }
     }
 }
+
+/// Whether `text` has consecutive whitespace-separated words, each
+/// accepted by its matcher in turn (a plain pattern for the words a test
+/// expects, without a regular-expression engine).
+pub fn has_words(text: &str, matchers: &[&dyn Fn(&str) -> bool]) -> bool {
+    let words: Vec<&str> = text.split_whitespace().collect();
+    words
+        .windows(matchers.len())
+        .any(|w| w.iter().zip(matchers).all(|(word, m)| m(word)))
+}
+
+/// A matcher of exactly `expected`.
+pub fn word(expected: &'static str) -> impl Fn(&str) -> bool {
+    move |w: &str| w == expected
+}
