@@ -504,7 +504,7 @@ fn life_calibrates_on_one_figure_and_predicts_the_others() {
             "life",
             path.to_str().unwrap(),
             "--phases",
-            "4",
+            "2",
             "--format",
             "json",
         ],
@@ -524,7 +524,7 @@ fn life_calibrates_on_one_figure_and_predicts_the_others() {
     );
     assert!((figures[1]["ratio"].as_f64().unwrap() - 0.25).abs() < 1e-9);
     assert_eq!(figures[0]["phases"], 1);
-    assert_eq!(figures[2]["phases"], 4);
+    assert_eq!(figures[2]["phases"], 2);
     // 10 A at 125 V AC burns far longer than 1 A at 30 V DC breaks.
     assert!(
         figures[2]["energy_per_operation"].as_f64().unwrap() > 10.0 * e1,
