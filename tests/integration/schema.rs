@@ -515,7 +515,14 @@ fn life_calibrates_on_one_figure_and_predicts_the_others() {
     let e1 = figures[0]["energy_per_operation"].as_f64().unwrap();
     assert!(e1 > 0.0, "{doc}");
     let b = doc["constant_j"].as_f64().unwrap();
-    assert!((b / (1.0e5 * e1) - 1.0).abs() < 1e-12);
+    // A DC operation wears the contacts DC_TRANSFER times its arc energy,
+    // an AC one once.
+    let dc = chatterspice::life::DC_TRANSFER;
+    assert_eq!(figures[0]["wear_factor"].as_f64(), Some(dc));
+    assert_eq!(figures[2]["wear_factor"].as_f64(), Some(1.0));
+    assert!((b / (1.0e5 * e1 * dc) - 1.0).abs() < 1e-12);
+    let e3 = figures[2]["energy_per_operation"].as_f64().unwrap();
+    assert!((figures[2]["predicted"].as_f64().unwrap() * e3 / b - 1.0).abs() < 1e-12);
     assert!((figures[0]["ratio"].as_f64().unwrap() - 1.0).abs() < 1e-12);
     // The same load, printed four times longer: predicted at the first's.
     assert!(
@@ -534,7 +541,9 @@ fn life_calibrates_on_one_figure_and_predicts_the_others() {
     let e_own = own["energy_per_operation"].as_f64().unwrap();
     assert!(e_own > 0.0);
     let n = own["operations"].as_f64().unwrap();
-    assert!((n * e_own / b - 1.0).abs() < 1e-12);
+    // The circuit is DC: no sine source.
+    assert_eq!(own["wear_factor"].as_f64(), Some(dc));
+    assert!((n * e_own * dc / b - 1.0).abs() < 1e-12);
     let expected_b10 = chatterspice::life::b10(n, 2.0);
     assert!((own["b10"].as_f64().unwrap() / expected_b10 - 1.0).abs() < 1e-12);
 
