@@ -4,7 +4,7 @@
 //!
 //! [`Collected`] takes each sample as its row is written (not the rows
 //! themselves): counts, sums and the worst sample as it goes, and a few
-//! numbers per sample in a [`Spill`] (bounded memory, a temporary file
+//! numbers per sample in a spill (`spill.rs`: bounded memory, a temporary file
 //! beyond it) for the quantiles and the plot; [`Collected::summary`]
 //! reduces them. Quantiles are nearest-rank: the p-quantile of n sorted
 //! values is the value at rank ⌈p·n⌉, so it is always one of the samples.
