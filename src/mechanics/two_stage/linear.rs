@@ -143,19 +143,11 @@ impl ModeKit {
     /// The forms' values and rates at `w` (zero for forms the mode has
     /// not: a relay without a pole face reads two, not four).
     fn read(&self, w: &W) -> Reading {
-        let mut at = Reading {
-            value: [0.0; 4],
-            rate: [0.0; 4],
-        };
-        let row = |i: usize| {
-            let r = &self.readout;
-            r[(i, 0)] * w[0] + r[(i, 1)] * w[1] + r[(i, 2)] * w[2] + r[(i, 3)] * w[3]
-        };
-        for i in 0..self.forms.len() {
-            at.value[i] = row(i) + self.offset[i];
-            at.rate[i] = row(4 + i);
+        let v = self.readout * w + self.offset;
+        Reading {
+            value: [v[0], v[1], v[2], v[3]],
+            rate: [v[4], v[5], v[6], v[7]],
         }
-        at
     }
 }
 
@@ -490,7 +482,9 @@ fn low_positive(kit: &ModeKit, term: Term, w0: &W, at0: &Reading) -> bool {
 /// The first event over `(0, h]` of a step from `w0` (read as `at0`):
 /// (τ, which). Every guard is searched by the one event locator
 /// ([`crate::mechanics::locate`]), which cannot step over a zero of the
-/// exact polynomial, and the zero it brackets is polished on it.
+/// exact polynomial, and the zero it brackets is polished on it. Most
+/// steps end here, every guard shown positive over the step by its
+/// Bernstein rows alone; the search itself is [`guard_event`].
 fn first_event(
     polys: &mut StepPolys<'_>,
     at0: &Reading,
@@ -501,63 +495,83 @@ fn first_event(
     for &(which, guard) in &polys.kit.guards {
         let (kit, w0) = (polys.kit, polys.w0);
         let positive = |t: Term| stays_positive(kit, t, w0, at0) || low_positive(kit, t, w0, at0);
-        let (combine, quick) = match guard {
-            Guard::One(t) => (Combine::One, positive(t)),
-            Guard::Max(a, b) => (Combine::Max, positive(a) || positive(b)),
-            Guard::Min(a, b) => (Combine::Min, positive(a) && positive(b)),
+        let quick = match guard {
+            Guard::One(t) => positive(t),
+            Guard::Max(a, b) => positive(a) || positive(b),
+            Guard::Min(a, b) => positive(a) && positive(b),
         };
         if quick {
             continue;
         }
-        let mut step_polys = [None; 2];
-        for (slot, t) in step_polys.iter_mut().zip(guard.terms()) {
-            *slot = Some(polys.of(t));
-        }
-        let step_polys = step_polys.iter().flatten();
-        // The common event: one form, one zero, nothing before it; the
-        // locator would bracket the whole step.
-        let isolated = match guard {
-            Guard::One(t) if h == kit.mode.h => kit.forms[t.form].isolated_over_step(w0, t.negated),
-            _ => false,
-        };
-        let bracket = if isolated {
-            Some((0.0, 1.0))
-        } else {
-            let mut forms = [StepForm::new(&[0.0]); 2];
-            let mut count = 0;
-            for (form, p) in forms.iter_mut().zip(step_polys.clone()) {
-                *form = StepForm::scaled(&p.p, h);
-                count += 1;
-            }
-            locate::first_zero(&forms[..count], combine, resolution / h)
-        };
-        let Some((lo, hi)) = bracket else {
+        let Some(tau) = guard_event(polys, guard, h, resolution) else {
             continue;
         };
-        let (lo, hi) = (lo * h, hi * h);
-        // Polish on the exact polynomial: the zero of each form that
-        // crosses in the bracket; for a max the last, else the first.
-        let crossings = step_polys.filter_map(|poly| {
-            let (v_lo, v_hi) = (poly.value(lo), poly.value(hi));
-            if v_hi >= 0.0 || v_lo < 0.0 {
-                return None;
-            }
-            // A form on its zero at the step's start is past that zero.
-            if lo == 0.0 && v_lo.abs() <= poly.noise(hi) {
-                return Some(hi);
-            }
-            Some(poly.root_from((lo, hi), (v_lo, v_hi)))
-        });
-        let tau = match combine {
-            Combine::Max => crossings.reduce(f64::max),
-            _ => crossings.reduce(f64::min),
-        }
-        .unwrap_or(hi);
         if best.is_none_or(|(tb, _)| tau < tb) {
             best = Some((tau, which));
         }
     }
     best
+}
+
+/// The first zero of `guard` over `(0, h]` (τ), when the quick test of
+/// [`first_event`] could not show it positive: bracketed by the locator
+/// (or by the form's full Bernstein rows, for the common event) and
+/// polished on the exact polynomial. Kept apart from the quick test, so
+/// that what only this search needs is never computed for a step that
+/// ends there.
+#[inline(never)]
+fn guard_event(polys: &mut StepPolys<'_>, guard: Guard, h: f64, resolution: f64) -> Option<f64> {
+    let (kit, w0) = (polys.kit, polys.w0);
+    let combine = match guard {
+        Guard::One(_) => Combine::One,
+        Guard::Max(..) => Combine::Max,
+        Guard::Min(..) => Combine::Min,
+    };
+    let mut step_polys = [None; 2];
+    for (slot, t) in step_polys.iter_mut().zip(guard.terms()) {
+        *slot = Some(polys.of(t));
+    }
+    let step_polys = step_polys.iter().flatten();
+    // The common event: one form, one zero, nothing before it; the
+    // locator would bracket the whole step.
+    let isolated = match guard {
+        Guard::One(t) if h == kit.mode.h => kit.forms[t.form].isolated_over_step(w0, t.negated),
+        _ => false,
+    };
+    let bracket = if isolated {
+        Some((0.0, 1.0))
+    } else {
+        let mut forms = [StepForm::new(&[0.0]); 2];
+        let mut count = 0;
+        for (form, p) in forms.iter_mut().zip(step_polys.clone()) {
+            *form = StepForm::scaled(&p.p, h);
+            count += 1;
+        }
+        locate::first_zero(&forms[..count], combine, resolution / h)
+    };
+    let (lo, hi) = bracket?;
+    let (lo, hi) = (lo * h, hi * h);
+    // Polish on the exact polynomial: the zero of each form that
+    // crosses in the bracket; for a max the last, else the first.
+    let crossings = step_polys.filter_map(|poly| {
+        let (v_lo, v_hi) = (poly.value(lo), poly.value(hi));
+        if v_hi >= 0.0 || v_lo < 0.0 {
+            return None;
+        }
+        // The rounding of the form's values over the bracket (0 ≤ lo < hi).
+        let noise = poly.noise(hi);
+        // A form on its zero at the step's start is past that zero.
+        if lo == 0.0 && v_lo.abs() <= noise {
+            return Some(hi);
+        }
+        Some(poly.root_within((lo, hi), (v_lo, v_hi), noise))
+    });
+    let tau = match combine {
+        Combine::Max => crossings.reduce(f64::max),
+        _ => crossings.reduce(f64::min),
+    }
+    .unwrap_or(hi);
+    Some(tau)
 }
 
 /// Propagate `p` exactly from event to event, to the horizon.
