@@ -229,12 +229,31 @@ impl Series {
         changes == 1 && last < 0.0
     }
 
-    /// Whether the form, negated when `negated`, starts on its zero and
-    /// is positive over the rest of a step from `w0`: `(f(s) − f(0))/s`
-    /// shown positive as [`Series::positive_over_step`] shows `f`.
-    pub(super) fn positive_after_zero(&self, w0: &W, negated: bool) -> bool {
-        let sign = if negated { -1.0 } else { 1.0 };
+    /// Whether the form, negated when `negated`, is shown positive over a
+    /// step of the mode from `w0`, where its value (negated likewise) is
+    /// `value`, with no polynomial built: far from its zero by its spread
+    /// alone; starting on its zero, within the rounding the locator
+    /// allows, by [`Series::positive_after_zero`]; else by
+    /// [`Series::positive_over_step`].
+    pub(super) fn shown_positive(&self, value: f64, w0: &W, negated: bool) -> bool {
         let scale = w0.amax();
+        if value > self.spread * scale * (1.0 + 1e-12) + 1e-300 {
+            return true;
+        }
+        let rounding = 64.0 * f64::EPSILON * (self.k.abs() + self.bern_norm * scale);
+        if value.abs() <= rounding {
+            self.positive_after_zero(w0, scale, negated)
+        } else {
+            self.positive_over_step(w0, scale, rounding, negated)
+        }
+    }
+
+    /// Whether the form, negated when `negated`, starts on its zero and
+    /// is positive over the rest of a step from `w0` (`‖w0‖∞ = scale`):
+    /// `(f(s) − f(0))/s` shown positive as [`Series::positive_over_step`]
+    /// shows `f`.
+    fn positive_after_zero(&self, w0: &W, scale: f64, negated: bool) -> bool {
+        let sign = if negated { -1.0 } else { 1.0 };
         let margin =
             self.tail * scale * (1.0 + 1e-9) + 64.0 * f64::EPSILON * self.bern_norm * scale;
         self.bern_after_zero
@@ -242,25 +261,16 @@ impl Series {
             .all(|b| sign * b.dot(w0) > margin)
     }
 
-    /// Whether the form is on its zero at `value` (its value at `w0`),
-    /// within the rounding the locator allows.
-    pub(super) fn on_zero(&self, value: f64, w0: &W) -> bool {
-        value.abs() <= 64.0 * f64::EPSILON * (self.k.abs() + self.bern_norm * w0.amax())
-    }
-
     /// Whether the form, negated when `negated`, is positive over a whole
-    /// step of the mode from `w0`: every Bernstein coefficient of its first
-    /// [`LOW_TERMS`] terms exceeds the bound on the rest and the rounding.
-    /// Over the mode's full step, so it holds for a shorter last step too.
-    pub(super) fn positive_over_step(&self, w0: &W, negated: bool) -> bool {
+    /// step of the mode from `w0` (`‖w0‖∞ = scale`): every Bernstein
+    /// coefficient of its first [`LOW_TERMS`] terms exceeds the bound on
+    /// the rest and the rounding (`rounding`). Over the mode's full step,
+    /// so it holds for a shorter last step too.
+    fn positive_over_step(&self, w0: &W, scale: f64, rounding: f64, negated: bool) -> bool {
         let sign = if negated { -1.0 } else { 1.0 };
-        let scale = w0.amax();
-        let margin = self.tail * scale * (1.0 + 1e-9)
-            + 64.0 * f64::EPSILON * (self.k.abs() + self.bern_norm * scale);
-        let [c0, c1, c2, c3] = &self.bern;
+        let margin = self.tail * scale * (1.0 + 1e-9) + rounding;
         let mut clear = true;
-        for j in 0..LOW_TERMS {
-            let b = self.k + (((c0[j] * w0[0] + c1[j] * w0[1]) + c2[j] * w0[2]) + c3[j] * w0[3]);
+        for b in rows_at(self.k, &self.bern, w0) {
             clear &= sign * b > margin;
         }
         clear
@@ -328,6 +338,13 @@ fn bernstein_rows<const N: usize>(scaled: &[W], weights: &[[f64; N]; N]) -> [W; 
     })
 }
 
+/// The coefficients `k + Σ_i rows[i][j] w0_i` of Bernstein rows kept by
+/// column.
+fn rows_at<const N: usize>(k: f64, rows: &[[f64; N]; 4], w0: &W) -> [f64; N] {
+    let [c0, c1, c2, c3] = rows;
+    std::array::from_fn(|j| k + (((c0[j] * w0[0] + c1[j] * w0[1]) + c2[j] * w0[2]) + c3[j] * w0[3]))
+}
+
 /// `1/k` for the series' terms.
 const RECIPROCALS: [f64; TERMS] = {
     let mut r = [0.0; TERMS];
@@ -391,21 +408,17 @@ fn evaluate_pair(p: &[f64; TERMS], s: f64, q: &[f64; TERMS], t: f64) -> (f64, f6
 }
 
 impl Poly {
-    pub(super) fn negated(&self) -> Poly {
-        Poly {
-            p: self.p.map(|c| -c),
-        }
-    }
-
     pub(super) fn value(&self, tau: f64) -> f64 {
         evaluate(&self.p, tau)
     }
 
-    /// A bound on the rounding of [`Poly::value`] over `|τ| ≤ t`: a few
-    /// units in the last place of the sum of the terms' magnitudes. Below
-    /// it a value is zero as far as the arithmetic can tell.
-    pub(super) fn noise(&self, t: f64) -> f64 {
-        8.0 * f64::EPSILON * evaluate(&self.p.map(f64::abs), t)
+    /// [`Poly::value`] at `t > 0`, and a bound on the rounding of a value
+    /// over `|τ| ≤ t` (the noise): a few units in the last place of the
+    /// sum of the terms' magnitudes. Below it a value is zero as far as
+    /// the arithmetic can tell. Both in one pass.
+    pub(super) fn value_and_noise(&self, t: f64) -> (f64, f64) {
+        let (v, magnitude) = evaluate_pair(&self.p, t, &self.p.map(f64::abs), t);
+        (v, 8.0 * f64::EPSILON * magnitude)
     }
 
     pub(super) fn derivative(&self) -> Poly {
@@ -419,7 +432,8 @@ impl Poly {
     /// τ in `[lo, hi]` where the polynomial is zero, given a sign change
     /// between the ends: Newton's method from the secant's zero, kept
     /// inside the bracket, bisection where it would leave it, to where
-    /// the value is lost in its rounding (`floor`, [`Poly::noise`] at the
+    /// the value is lost in its rounding (`floor`, the noise of
+    /// [`Poly::value_and_noise`] at the
     /// bracket's farther end) or the bracket is two floats wide. The
     /// values at the ends are given (as [`Poly::value`] has them).
     pub(super) fn root_within(&self, bracket: (f64, f64), values: (f64, f64), floor: f64) -> f64 {
@@ -474,10 +488,11 @@ impl Poly {
     /// other use, holds.
     pub(super) fn extremum(&self, h: f64) -> Option<f64> {
         let rate = self.derivative();
-        let (r0, r1) = (rate.p[0], rate.value(h));
+        let (r1, noise) = rate.value_and_noise(h);
+        let r0 = rate.p[0];
         if r0 == 0.0 || r1 == 0.0 || (r0 > 0.0) == (r1 > 0.0) {
             return None;
         }
-        Some(rate.root_between((0.0, h), (r0, r1), rate.noise(h), EXTREMUM_TOLERANCE))
+        Some(rate.root_between((0.0, h), (r0, r1), noise, EXTREMUM_TOLERANCE))
     }
 }
