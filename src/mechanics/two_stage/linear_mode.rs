@@ -496,3 +496,56 @@ impl Poly {
         Some(rate.root_between((0.0, h), (r0, r1), noise, EXTREMUM_TOLERANCE))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `Σ_j b_j C(n, j) s^j (1 − s)^(n − j)`, the Bernstein form at `s`.
+    fn bernstein_at(b: &[f64], s: f64) -> f64 {
+        let n = b.len() - 1;
+        let mut binomial = 1.0;
+        let mut sum = 0.0;
+        for (j, bj) in b.iter().enumerate() {
+            if j > 0 {
+                binomial *= (n - j + 1) as f64 / j as f64;
+            }
+            sum += bj * binomial * s.powi(j as i32) * (1.0 - s).powi((n - j) as i32);
+        }
+        sum
+    }
+
+    /// The weights' rows turn a polynomial's power coefficients into
+    /// Bernstein coefficients of the same polynomial, for each degree the
+    /// engine uses: both forms agree along [0, 1].
+    #[test]
+    fn bernstein_rows_are_the_same_polynomial() {
+        fn check<const N: usize>(weights: &[[f64; N]; N]) {
+            let a: [f64; N] = std::array::from_fn(|k| ((k * 7 + 3) % 11) as f64 - 5.0);
+            let terms: [W; N] = std::array::from_fn(|k| W::new(a[k], -a[k], 0.5 * a[k], 0.0));
+            let rows = bernstein_rows(&terms, weights);
+            let b0: Vec<f64> = rows.iter().map(|r| r[0]).collect();
+            let b1: Vec<f64> = rows.iter().map(|r| r[1]).collect();
+            for i in 0..=20 {
+                let s = i as f64 / 20.0;
+                let power: f64 = a.iter().rev().fold(0.0, |acc, c| acc * s + c);
+                let scale: f64 = a.iter().map(|c| c.abs()).sum();
+                assert!(
+                    (bernstein_at(&b0, s) - power).abs() <= 1e-12 * scale,
+                    "N = {N}, s = {s}"
+                );
+                assert!(
+                    (bernstein_at(&b1, s) + power).abs() <= 1e-12 * scale,
+                    "N = {N}, s = {s}"
+                );
+            }
+            // The end coefficients are the polynomial's ends.
+            assert_eq!(b0[0], a[0]);
+            let sum: f64 = a.iter().sum();
+            assert!((b0[N - 1] - sum).abs() <= 1e-12 * sum.abs().max(1.0));
+        }
+        check(&LOW_WEIGHTS);
+        check(&AFTER_ZERO_WEIGHTS);
+        check(&FULL_WEIGHTS);
+    }
+}
