@@ -120,6 +120,9 @@ struct ModeKit {
     /// of `w`, rows of absent forms zero: a step reads them in one product.
     readout: SMatrix<f64, 8, 4>,
     offset: SVector<f64, 8>,
+    /// `readout · Φ`: the same read at the end of a full step, from the
+    /// state at its start (so that it need not wait for that state).
+    readout_after: SMatrix<f64, 8, 4>,
 }
 
 impl ModeKit {
@@ -132,6 +135,7 @@ impl ModeKit {
             offset[i] = form.k;
         }
         ModeKit {
+            readout_after: readout * mode.phi,
             mode,
             forms,
             guards,
@@ -143,19 +147,12 @@ impl ModeKit {
     /// The forms' values and rates at `w` (zero for forms the mode has
     /// not: a relay without a pole face reads two, not four).
     fn read(&self, w: &W) -> Reading {
-        let mut at = Reading {
-            value: [0.0; 4],
-            rate: [0.0; 4],
-        };
-        let row = |i: usize| {
-            let r = &self.readout;
-            r[(i, 0)] * w[0] + r[(i, 1)] * w[1] + r[(i, 2)] * w[2] + r[(i, 3)] * w[3]
-        };
-        for i in 0..self.forms.len() {
-            at.value[i] = row(i) + self.offset[i];
-            at.rate[i] = row(4 + i);
-        }
-        at
+        Reading::of(&(self.readout * w + self.offset))
+    }
+
+    /// The forms' values and rates after a full step of the mode from `w`.
+    fn read_after_step(&self, w: &W) -> Reading {
+        Reading::of(&(self.readout_after * w + self.offset))
     }
 }
 
@@ -164,6 +161,15 @@ impl ModeKit {
 struct Reading {
     value: [f64; 4],
     rate: [f64; 4],
+}
+
+impl Reading {
+    fn of(v: &SVector<f64, 8>) -> Reading {
+        Reading {
+            value: [v[0], v[1], v[2], v[3]],
+            rate: [v[4], v[5], v[6], v[7]],
+        }
+    }
 }
 
 /// The forms' polynomials over one step, each built when first needed.
@@ -175,10 +181,10 @@ struct StepPolys<'a> {
 }
 
 impl StepPolys<'_> {
-    fn of(&mut self, term: Term) -> Poly {
+    /// The polynomial of form `form` (not negated), built on first use.
+    fn of(&mut self, form: usize) -> &Poly {
         let (kit, w0, y0) = (self.kit, self.w0, self.y0);
-        let poly = *self.polys[term.form].get_or_insert_with(|| kit.forms[term.form].poly(w0, y0));
-        if term.negated { poly.negated() } else { poly }
+        self.polys[form].get_or_insert_with(|| kit.forms[form].poly(w0, y0))
     }
 }
 
@@ -467,30 +473,18 @@ fn turns(term: Term, at0: &Reading, at1: &Reading) -> bool {
 }
 
 /// Whether `term` stays positive over a step from `w0` (read as `at0`),
-/// as its series' spread alone shows: far from its zero, no polynomial is
-/// needed.
+/// as its series shows without a polynomial (see
+/// [`Series::shown_positive`]): most steps need no more.
 fn stays_positive(kit: &ModeKit, term: Term, w0: &W, at0: &Reading) -> bool {
-    let series = &kit.forms[term.form];
-    term.value(at0) > series.spread * w0.amax() * (1.0 + 1e-12) + 1e-300
-}
-
-/// Whether `term` stays positive over a step from `w0`, as the Bernstein
-/// coefficients of its series' first terms and a bound on the rest show
-/// (see [`Series::positive_over_step`]): most steps near a stop need no
-/// more.
-fn low_positive(kit: &ModeKit, term: Term, w0: &W, at0: &Reading) -> bool {
-    let series = &kit.forms[term.form];
-    if series.on_zero(term.value(at0), w0) {
-        series.positive_after_zero(w0, term.negated)
-    } else {
-        series.positive_over_step(w0, term.negated)
-    }
+    kit.forms[term.form].shown_positive(term.value(at0), w0, term.negated)
 }
 
 /// The first event over `(0, h]` of a step from `w0` (read as `at0`):
 /// (τ, which). Every guard is searched by the one event locator
 /// ([`crate::mechanics::locate`]), which cannot step over a zero of the
-/// exact polynomial, and the zero it brackets is polished on it.
+/// exact polynomial, and the zero it brackets is polished on it. Most
+/// steps end here, every guard shown positive over the step by its
+/// Bernstein rows alone; the search itself is [`guard_event`].
 fn first_event(
     polys: &mut StepPolys<'_>,
     at0: &Reading,
@@ -500,64 +494,92 @@ fn first_event(
     let mut best: Option<(f64, Which)> = None;
     for &(which, guard) in &polys.kit.guards {
         let (kit, w0) = (polys.kit, polys.w0);
-        let positive = |t: Term| stays_positive(kit, t, w0, at0) || low_positive(kit, t, w0, at0);
-        let (combine, quick) = match guard {
-            Guard::One(t) => (Combine::One, positive(t)),
-            Guard::Max(a, b) => (Combine::Max, positive(a) || positive(b)),
-            Guard::Min(a, b) => (Combine::Min, positive(a) && positive(b)),
+        let positive = |t: Term| stays_positive(kit, t, w0, at0);
+        let quick = match guard {
+            Guard::One(t) => positive(t),
+            Guard::Max(a, b) => positive(a) || positive(b),
+            Guard::Min(a, b) => positive(a) && positive(b),
         };
         if quick {
             continue;
         }
-        let mut step_polys = [None; 2];
-        for (slot, t) in step_polys.iter_mut().zip(guard.terms()) {
-            *slot = Some(polys.of(t));
-        }
-        let step_polys = step_polys.iter().flatten();
-        // The common event: one form, one zero, nothing before it; the
-        // locator would bracket the whole step.
-        let isolated = match guard {
-            Guard::One(t) if h == kit.mode.h => kit.forms[t.form].isolated_over_step(w0, t.negated),
-            _ => false,
-        };
-        let bracket = if isolated {
-            Some((0.0, 1.0))
-        } else {
-            let mut forms = [StepForm::new(&[0.0]); 2];
-            let mut count = 0;
-            for (form, p) in forms.iter_mut().zip(step_polys.clone()) {
-                *form = StepForm::scaled(&p.p, h);
-                count += 1;
-            }
-            locate::first_zero(&forms[..count], combine, resolution / h)
-        };
-        let Some((lo, hi)) = bracket else {
+        let Some(tau) = guard_event(polys, guard, h, resolution) else {
             continue;
         };
-        let (lo, hi) = (lo * h, hi * h);
-        // Polish on the exact polynomial: the zero of each form that
-        // crosses in the bracket; for a max the last, else the first.
-        let crossings = step_polys.filter_map(|poly| {
-            let (v_lo, v_hi) = (poly.value(lo), poly.value(hi));
-            if v_hi >= 0.0 || v_lo < 0.0 {
-                return None;
-            }
-            // A form on its zero at the step's start is past that zero.
-            if lo == 0.0 && v_lo.abs() <= poly.noise(hi) {
-                return Some(hi);
-            }
-            Some(poly.root_from((lo, hi), (v_lo, v_hi)))
-        });
-        let tau = match combine {
-            Combine::Max => crossings.reduce(f64::max),
-            _ => crossings.reduce(f64::min),
-        }
-        .unwrap_or(hi);
         if best.is_none_or(|(tb, _)| tau < tb) {
             best = Some((tau, which));
         }
     }
     best
+}
+
+/// The first zero of `guard` over `(0, h]` (τ), when the quick test of
+/// [`first_event`] could not show it positive: bracketed by the locator
+/// (or by the form's full Bernstein rows, for the common event) and
+/// polished on the exact polynomial. Kept apart from the quick test, so
+/// that what only this search needs is never computed for a step that
+/// ends there.
+#[inline(never)]
+fn guard_event(polys: &mut StepPolys<'_>, guard: Guard, h: f64, resolution: f64) -> Option<f64> {
+    let (kit, w0) = (polys.kit, polys.w0);
+    let combine = match guard {
+        Guard::One(_) => Combine::One,
+        Guard::Max(..) => Combine::Max,
+        Guard::Min(..) => Combine::Min,
+    };
+    for t in guard.terms() {
+        polys.of(t.form);
+    }
+    // Each term's polynomial, by reference, with its sign: a negated
+    // form has the same zeros and its values negated exactly.
+    let built = &polys.polys;
+    let mut terms = [None; 2];
+    for (slot, t) in terms.iter_mut().zip(guard.terms()) {
+        *slot = built[t.form].as_ref().map(|poly| (poly, t.sign()));
+    }
+    let step_polys = terms.iter().flatten().copied();
+    // The common event: one form, one zero, nothing before it; the
+    // locator would bracket the whole step.
+    let isolated = match guard {
+        Guard::One(t) if h == kit.mode.h => kit.forms[t.form].isolated_over_step(w0, t.negated),
+        _ => false,
+    };
+    let bracket = if isolated {
+        Some((0.0, 1.0))
+    } else {
+        let mut forms = [StepForm::new(&[0.0]); 2];
+        let mut count = 0;
+        for (form, (p, sign)) in forms.iter_mut().zip(step_polys.clone()) {
+            *form = StepForm::scaled(&p.p.map(|c| sign * c), h);
+            count += 1;
+        }
+        locate::first_zero(&forms[..count], combine, resolution / h)
+    };
+    let (lo, hi) = bracket?;
+    let (lo, hi) = (lo * h, hi * h);
+    // Polish on the exact polynomial: the zero of each form that
+    // crosses in the bracket; for a max the last, else the first.
+    let crossings = step_polys.filter_map(|(poly, sign)| {
+        // The value at the bracket's end and the rounding of the form's
+        // values over the bracket (0 ≤ lo < hi).
+        let (f_hi, noise) = poly.value_and_noise(hi);
+        let f_lo = poly.value(lo);
+        let (v_lo, v_hi) = (sign * f_lo, sign * f_hi);
+        if v_hi >= 0.0 || v_lo < 0.0 {
+            return None;
+        }
+        // A form on its zero at the step's start is past that zero.
+        if lo == 0.0 && v_lo.abs() <= noise {
+            return Some(hi);
+        }
+        Some(poly.root_within((lo, hi), (f_lo, f_hi), noise))
+    });
+    let tau = match combine {
+        Combine::Max => crossings.reduce(f64::max),
+        _ => crossings.reduce(f64::min),
+    }
+    .unwrap_or(hi);
+    Some(tau)
 }
 
 /// Propagate `p` exactly from event to event, to the horizon.
@@ -594,12 +616,12 @@ pub(crate) fn propagate<D: DriveModel>(
         loop {
             p.count_step(model.m, settings)?;
             let h = mode.h.min(settings.t_end - p.t);
-            let w1 = if h == mode.h {
-                mode.phi * w
+            let (w1, at1) = if h == mode.h {
+                (mode.phi * w, kit.read_after_step(&w))
             } else {
-                mode.at(&w, h)
+                let w1 = mode.at(&w, h);
+                (w1, kit.read(&w1))
             };
-            let at1 = kit.read(&w1);
             let y0 = p.y;
             let mut polys = StepPolys {
                 kit: &kit,
@@ -676,7 +698,7 @@ fn track(
     if !turns(watched, at0, at1) {
         return;
     }
-    let poly = polys.of(watched);
+    let poly = polys.of(watched.form);
     if let Some(tm) = poly.extremum(h) {
         let v = poly.value(tm);
         if open {

@@ -114,8 +114,10 @@ pub(super) struct Series {
     pub(super) tail: f64,
     /// The Bernstein coefficients (degree `LOW_TERMS − 1`, over the mode's
     /// full step) of the series' first [`LOW_TERMS`] terms, as rows to dot
-    /// with `w0`: `b_j = k + bern_j·w0`.
-    pub(super) bern: [W; LOW_TERMS],
+    /// with `w0`: `b_j = k + Σ_i bern[i][j] w0_i`. Kept by column, so that
+    /// the thirteen coefficients of a step are had in four vector
+    /// products.
+    pub(super) bern: [[f64; LOW_TERMS]; 4],
     /// `max_j ‖bern_j‖₁`, for the rounding of `bern_j·w0`.
     pub(super) bern_norm: f64,
     /// The same for `(f(s) − f(0))/s`, the sign of a form that starts a
@@ -144,53 +146,23 @@ impl Series {
         let k = c[0] * eq[0] + c[1] * eq[1] + c[2] * eq[2] + c[3] * eq[3] + d;
         let q = W::from_fn(|i, _| c[i] * mode.d[i]);
         let r: [W; TERMS] = std::array::from_fn(|k| mode.powers[k].tr_mul(&q));
+        // The terms over the mode's full step, `r_k h^k`.
+        let mut scaled = [W::zeros(); TERMS];
         let mut hk = 1.0;
-        let (mut spread, mut tail) = (0.0, 0.0);
-        for (i, rk) in r.iter().enumerate().skip(1) {
-            hk *= mode.h;
-            spread += rk.abs().sum() * hk;
-            if i >= LOW_TERMS {
-                tail += rk.abs().sum() * hk;
-            }
-        }
-        // b_j = Σ_{k ≤ j} C(j, k)/C(n, k) (r_k h^k), n = LOW_TERMS − 1.
-        let n = LOW_TERMS - 1;
-        let mut bern = [W::zeros(); LOW_TERMS];
-        let mut hk = 1.0;
-        let mut inv_binom = 1.0;
-        for (k, rk) in r.iter().enumerate().take(LOW_TERMS) {
+        for (k, (s, rk)) in scaled.iter_mut().zip(&r).enumerate() {
             if k > 0 {
                 hk *= mode.h;
-                inv_binom *= k as f64 / (n - k + 1) as f64;
             }
-            let mut ratio = inv_binom;
-            for (j, b) in bern.iter_mut().enumerate().skip(k) {
-                if j > k {
-                    ratio *= j as f64 / (j - k) as f64;
-                }
-                *b += rk * (ratio * hk);
-            }
+            *s = rk * hk;
         }
-        let bern_norm = bern.iter().map(|b| b.abs().sum()).fold(0.0, f64::max);
+        let norms = scaled.map(|s| s.abs().sum());
+        let spread: f64 = norms[1..].iter().sum();
+        let tail: f64 = norms[LOW_TERMS..].iter().sum();
+        let rows = bernstein_rows(&scaled[..LOW_TERMS], &LOW_WEIGHTS);
+        let bern_norm = rows.iter().map(|b| b.abs().sum()).fold(0.0, f64::max);
+        let bern = std::array::from_fn(|i| rows.map(|b| b[i]));
         // (f − f(0))/s = Σ_{k≥1} a_k s^{k−1}: degree LOW_TERMS − 2.
-        let m = LOW_TERMS - 2;
-        let mut bern_after_zero = [W::zeros(); LOW_TERMS - 1];
-        let mut hk = 1.0;
-        let mut inv_binom = 1.0;
-        for (k, rk) in r.iter().enumerate().take(LOW_TERMS).skip(1) {
-            hk *= mode.h;
-            let i = k - 1;
-            if i > 0 {
-                inv_binom *= i as f64 / (m - i + 1) as f64;
-            }
-            let mut ratio = inv_binom;
-            for (j, b) in bern_after_zero.iter_mut().enumerate().skip(i) {
-                if j > i {
-                    ratio *= j as f64 / (j - i) as f64;
-                }
-                *b += rk * (ratio * hk);
-            }
-        }
+        let bern_after_zero = bernstein_rows(&scaled[1..LOW_TERMS], &AFTER_ZERO_WEIGHTS);
         Series {
             c,
             d,
@@ -211,25 +183,17 @@ impl Series {
     /// their magnitude.
     fn full(&self) -> &(Box<[W; TERMS]>, f64) {
         self.full.get_or_init(|| {
-            let n = TERMS - 1;
-            let mut full = Box::new([W::zeros(); TERMS]);
+            let mut scaled = [W::zeros(); TERMS];
             let mut hk = 1.0;
-            let mut inv_binom = 1.0;
             let mut magnitude = 0.0;
-            for (k, rk) in self.r.iter().enumerate() {
+            for (k, (s, rk)) in scaled.iter_mut().zip(&self.r).enumerate() {
                 if k > 0 {
                     hk *= self.h;
-                    inv_binom *= k as f64 / (n - k + 1) as f64;
                 }
-                magnitude += rk.abs().sum() * hk;
-                let mut ratio = inv_binom;
-                for (j, b) in full.iter_mut().enumerate().skip(k) {
-                    if j > k {
-                        ratio *= j as f64 / (j - k) as f64;
-                    }
-                    *b += rk * (ratio * hk);
-                }
+                *s = rk * hk;
+                magnitude += s.abs().sum();
             }
+            let full = Box::new(bernstein_rows(&scaled, &FULL_WEIGHTS));
             (full, magnitude)
         })
     }
@@ -265,12 +229,31 @@ impl Series {
         changes == 1 && last < 0.0
     }
 
-    /// Whether the form, negated when `negated`, starts on its zero and
-    /// is positive over the rest of a step from `w0`: `(f(s) − f(0))/s`
-    /// shown positive as [`Series::positive_over_step`] shows `f`.
-    pub(super) fn positive_after_zero(&self, w0: &W, negated: bool) -> bool {
-        let sign = if negated { -1.0 } else { 1.0 };
+    /// Whether the form, negated when `negated`, is shown positive over a
+    /// step of the mode from `w0`, where its value (negated likewise) is
+    /// `value`, with no polynomial built: far from its zero by its spread
+    /// alone; starting on its zero, within the rounding the locator
+    /// allows, by [`Series::positive_after_zero`]; else by
+    /// [`Series::positive_over_step`].
+    pub(super) fn shown_positive(&self, value: f64, w0: &W, negated: bool) -> bool {
         let scale = w0.amax();
+        if value > self.spread * scale * (1.0 + 1e-12) + 1e-300 {
+            return true;
+        }
+        let rounding = 64.0 * f64::EPSILON * (self.k.abs() + self.bern_norm * scale);
+        if value.abs() <= rounding {
+            self.positive_after_zero(w0, scale, negated)
+        } else {
+            self.positive_over_step(w0, scale, rounding, negated)
+        }
+    }
+
+    /// Whether the form, negated when `negated`, starts on its zero and
+    /// is positive over the rest of a step from `w0` (`‖w0‖∞ = scale`):
+    /// `(f(s) − f(0))/s` shown positive as [`Series::positive_over_step`]
+    /// shows `f`.
+    fn positive_after_zero(&self, w0: &W, scale: f64, negated: bool) -> bool {
+        let sign = if negated { -1.0 } else { 1.0 };
         let margin =
             self.tail * scale * (1.0 + 1e-9) + 64.0 * f64::EPSILON * self.bern_norm * scale;
         self.bern_after_zero
@@ -278,24 +261,19 @@ impl Series {
             .all(|b| sign * b.dot(w0) > margin)
     }
 
-    /// Whether the form is on its zero at `value` (its value at `w0`),
-    /// within the rounding the locator allows.
-    pub(super) fn on_zero(&self, value: f64, w0: &W) -> bool {
-        value.abs() <= 64.0 * f64::EPSILON * (self.k.abs() + self.bern_norm * w0.amax())
-    }
-
     /// Whether the form, negated when `negated`, is positive over a whole
-    /// step of the mode from `w0`: every Bernstein coefficient of its first
-    /// [`LOW_TERMS`] terms exceeds the bound on the rest and the rounding.
-    /// Over the mode's full step, so it holds for a shorter last step too.
-    pub(super) fn positive_over_step(&self, w0: &W, negated: bool) -> bool {
+    /// step of the mode from `w0` (`‖w0‖∞ = scale`): every Bernstein
+    /// coefficient of its first [`LOW_TERMS`] terms exceeds the bound on
+    /// the rest and the rounding (`rounding`). Over the mode's full step,
+    /// so it holds for a shorter last step too.
+    fn positive_over_step(&self, w0: &W, scale: f64, rounding: f64, negated: bool) -> bool {
         let sign = if negated { -1.0 } else { 1.0 };
-        let scale = w0.amax();
-        let margin = self.tail * scale * (1.0 + 1e-9)
-            + 64.0 * f64::EPSILON * (self.k.abs() + self.bern_norm * scale);
-        self.bern
-            .iter()
-            .all(|b| sign * (self.k + b.dot(w0)) > margin)
+        let margin = self.tail * scale * (1.0 + 1e-9) + rounding;
+        let mut clear = true;
+        for b in rows_at(self.k, &self.bern, w0) {
+            clear &= sign * b > margin;
+        }
+        clear
     }
 
     /// The form along the motion from `w0` (the state `y0`), as a
@@ -311,6 +289,60 @@ impl Series {
         p[0] = c[0] * y0[0] + c[1] * y0[1] + c[2] * y0[2] + c[3] * y0[3] + self.d;
         Poly { p }
     }
+}
+
+/// `C(j, k)/C(n, k)` at `[j][k]` (`k ≤ j ≤ n = N − 1`, else 0): the
+/// weight of a polynomial's coefficient `k` (in the power basis on
+/// `[0, 1]`) in its Bernstein coefficient `j` of degree `n`. A table, so
+/// that a form's rows cost multiplications only.
+const fn bernstein_weights<const N: usize>() -> [[f64; N]; N] {
+    // C(i, k) for i ≤ n, exact in f64 for n < 60.
+    let mut binomial = [[0.0; N]; N];
+    let mut i = 0;
+    while i < N {
+        binomial[i][0] = 1.0;
+        let mut k = 1;
+        while k <= i {
+            binomial[i][k] = binomial[i - 1][k - 1] + binomial[i - 1][k];
+            k += 1;
+        }
+        i += 1;
+    }
+    let mut w = [[0.0; N]; N];
+    let mut j = 0;
+    while j < N {
+        let mut k = 0;
+        while k <= j {
+            w[j][k] = binomial[j][k] / binomial[N - 1][k];
+            k += 1;
+        }
+        j += 1;
+    }
+    w
+}
+
+const LOW_WEIGHTS: [[f64; LOW_TERMS]; LOW_TERMS] = bernstein_weights();
+const AFTER_ZERO_WEIGHTS: [[f64; LOW_TERMS - 1]; LOW_TERMS - 1] = bernstein_weights();
+const FULL_WEIGHTS: [[f64; TERMS]; TERMS] = bernstein_weights();
+
+/// The Bernstein rows of degree `N − 1` of the terms `scaled` (each the
+/// row of a power-basis coefficient on `[0, 1]`, dotted with `w0`):
+/// `b_j = Σ_{k ≤ j} C(j, k)/C(n, k) scaled_k`.
+fn bernstein_rows<const N: usize>(scaled: &[W], weights: &[[f64; N]; N]) -> [W; N] {
+    std::array::from_fn(|j| {
+        let mut b = W::zeros();
+        for (s, &w) in scaled[..=j].iter().zip(&weights[j][..=j]) {
+            b += s * w;
+        }
+        b
+    })
+}
+
+/// The coefficients `k + Σ_i rows[i][j] w0_i` of Bernstein rows kept by
+/// column.
+fn rows_at<const N: usize>(k: f64, rows: &[[f64; N]; 4], w0: &W) -> [f64; N] {
+    let [c0, c1, c2, c3] = rows;
+    std::array::from_fn(|j| k + (((c0[j] * w0[0] + c1[j] * w0[1]) + c2[j] * w0[2]) + c3[j] * w0[3]))
 }
 
 /// `1/k` for the series' terms.
@@ -376,21 +408,17 @@ fn evaluate_pair(p: &[f64; TERMS], s: f64, q: &[f64; TERMS], t: f64) -> (f64, f6
 }
 
 impl Poly {
-    pub(super) fn negated(&self) -> Poly {
-        Poly {
-            p: self.p.map(|c| -c),
-        }
-    }
-
     pub(super) fn value(&self, tau: f64) -> f64 {
         evaluate(&self.p, tau)
     }
 
-    /// A bound on the rounding of [`Poly::value`] over `|τ| ≤ t`: a few
-    /// units in the last place of the sum of the terms' magnitudes. Below
-    /// it a value is zero as far as the arithmetic can tell.
-    pub(super) fn noise(&self, t: f64) -> f64 {
-        8.0 * f64::EPSILON * evaluate(&self.p.map(f64::abs), t)
+    /// [`Poly::value`] at `t > 0`, and a bound on the rounding of a value
+    /// over `|τ| ≤ t` (the noise): a few units in the last place of the
+    /// sum of the terms' magnitudes. Below it a value is zero as far as
+    /// the arithmetic can tell. Both in one pass.
+    pub(super) fn value_and_noise(&self, t: f64) -> (f64, f64) {
+        let (v, magnitude) = evaluate_pair(&self.p, t, &self.p.map(f64::abs), t);
+        (v, 8.0 * f64::EPSILON * magnitude)
     }
 
     pub(super) fn derivative(&self) -> Poly {
@@ -404,11 +432,12 @@ impl Poly {
     /// τ in `[lo, hi]` where the polynomial is zero, given a sign change
     /// between the ends: Newton's method from the secant's zero, kept
     /// inside the bracket, bisection where it would leave it, to where
-    /// the value is lost in its rounding or the bracket is two floats wide.
-    /// The values at the ends are given (as [`Poly::value`] has them).
-    pub(super) fn root_from(&self, (lo, hi): (f64, f64), (v_lo, v_hi): (f64, f64)) -> f64 {
-        let floor = self.noise(lo.abs().max(hi.abs()));
-        self.root_between((lo, hi), (v_lo, v_hi), floor, ROOT_TOLERANCE)
+    /// the value is lost in its rounding (`floor`, the noise of
+    /// [`Poly::value_and_noise`] at the
+    /// bracket's farther end) or the bracket is two floats wide. The
+    /// values at the ends are given (as [`Poly::value`] has them).
+    pub(super) fn root_within(&self, bracket: (f64, f64), values: (f64, f64), floor: f64) -> f64 {
+        self.root_between(bracket, values, floor, ROOT_TOLERANCE)
     }
 
     /// [`Poly::root`] with the values at the ends known, to where the
@@ -459,10 +488,64 @@ impl Poly {
     /// other use, holds.
     pub(super) fn extremum(&self, h: f64) -> Option<f64> {
         let rate = self.derivative();
-        let (r0, r1) = (rate.p[0], rate.value(h));
+        let (r1, noise) = rate.value_and_noise(h);
+        let r0 = rate.p[0];
         if r0 == 0.0 || r1 == 0.0 || (r0 > 0.0) == (r1 > 0.0) {
             return None;
         }
-        Some(rate.root_between((0.0, h), (r0, r1), rate.noise(h), EXTREMUM_TOLERANCE))
+        Some(rate.root_between((0.0, h), (r0, r1), noise, EXTREMUM_TOLERANCE))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `Σ_j b_j C(n, j) s^j (1 − s)^(n − j)`, the Bernstein form at `s`.
+    fn bernstein_at(b: &[f64], s: f64) -> f64 {
+        let n = b.len() - 1;
+        let mut binomial = 1.0;
+        let mut sum = 0.0;
+        for (j, bj) in b.iter().enumerate() {
+            if j > 0 {
+                binomial *= (n - j + 1) as f64 / j as f64;
+            }
+            sum += bj * binomial * s.powi(j as i32) * (1.0 - s).powi((n - j) as i32);
+        }
+        sum
+    }
+
+    /// The weights' rows turn a polynomial's power coefficients into
+    /// Bernstein coefficients of the same polynomial, for each degree the
+    /// engine uses: both forms agree along [0, 1].
+    #[test]
+    fn bernstein_rows_are_the_same_polynomial() {
+        fn check<const N: usize>(weights: &[[f64; N]; N]) {
+            let a: [f64; N] = std::array::from_fn(|k| ((k * 7 + 3) % 11) as f64 - 5.0);
+            let terms: [W; N] = std::array::from_fn(|k| W::new(a[k], -a[k], 0.5 * a[k], 0.0));
+            let rows = bernstein_rows(&terms, weights);
+            let b0: Vec<f64> = rows.iter().map(|r| r[0]).collect();
+            let b1: Vec<f64> = rows.iter().map(|r| r[1]).collect();
+            for i in 0..=20 {
+                let s = i as f64 / 20.0;
+                let power: f64 = a.iter().rev().fold(0.0, |acc, c| acc * s + c);
+                let scale: f64 = a.iter().map(|c| c.abs()).sum();
+                assert!(
+                    (bernstein_at(&b0, s) - power).abs() <= 1e-12 * scale,
+                    "N = {N}, s = {s}"
+                );
+                assert!(
+                    (bernstein_at(&b1, s) + power).abs() <= 1e-12 * scale,
+                    "N = {N}, s = {s}"
+                );
+            }
+            // The end coefficients are the polynomial's ends.
+            assert_eq!(b0[0], a[0]);
+            let sum: f64 = a.iter().sum();
+            assert!((b0[N - 1] - sum).abs() <= 1e-12 * sum.abs().max(1.0));
+        }
+        check(&LOW_WEIGHTS);
+        check(&AFTER_ZERO_WEIGHTS);
+        check(&FULL_WEIGHTS);
     }
 }

@@ -383,7 +383,7 @@ pub(super) fn start<D: DriveModel>(model: &RelayModel<'_, D>, e0: f64) -> Propag
         y,
         modes,
         rec,
-        pieces: Vec::new(),
+        pieces: Vec::with_capacity(64),
         steps: 0,
         bound: EnergyBound::new(),
         ending: None,
