@@ -36,6 +36,16 @@ fn functions(source: &str) -> Vec<(String, String)> {
     names
 }
 
+/// The last path segment of what each `prefix…end` line of `lib` names,
+/// e.g. `py_run` of `m.add_function(wrap_pyfunction!(verdicts::py_run, m)?)?;`.
+fn registered<'a>(lib: &'a str, prefix: &str, end: char) -> Vec<&'a str> {
+    lib.lines()
+        .filter_map(|l| l.trim().strip_prefix(prefix))
+        .filter_map(|rest| rest.split(end).next())
+        .map(|path| path.rsplit("::").next().unwrap_or(path))
+        .collect()
+}
+
 #[test]
 fn every_function_and_class_the_module_adds_has_a_stub() {
     let stubs = read("chatterspice.pyi");
@@ -49,12 +59,7 @@ fn every_function_and_class_the_module_adds_has_a_stub() {
     }
     let all = functions(&sources);
     // The functions the module adds (`m.add_function(wrap_pyfunction!(x, m)`).
-    let added: Vec<&str> = lib
-        .lines()
-        .filter_map(|l| l.trim().strip_prefix("m.add_function(wrap_pyfunction!("))
-        .filter_map(|rest| rest.split(',').next())
-        .map(|path| path.rsplit("::").next().unwrap_or(path))
-        .collect();
+    let added = registered(&lib, "m.add_function(wrap_pyfunction!(", ',');
     assert!(added.len() >= 10, "{added:?}");
     for rust in &added {
         let (_, name) = all
@@ -66,12 +71,7 @@ fn every_function_and_class_the_module_adds_has_a_stub() {
             "chatterspice.pyi has no `def {name}(`"
         );
     }
-    let classes: Vec<&str> = lib
-        .lines()
-        .filter_map(|l| l.trim().strip_prefix("m.add_class::<"))
-        .filter_map(|rest| rest.split('>').next())
-        .map(|path| path.rsplit("::").next().unwrap_or(path))
-        .collect();
+    let classes = registered(&lib, "m.add_class::<", '>');
     assert!(classes.len() >= 5, "{classes:?}");
     for class in classes {
         assert!(

@@ -144,19 +144,19 @@ fn write_merged_summary(
     let seed = identity.as_ref().and_then(|i| i.seed);
     let grid = identity.as_ref().is_some_and(|i| i.seed.is_none());
     // The worst sample's values: a second pass over the rows.
-    let values_of = |index: u64| -> Result<Vec<f64>, SweepError> {
-        let mut found = None;
+    let mut worst_values = Vec::new();
+    if let Some(worst) = collected.worst_index() {
+        let mut found = false;
         super::resume::all_rows(output, header, keys.len(), signals.len(), columns, |r| {
-            if found.is_none() && r.index == index {
-                found = Some(r.values);
+            if !found && r.index == worst {
+                worst_values = r.values;
+                found = true;
             }
-            Ok::<_, super::resume::ResumeError>(())
-        })
-        .map_err(|e| SweepError::Write(std::io::Error::other(e.to_string())))?;
-        Ok(found.unwrap_or_default())
-    };
+            Ok::<_, MergeFilesError>(())
+        })?;
+    }
     let mut summary = collected
-        .summary_with(grid, seed, values_of)
+        .summary_with(grid, seed, |_| Ok(worst_values.clone()))
         .map_err(summary_error)?;
     summary.identity = Some(verified);
     let path = output.with_file_name("summary.json");

@@ -215,13 +215,14 @@ fn grid_panels(c: &Collected, sampler: &Sampler) -> Result<Vec<Panel>, SweepErro
     Ok(panels)
 }
 
-/// "2nd value of a, 4th of b": what a thinned grid plot shows.
+/// "2-th value of a, 4-th of b": what a thinned grid plot shows.
 fn thinning(stride: u64, series_stride: u64, keys: &[String]) -> String {
-    let nth = |k: u64| match k {
-        1 => "".to_owned(),
-        2 => "2nd ".to_owned(),
-        3 => "3rd ".to_owned(),
-        k => format!("{k}th "),
+    let nth = |k: u64| {
+        if k == 1 {
+            String::new()
+        } else {
+            format!("{k}-th ")
+        }
     };
     let mut parts = vec![format!("{}value of {}", nth(stride), keys[0])];
     if series_stride > 1 {

@@ -231,6 +231,11 @@ impl Collected {
         (m.count > 0).then_some((m.min, m.max))
     }
 
+    /// The worst sample's index (see the module overview), if any.
+    pub fn worst_index(&self) -> Option<u64> {
+        self.worst.as_ref().map(|w| w.index)
+    }
+
     /// Samples per number of edges of probe `p`.
     pub(super) fn edge_counts(&self, p: usize) -> &BTreeMap<u32, u64> {
         &self.edge_counts[p]
