@@ -516,16 +516,6 @@ fn read_measured(csv: &Path) -> Result<Vec<chatterspice::chatter::Interval>> {
     Ok(read_state_csv(&text, csv)?)
 }
 
-/// A PNG drawn without a font has no text: say how to get one.
-fn warn_if_no_fonts() {
-    if !report::png::fonts_available() {
-        eprintln!(
-            "warning: no font found, so the PNG plots have no text; install one \
-             (Debian: apt-get install fonts-dejavu-core) or use the SVG"
-        );
-    }
-}
-
 /// Fail before any work if `--out DIR` already holds a file the run
 /// would write (or something in the way of one, or an input).
 fn refuse_existing_bundle(dir: &Path, force: bool) -> Result<()> {

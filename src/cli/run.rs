@@ -60,7 +60,6 @@ pub(super) fn run(args: &RunArgs) -> Result<()> {
         )
         .context("the run succeeded, but its files could not be made")?;
         report::write_bundle(dir, &files, args.force)?;
-        warn_if_no_fonts();
     }
     emit(&text, None, false)
 }

@@ -15,7 +15,7 @@ use chatterspice::scenario::Scenario;
 use chatterspice::spice::Ngspice;
 use chatterspice::sweep::{self, Sampler, Shard, SweepMode, SweepOptions};
 
-use super::{SimulatorArgs, Status, emit, warn_if_no_fonts};
+use super::{SimulatorArgs, Status, emit};
 
 #[derive(Debug, Args)]
 pub struct SweepArgs {
@@ -166,9 +166,6 @@ pub fn sweep(args: &SweepArgs) -> Result<Status> {
         progress,
         |note| eprintln!("{note}"),
     )?;
-    if args.shard.is_none() {
-        warn_if_no_fonts();
-    }
     let summary = written.summary;
     let mut text = summary.render_table();
     text.push_str(&format!(

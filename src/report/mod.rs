@@ -16,6 +16,8 @@
 
 pub mod bundle;
 pub mod csv;
+#[cfg(feature = "png")]
+mod glyphs;
 pub mod json;
 #[cfg(feature = "png")]
 pub mod png;
