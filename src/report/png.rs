@@ -10,7 +10,7 @@
 //! draw either, and its output would no longer be byte-identical from run to
 //! run.)
 //!
-//! Text is drawn with the built-in stroke font ([`super::glyphs`]): each
+//! Text is drawn with the built-in stroke font (`src/report/glyphs.rs`): each
 //! `<text>` element becomes a stroked path before rendering, so a PNG has
 //! its labels on a machine without any fonts, and its look does not depend
 //! on which fonts a machine has. The SVG keeps its text as text.
