@@ -21,6 +21,7 @@ use resvg::tiny_skia::{Color, Pixmap, Transform};
 use resvg::usvg;
 
 use super::glyphs::{self, Pen};
+use super::svg::escape;
 use thiserror::Error;
 
 /// Pixels per SVG unit: twice the SVG's size, sharp on high-density screens.
@@ -174,26 +175,17 @@ fn outline_text(svg: &str) -> String {
             break;
         };
         let tag = &rest[..=close];
-        let name = tag_name(tag);
-        if name == "text"
+        if tag_name(tag) == "text"
             && !tag.ends_with("/>")
             && let Some(end) = rest.find("</text>")
         {
-            let attributes = attributes(&tag[5..tag.len() - 1]);
             let inner = &rest[close + 1..end];
             let style = styles.last().cloned().unwrap_or_default();
-            write_text(&style, &attributes, inner, &mut out);
+            write_text(&style, &tag_attributes(tag), inner, &mut out);
             rest = &rest[end + "</text>".len()..];
             continue;
         }
-        if tag.starts_with("</") {
-            if styles.len() > 1 {
-                styles.pop();
-            }
-        } else if !tag.starts_with("<!") && !tag.starts_with("<?") && !tag.ends_with("/>") {
-            let parent = styles.last().cloned().unwrap_or_default();
-            styles.push(parent.with(&attributes(&tag[1 + name.len()..tag.len() - 1])));
-        }
+        follow(&mut styles, tag);
         out.push_str(tag);
         rest = &rest[close + 1..];
     }
@@ -217,6 +209,25 @@ fn tag_end(s: &str) -> Option<usize> {
         }
     }
     None
+}
+
+/// The style stack after `tag`: a start tag pushes its element's style,
+/// an end tag pops it; comments, declarations and empty elements leave it.
+fn follow(styles: &mut Vec<TextStyle>, tag: &str) {
+    if tag.starts_with("</") {
+        if styles.len() > 1 {
+            styles.pop();
+        }
+    } else if !tag.starts_with("<!") && !tag.starts_with("<?") && !tag.ends_with("/>") {
+        let parent = styles.last().cloned().unwrap_or_default();
+        styles.push(parent.with(&tag_attributes(tag)));
+    }
+}
+
+/// The attributes of a start tag (`<name …>`), values unescaped.
+fn tag_attributes(tag: &str) -> Vec<(&str, String)> {
+    let start = 1 + tag_name(tag).len();
+    attributes(tag.get(start..tag.len() - 1).unwrap_or(""))
 }
 
 /// The element name of a tag (`"g"` for `<g fill="red">`, `</g>`).
@@ -319,21 +330,13 @@ fn write_text(inherited: &TextStyle, attributes: &[(&str, String)], inner: &str,
     let mut span_styles = vec![style.clone()];
     while !rest.is_empty() {
         let next = rest.find('<').unwrap_or(rest.len());
-        let current = span_styles.last().unwrap_or(&style).clone();
-        push(&current, &unescape(&rest[..next]), &mut runs);
+        let current = span_styles.last().unwrap_or(&style);
+        push(current, &unescape(&rest[..next]), &mut runs);
         rest = &rest[next..];
         let Some(close) = tag_end(rest) else {
             break;
         };
-        let tag = &rest[..=close];
-        if tag.starts_with("</") {
-            if span_styles.len() > 1 {
-                span_styles.pop();
-            }
-        } else if !tag.starts_with("<!") && !tag.ends_with("/>") {
-            let name = tag_name(tag);
-            span_styles.push(current.with(&self::attributes(&tag[1 + name.len()..tag.len() - 1])));
-        }
+        follow(&mut span_styles, &rest[..=close]);
         rest = &rest[close + 1..];
     }
     if let Some((_, last)) = runs.last_mut()
@@ -380,14 +383,6 @@ fn write_text(inherited: &TextStyle, attributes: &[(&str, String)], inner: &str,
             run.stroke_width(),
         );
     }
-}
-
-/// An attribute value, quoted for a double-quoted attribute.
-fn escape(value: &str) -> String {
-    value
-        .replace('&', "&amp;")
-        .replace('"', "&quot;")
-        .replace('<', "&lt;")
 }
 
 #[cfg(test)]
