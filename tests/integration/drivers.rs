@@ -325,17 +325,18 @@ fn every_driver_circuit_is_read_as_the_operations_it_makes() {
     for driver in &all {
         let scenario = scenario(dir.path(), driver);
         // Both couplings read operations the same way (the library does it
-        // on the coupled result); the passes also run where their iterated
-        // trajectory differs in kind: a plain pulse, a ringing snubber that
-        // re-closes, a supply dip and a PWM hold. The release checks
-        // (`CHATTERSPICE_LOCKSTEP_ALL=1`) run them on every driver but the
-        // rectified AC coil, whose ripple the passes' waveform relaxation
-        // does not settle within their 20 iterations.
+        // on the coupled result). The lock-step test compares the passes on
+        // a plain pulse and on a ringing snubber that re-closes; here they
+        // also run on a supply dip (1 s). The release checks
+        // (`CHATTERSPICE_LOCKSTEP_ALL=1`) run them on every driver (the PWM
+        // hold alone takes 13 s) but the rectified AC coil, whose ripple the
+        // passes' waveform relaxation does not settle within their 20
+        // iterations.
         let passes_too = if std::env::var_os("CHATTERSPICE_LOCKSTEP_ALL").is_some_and(|v| v == "1")
         {
             driver.name != "ac_bridge"
         } else {
-            ["npn_diode", "rc_snubber", "supply_dip_holds", "pwm_hold"].contains(&driver.name)
+            ["supply_dip_holds"].contains(&driver.name)
         };
         let schemes: &[Coupling] = if passes_too {
             &[Coupling::LockStep, Coupling::Passes]
@@ -351,5 +352,5 @@ fn every_driver_circuit_is_read_as_the_operations_it_makes() {
         }
     }
     // The snubber's ringing pulls the armature in again.
-    assert!(reclosures >= 2, "{reclosures}");
+    assert!(reclosures >= 1, "{reclosures}");
 }

@@ -20,7 +20,7 @@
 //! the sequence; a family driven short of the contact ends open. An
 //! opening below resolution (1 ns, 1 nm) is merged by both.
 //!
-//! `CHATTERSPICE_DIFFERENTIAL=N` sets the number of relays (300 by
+//! `CHATTERSPICE_DIFFERENTIAL=N` sets the number of relays (120 by
 //! default, for CI); `CHATTERSPICE_DIFFERENTIAL_SEED=S` the first seed.
 //! `scripts/differential` runs 10⁵ of them, optimised, for a release.
 
