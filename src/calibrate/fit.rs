@@ -44,8 +44,8 @@
 //! Levenberg–Marquardt with a central-difference Jacobian (the event
 //! times come out of an adaptive integrator, so there is no analytic
 //! derivative), Marquardt's diagonal scaling, and the parameters clamped
-//! into their bounds. It is a few dozen lines on nalgebra, which the crate
-//! already uses; the problem is tiny (≤ 6 parameters, tens of residuals),
+//! into their bounds. It is a few dozen lines on a small dense matrix of its
+//! own (`fit_dense.rs`); the problem is tiny (≤ 6 parameters, tens of residuals),
 //! and the candidates (dropped pairs) and held keys need control of the
 //! residual function that a general crate's trait would only wrap. With
 //! many bounces the misfit has local minima wherever the event count
@@ -81,6 +81,8 @@ use crate::scenario::{PrintedFigure, Scenario, ScenarioError};
 mod breaking;
 #[path = "fit_datasheet.rs"]
 mod datasheet;
+#[path = "fit_dense.rs"]
+mod dense;
 #[path = "fit_problem.rs"]
 mod problem;
 #[path = "fit_report.rs"]

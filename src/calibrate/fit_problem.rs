@@ -3,8 +3,7 @@
 //! point (the record's event times matched in order, the datasheet's
 //! figures as the datasheet measures them).
 
-use nalgebra::{DMatrix, DVector};
-
+use super::dense::Matrix;
 use super::{
     COUNT_PENALTY, DatasheetSection, Event, FitError, FitRequest, JACOBIAN_STEP, PRIOR_WEIGHT,
     RELATIVE_SCALE, TIME_SCALE, coil_tolerance_corner, datasheet_figures, events_of, model_events,
@@ -146,8 +145,8 @@ impl Problem<'_> {
         active: &[usize],
         f: impl Fn(&[f64]) -> Option<Vec<f64>>,
         rows: usize,
-    ) -> Option<DMatrix<f64>> {
-        let mut j = DMatrix::zeros(rows, active.len());
+    ) -> Option<Matrix> {
+        let mut j = Matrix::zeros(rows, active.len());
         for (col, &k) in active.iter().enumerate() {
             let mut up = u.to_vec();
             let mut down = u.to_vec();
@@ -179,16 +178,15 @@ impl Problem<'_> {
             let Some(j) = self.jacobian(&u, active, f, r.len()) else {
                 break;
             };
-            let jt = j.transpose();
-            let a = &jt * &j;
-            let g = &jt * DVector::from_vec(r.clone());
+            let a = j.gram();
+            let minus_g: Vec<f64> = j.tr_mul(&r).iter().map(|x| -x).collect();
             let mut improved = false;
             while lambda < 1e12 {
                 let mut damped = a.clone();
                 for d in 0..active.len() {
                     damped[(d, d)] += lambda * (a[(d, d)] + 1e-12);
                 }
-                let Some(step) = damped.lu().solve(&(-&g)) else {
+                let Some(step) = damped.solve(&minus_g) else {
                     lambda *= 10.0;
                     continue;
                 };
@@ -300,7 +298,7 @@ pub(super) type Point = (Vec<f64>, f64);
 pub(super) struct Held {
     pub(super) best: Point,
     pub(super) held: Vec<bool>,
-    pub(super) jacobian: Option<DMatrix<f64>>,
+    pub(super) jacobian: Option<Matrix>,
 }
 
 impl<'a> Problem<'a> {

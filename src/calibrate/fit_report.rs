@@ -4,8 +4,7 @@
 
 use std::time::Instant;
 
-use nalgebra::DMatrix;
-
+use super::dense::Matrix;
 use super::problem::{Evaluation, Held, event_residuals};
 use super::{
     BounceCount, Candidate, DatasheetSection, Determined, Event, EventKind, EventRow, FigureRow,
@@ -83,16 +82,16 @@ pub(super) fn uncertainties(
 /// `(JᵀJ)⁻¹·rms²`, rms² the data's mean square per degree of freedom.
 fn residual_covariance(
     problem: &Problem,
-    jacobian: Option<&DMatrix<f64>>,
+    jacobian: Option<&Matrix>,
     data: &[f64],
     active: usize,
-) -> Option<DMatrix<f64>> {
+) -> Option<Matrix> {
     let ssr: f64 = data.iter().map(|x| x * x).sum();
     let dof = problem.data_len().saturating_sub(active).max(1);
     let rms2 = ssr / dof as f64;
     jacobian
-        .and_then(|j| (j.transpose() * j).try_inverse())
-        .map(|c| c * rms2)
+        .and_then(|j| j.gram().inverse())
+        .map(|c| c.scaled(rms2))
 }
 
 /// The covariance of the log parameters from the datasheet figures'
@@ -100,10 +99,10 @@ fn residual_covariance(
 /// see them as keys, and no misfit left).
 fn figure_covariance(
     d: &DatasheetSection,
-    jacobian: Option<&DMatrix<f64>>,
+    jacobian: Option<&Matrix>,
     data: &[f64],
     active: usize,
-) -> (Option<DMatrix<f64>>, bool) {
+) -> (Option<Matrix>, bool) {
     let Some(j) = jacobian else {
         return (None, false);
     };
@@ -135,9 +134,7 @@ fn figure_covariance(
         .map(|x| (x * RELATIVE_SCALE).abs())
         .fold(0.0, f64::max);
     let exactly = seen == active && active > 0 && worst < EXACT_MISFIT;
-    let covariance = (weighted.transpose() * &weighted)
-        .try_inverse()
-        .map(|c| c * scale);
+    let covariance = weighted.gram().inverse().map(|c| c.scaled(scale));
     (covariance, exactly)
 }
 

@@ -2,8 +2,6 @@
 //! Levenberg–Marquardt refinement from the best of them, one bad edge set
 //! aside, and the keys the data cannot see held at their priors.
 
-use nalgebra::SymmetricEigen;
-
 use super::problem::{Candidate, Held, Point, Problem, halton};
 use super::{EXTRA_STARTS, SINGULAR_RATIO, SURVEY_PER_KEY, closed_form_start};
 
@@ -119,20 +117,24 @@ pub(super) fn hold_blind_keys(
         let Some(j) = problem.jacobian(&best.0, active, f, data_rows) else {
             break;
         };
-        let a = j.transpose() * &j;
-        let eigen = SymmetricEigen::new(a);
-        let max = eigen.eigenvalues.iter().cloned().fold(0.0, f64::max);
-        let (imin, min) = eigen.eigenvalues.iter().cloned().enumerate().fold(
-            (0, f64::INFINITY),
-            |acc, (i, v)| if v < acc.1 { (i, v) } else { acc },
-        );
+        let (eigenvalues, eigenvectors) = j.gram().symmetric_eigen();
+        let max = eigenvalues.iter().cloned().fold(0.0, f64::max);
+        let (imin, min) =
+            eigenvalues
+                .iter()
+                .cloned()
+                .enumerate()
+                .fold(
+                    (0, f64::INFINITY),
+                    |acc, (i, v)| if v < acc.1 { (i, v) } else { acc },
+                );
         if max > 0.0 && min > SINGULAR_RATIO * max {
             jacobian = Some(j);
             break;
         }
         // The key with the largest share of the blind direction; on a tie
         // (a pure ratio) the later key in the free list.
-        let v = eigen.eigenvectors.column(imin);
+        let v = eigenvectors.column(imin);
         let mut pick = 0;
         for i in 0..active.len() {
             if v[i].abs() >= v[pick].abs() - 1e-6 {

@@ -11,7 +11,7 @@ use std::fmt;
 pub const MAX_LOADED_BYTES: u64 = 4 << 30;
 
 /// A complex value of an AC (or other complex) plot.
-pub type Complex64 = nalgebra::Complex<f64>;
+pub type Complex64 = num_complex::Complex<f64>;
 
 /// Everything in one raw file.
 #[derive(Debug, Clone, PartialEq)]
