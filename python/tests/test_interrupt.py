@@ -4,6 +4,7 @@ interpreter with a temporary directory of its own (TMPDIR), which the
 work directories are made in and ngspice runs in."""
 
 import os
+import select
 import signal
 import subprocess
 import sys
@@ -82,6 +83,12 @@ def ngspice_running_in(directory):
     return any("ngspice" in name for _, name in processes_in(directory))
 
 
+# Ctrl-C as in an interactive Python. A shell that runs pytest in the
+# background (as CI scripts may) starts it with SIGINT ignored, and Python
+# then installs no KeyboardInterrupt handler in the script's process.
+INTERACTIVE = "import signal\nsignal.signal(signal.SIGINT, signal.default_int_handler)\n"
+
+
 def interrupt(tmp_path, script, sig, wait_for_ngspice):
     """Start `script`, wait until it prints `running` (and, if asked, until
     ngspice runs under tmp_path), send `sig`; returns the seconds from the
@@ -90,7 +97,7 @@ def interrupt(tmp_path, script, sig, wait_for_ngspice):
     work.mkdir()
     env = dict(os.environ, TMPDIR=str(work))
     child = subprocess.Popen(
-        [sys.executable, "-c", script],
+        [sys.executable, "-c", INTERACTIVE + script],
         cwd=tmp_path,
         env=env,
         stdout=subprocess.PIPE,
@@ -105,6 +112,9 @@ def interrupt(tmp_path, script, sig, wait_for_ngspice):
             time.sleep(0.01)
         sent = time.monotonic()
         child.send_signal(sig)
+        # A call the signal did not stop must fail the test, not hang it.
+        ready, _, _ = select.select([child.stdout], [], [], 30)
+        assert ready, f"the script said nothing in the 30 s after {sig.name}"
         last = child.stdout.readline().strip()
         elapsed = time.monotonic() - sent
         child.wait(timeout=30)
