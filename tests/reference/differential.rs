@@ -853,3 +853,84 @@ fn slowest_relays() {
     }
     assert!(total > 0.0);
 }
+
+/// The engine's whole records (every impact's times, velocities, forces
+/// and openings, the pole face's, the ending) on the random relays at
+/// both horizons, written to the file `CHATTERSPICE_DUMP` names: a change
+/// that should not move a result is checked by dumping before and after
+/// and comparing the numbers. A tool, not a check. Run it optimised:
+/// `CHATTERSPICE_DUMP=/tmp/a CHATTERSPICE_DIFFERENTIAL=400 cargo test
+/// --release --test integration record_dump -- --ignored`.
+#[test]
+#[ignore = "a tool for comparing the engine's records before and after a change"]
+fn record_dump() {
+    use std::fmt::Write as _;
+    let Ok(path) = std::env::var("CHATTERSPICE_DUMP") else {
+        return;
+    };
+    let (n, first) = (count(), first_seed());
+    let mut out = String::new();
+    for seed in first..first + n {
+        let relay = relay(seed);
+        let t_end = if seed % 3 == 0 {
+            1.5e-3 + 8.5e-3 * Draw::new(seed ^ 0x7E7D).unit()
+        } else {
+            0.02
+        };
+        for horizon in [t_end, 2.0 * t_end] {
+            match relay.engine(horizon) {
+                Ok(run) => writeln!(
+                    out,
+                    "seed {seed} t_end {horizon:e}: {:?} settle {:?} impacts {:?} pole {:?}",
+                    run.contact.outcome,
+                    run.contact.settle_time,
+                    run.contact.impacts,
+                    run.pole_face
+                ),
+                Err(e) => writeln!(out, "seed {seed} t_end {horizon:e}: error {e}"),
+            }
+            .expect("a string takes it");
+        }
+    }
+    // The speed bench's relay (benches/mechanics.rs): the paper's
+    // reference sequence carried on a blade.
+    let m = Mechanics {
+        mass: 1.0,
+        stiffness: 1.0,
+        damping: 0.1,
+        force: 1.0,
+        gap: 0.9,
+        initial_position: 0.0,
+        initial_velocity: 0.0,
+        preload: 0.0,
+    };
+    let stops = Stops {
+        make: Surface::KelvinVoigt {
+            stiffness: 100.0,
+            damping: 2.0 * 0.4692,
+        },
+        back: None,
+    };
+    let build = TwoStage {
+        blade: Some(Blade {
+            mass: 0.2,
+            stiffness: 100.0,
+            damping: 1.0,
+        }),
+        pole_face: None,
+        release: Release::Position,
+    };
+    let settings = Settings {
+        t_end: 100.0,
+        ..Settings::default()
+    };
+    let run = simulate_two_stage(&m, &build, &stops, &settings, Drive::Step, Horizon::Closing)
+        .expect("the bench relay runs");
+    writeln!(
+        out,
+        "bench: {:?} settle {:?} impacts {:?} steps {}",
+        run.contact.outcome, run.contact.settle_time, run.contact.impacts, run.steps
+    )
+    .expect("a string takes it");
+    std::fs::write(&path, out).expect("the dump is written");
+}

@@ -116,43 +116,77 @@ struct ModeKit {
     mode: Arc<LinearMode>,
     forms: Vec<Series>,
     guards: Vec<(Which, Guard)>,
-    /// The forms' values (rows 0–3) and rates (rows 4–7) as one affine map
-    /// of `w`, rows of absent forms zero: a step reads them in one product.
-    readout: SMatrix<f64, 8, 4>,
-    offset: SVector<f64, 8>,
-    /// `readout · Φ`: the same read at the end of a full step, from the
-    /// state at its start (so that it need not wait for that state).
-    readout_after: SMatrix<f64, 8, 4>,
+    readout: Readout,
+}
+
+/// The forms' values and rates as one affine map of `w`, so that a step
+/// reads them in one product: a relay without a pole face has two forms
+/// (four rows: the values, then the rates), one with a pole face four
+/// (eight rows). `after` is `at · Φ`: the same read at the end of a full
+/// step, from the state at its start (so that it need not wait for that
+/// state).
+// One per mode and run, read on every step: kept inline, not boxed.
+#[allow(clippy::large_enum_variant)]
+enum Readout {
+    Two {
+        at: Matrix4<f64>,
+        after: Matrix4<f64>,
+        offset: Vector4<f64>,
+    },
+    Four {
+        at: SMatrix<f64, 8, 4>,
+        after: SMatrix<f64, 8, 4>,
+        offset: SVector<f64, 8>,
+    },
 }
 
 impl ModeKit {
     fn new(mode: Arc<LinearMode>, forms: Vec<Series>, guards: Vec<(Which, Guard)>) -> ModeKit {
-        let mut readout = SMatrix::<f64, 8, 4>::zeros();
+        let n = forms.len();
+        let mut at = SMatrix::<f64, 8, 4>::zeros();
         let mut offset = SVector::<f64, 8>::zeros();
         for (i, form) in forms.iter().enumerate() {
-            readout.set_row(i, &form.r[0].transpose());
-            readout.set_row(4 + i, &form.r[1].transpose());
+            at.set_row(i, &form.r[0].transpose());
+            at.set_row(n + i, &form.r[1].transpose());
             offset[i] = form.k;
         }
+        let readout = if n <= 2 {
+            let at: Matrix4<f64> = at.fixed_rows::<4>(0).into_owned();
+            Readout::Two {
+                after: at * mode.phi,
+                at,
+                offset: offset.fixed_rows::<4>(0).into_owned(),
+            }
+        } else {
+            Readout::Four {
+                after: at * mode.phi,
+                at,
+                offset,
+            }
+        };
         ModeKit {
-            readout_after: readout * mode.phi,
             mode,
             forms,
             guards,
             readout,
-            offset,
         }
     }
 
     /// The forms' values and rates at `w` (zero for forms the mode has
-    /// not: a relay without a pole face reads two, not four).
+    /// not).
     fn read(&self, w: &W) -> Reading {
-        Reading::of(&(self.readout * w + self.offset))
+        match &self.readout {
+            Readout::Two { at, offset, .. } => Reading::two(&(at * w + offset)),
+            Readout::Four { at, offset, .. } => Reading::four(&(at * w + offset)),
+        }
     }
 
     /// The forms' values and rates after a full step of the mode from `w`.
     fn read_after_step(&self, w: &W) -> Reading {
-        Reading::of(&(self.readout_after * w + self.offset))
+        match &self.readout {
+            Readout::Two { after, offset, .. } => Reading::two(&(after * w + offset)),
+            Readout::Four { after, offset, .. } => Reading::four(&(after * w + offset)),
+        }
     }
 }
 
@@ -164,7 +198,16 @@ struct Reading {
 }
 
 impl Reading {
-    fn of(v: &SVector<f64, 8>) -> Reading {
+    /// Two forms' values and rates (the others zero).
+    fn two(v: &Vector4<f64>) -> Reading {
+        Reading {
+            value: [v[0], v[1], 0.0, 0.0],
+            rate: [v[2], v[3], 0.0, 0.0],
+        }
+    }
+
+    /// Four forms' values and rates.
+    fn four(v: &SVector<f64, 8>) -> Reading {
         Reading {
             value: [v[0], v[1], v[2], v[3]],
             rate: [v[4], v[5], v[6], v[7]],

@@ -116,8 +116,10 @@ pub(super) struct Series {
     /// full step) of the series' first [`LOW_TERMS`] terms, as rows to dot
     /// with `w0`: `b_j = k + Σ_i bern[i][j] w0_i`. Kept by column, so that
     /// the thirteen coefficients of a step are had in four vector
-    /// products.
-    pub(super) bern: [[f64; LOW_TERMS]; 4],
+    /// products, and padded to an even length with the last one repeated
+    /// (the test is of every coefficient, so a repeated one changes
+    /// nothing), so that they go two at a time.
+    pub(super) bern: [[f64; LOW_PADDED]; 4],
     /// `max_j ‖bern_j‖₁`, for the rounding of `bern_j·w0`.
     pub(super) bern_norm: f64,
     /// The same for `(f(s) − f(0))/s`, the sign of a form that starts a
@@ -140,6 +142,9 @@ pub(super) struct Series {
 /// 1e-4 of the form's swing over a step).
 pub(super) const LOW_TERMS: usize = 13;
 
+/// [`LOW_TERMS`] rounded up to an even number.
+const LOW_PADDED: usize = LOW_TERMS.next_multiple_of(2);
+
 impl Series {
     pub(super) fn new(mode: &LinearMode, c: [f64; 4], d: f64) -> Series {
         let eq = &mode.eq;
@@ -160,7 +165,7 @@ impl Series {
         let tail: f64 = norms[LOW_TERMS..].iter().sum();
         let rows = bernstein_rows(&scaled[..LOW_TERMS], &LOW_WEIGHTS);
         let bern_norm = rows.iter().map(|b| b.abs().sum()).fold(0.0, f64::max);
-        let bern = std::array::from_fn(|i| rows.map(|b| b[i]));
+        let bern = std::array::from_fn(|i| std::array::from_fn(|j| rows[j.min(LOW_TERMS - 1)][i]));
         // (f − f(0))/s = Σ_{k≥1} a_k s^{k−1}: degree LOW_TERMS − 2.
         let bern_after_zero = bernstein_rows(&scaled[1..LOW_TERMS], &AFTER_ZERO_WEIGHTS);
         Series {
@@ -267,11 +272,19 @@ impl Series {
     /// the rest and the rounding (`rounding`). Over the mode's full step,
     /// so it holds for a shorter last step too.
     fn positive_over_step(&self, w0: &W, scale: f64, rounding: f64, negated: bool) -> bool {
-        let sign = if negated { -1.0 } else { 1.0 };
         let margin = self.tail * scale * (1.0 + 1e-9) + rounding;
+        let b = rows_at(self.k, &self.bern, w0);
+        // Every coefficient clear of the margin (a NaN is not), without a
+        // branch per coefficient.
         let mut clear = true;
-        for b in rows_at(self.k, &self.bern, w0) {
-            clear &= sign * b > margin;
+        if negated {
+            for b in b {
+                clear &= -b > margin;
+            }
+        } else {
+            for b in b {
+                clear &= b > margin;
+            }
         }
         clear
     }
@@ -342,7 +355,12 @@ fn bernstein_rows<const N: usize>(scaled: &[W], weights: &[[f64; N]; N]) -> [W; 
 /// column.
 fn rows_at<const N: usize>(k: f64, rows: &[[f64; N]; 4], w0: &W) -> [f64; N] {
     let [c0, c1, c2, c3] = rows;
-    std::array::from_fn(|j| k + (((c0[j] * w0[0] + c1[j] * w0[1]) + c2[j] * w0[2]) + c3[j] * w0[3]))
+    let (w0, w1, w2, w3) = (w0[0], w0[1], w0[2], w0[3]);
+    let mut b = [0.0; N];
+    for j in 0..N {
+        b[j] = k + (((c0[j] * w0 + c1[j] * w1) + c2[j] * w2) + c3[j] * w3);
+    }
+    b
 }
 
 /// `1/k` for the series' terms.
