@@ -860,7 +860,7 @@ fn slowest_relays() {
 /// that should not move a result is checked by dumping before and after
 /// and comparing the numbers. A tool, not a check. Run it optimised:
 /// `CHATTERSPICE_DUMP=/tmp/a CHATTERSPICE_DIFFERENTIAL=400 cargo test
-/// --release --test integration record_dump -- --ignored`.
+/// --release --test reference record_dump -- --ignored`.
 #[test]
 #[ignore = "a tool for comparing the engine's records before and after a change"]
 fn record_dump() {
