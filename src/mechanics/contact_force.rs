@@ -7,7 +7,7 @@
 //! the state it depends on: Kelvin–Voigt in closed form, Hunt–Crossley by
 //! the same integration as the engine with its dense output.
 
-use nalgebra::Vector2;
+use crate::mechanics::linalg::Vector2;
 
 use super::engine::kelvin_voigt_contact;
 use super::error::MechanicsError;

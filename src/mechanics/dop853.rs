@@ -20,7 +20,7 @@
 
 #![allow(clippy::excessive_precision)]
 
-use nalgebra::SVector;
+use crate::mechanics::linalg::SVector;
 
 use super::error::MechanicsError;
 use super::step_control::{StepTolerance, trial_step};
@@ -619,7 +619,7 @@ fn inverse_16th_root(x: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::Vector2;
+    use crate::mechanics::linalg::Vector2;
 
     #[test]
     fn inverse_16th_root_is_within_its_bound() {
@@ -743,12 +743,14 @@ mod tests {
         // steps (M = 2).
         let tol = StepTolerance {
             rtol: 1e-9,
-            atol: nalgebra::Vector3::new(1e-9, 1e-9, f64::NAN),
+            atol: crate::mechanics::linalg::Vector3::new(1e-9, 1e-9, f64::NAN),
         };
         let mut s = Dop853::new(
-            |_t, y: &nalgebra::Vector3<f64>| nalgebra::Vector3::new(y[1], -y[0], y[0]),
+            |_t, y: &crate::mechanics::linalg::Vector3<f64>| {
+                crate::mechanics::linalg::Vector3::new(y[1], -y[0], y[0])
+            },
             0.0,
-            nalgebra::Vector3::new(1.0, 0.0, 0.0),
+            crate::mechanics::linalg::Vector3::new(1.0, 0.0, 0.0),
             1e-2,
             tol,
         )

@@ -20,7 +20,7 @@
 //! (`sign_change`). Steps are far shorter than any oscillation (≈ 1000 a
 //! period at the tolerance used), so a part holds at most one sign change.
 
-use nalgebra::Vector3;
+use crate::mechanics::linalg::Vector3;
 
 use super::error::DriveError;
 use super::integrate::{Dopri5Step, StepTolerance};

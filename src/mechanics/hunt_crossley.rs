@@ -35,7 +35,7 @@
 //!   and happens in finite time whenever the in-contact equilibrium lies
 //!   past the surface (k0 < 1).
 
-use nalgebra::Vector3;
+use crate::mechanics::linalg::Vector3;
 
 use super::dop853::{Dense, Dop853, Dop853Step};
 use super::error::{MAX_CONTACT_STEPS, MechanicsError};

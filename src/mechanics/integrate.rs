@@ -14,7 +14,7 @@
 //! [`Dopri5Step`]), checks its events on the step, and stops when it likes; so
 //! events are bracketed by the step and polished on the interpolant.
 
-use nalgebra::SVector;
+use crate::mechanics::linalg::SVector;
 
 use super::error::MechanicsError;
 pub use super::step_control::StepTolerance;
@@ -206,7 +206,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::Vector2;
+    use crate::mechanics::linalg::Vector2;
 
     fn oscillator_error(rtol: f64) -> f64 {
         // ẍ = −x, x(0) = 1: x = cos t.

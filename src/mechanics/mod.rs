@@ -52,6 +52,7 @@ mod error;
 pub mod forced;
 pub mod hunt_crossley;
 pub mod integrate;
+pub mod linalg;
 pub mod linear;
 pub(crate) mod locate;
 mod parameters;

@@ -2,7 +2,7 @@
 //! (Dormand–Prince 5(4) and DOP853): the tolerance a step must meet, and
 //! the step to try next, refused once it has shrunk to rounding level.
 
-use nalgebra::SVector;
+use crate::mechanics::linalg::SVector;
 
 use super::error::MechanicsError;
 

@@ -35,7 +35,7 @@
 
 use std::sync::Arc;
 
-use nalgebra::{Matrix4, SMatrix, SVector, Vector4};
+use crate::mechanics::linalg::{Matrix4, SMatrix, SVector, Vector4};
 
 use super::linear_mode::{LinearMode, Poly, STEP_NORM, Series, W};
 use super::model::{RelayModel, StopMode, StopModes, Which, Y};

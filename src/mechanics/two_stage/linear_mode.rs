@@ -4,7 +4,7 @@
 //! ([`Series`]) as scalar polynomials in τ ([`Poly`]) whose roots and
 //! extrema locate events.
 
-use nalgebra::{Matrix4, Vector4};
+use crate::mechanics::linalg::{Matrix4, Vector4};
 
 use super::model::Y;
 

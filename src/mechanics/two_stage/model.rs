@@ -3,7 +3,7 @@
 //! the forces on the armature and the blade, the equations of motion in
 //! each mode and the event function of each stop.
 
-use nalgebra::SVector;
+use crate::mechanics::linalg::SVector;
 
 use super::relay::{Release, TwoStage};
 use crate::mechanics::driven::DriveModel;
