@@ -444,17 +444,22 @@ fn engine_events(run: &TwoStageRun, horizon: f64) -> Vec<Ev> {
     out
 }
 
+/// The horizon of the relay of `seed`: a third of the relays run to a
+/// short one (1.5–10 ms), often inside the sequence or the pole face's
+/// burst, the rest to 20 ms.
+fn t_end_of(seed: u64) -> f64 {
+    if seed % 3 == 0 {
+        1.5e-3 + 8.5e-3 * Draw::new(seed ^ 0x7E7D).unit()
+    } else {
+        0.02
+    }
+}
+
 /// Compare the engine with the reference on the relay of `seed`: `Ok` with
 /// the number of contact events and the ending, or what differed.
 pub fn compare(seed: u64) -> Result<(usize, Outcome), String> {
     let relay = relay(seed);
-    // A third of the relays run to a short horizon, often inside the
-    // sequence or the pole face's burst.
-    let t_end = if seed % 3 == 0 {
-        1.5e-3 + 8.5e-3 * Draw::new(seed ^ 0x7E7D).unit()
-    } else {
-        0.02
-    };
+    let t_end = t_end_of(seed);
     let run = relay
         .engine(t_end)
         .map_err(|e| format!("seed {seed}: the engine failed: {e}\n{relay:?}"))?;
@@ -816,7 +821,7 @@ fn endings_are_proven_whatever_t_end() {
 /// The engine's time on each relay of the random families (both horizons
 /// the comparison runs), the slowest printed: a survey, not a check (speed
 /// is held by `cargo bench --bench mechanics`). Run it optimised:
-/// `CHATTERSPICE_DIFFERENTIAL=3000 cargo test --release --test integration
+/// `CHATTERSPICE_DIFFERENTIAL=3000 cargo test --release --test reference
 /// slowest_relays -- --ignored --nocapture`.
 #[test]
 #[ignore = "a timing survey; run it by name, optimised"]
@@ -825,11 +830,7 @@ fn slowest_relays() {
     let mut times: Vec<(f64, u64, usize, Outcome)> = Vec::new();
     for seed in first..first + n {
         let relay = relay(seed);
-        let t_end = if seed % 3 == 0 {
-            1.5e-3 + 8.5e-3 * Draw::new(seed ^ 0x7E7D).unit()
-        } else {
-            0.02
-        };
+        let t_end = t_end_of(seed);
         for horizon in [t_end, 2.0 * t_end] {
             let start = std::time::Instant::now();
             let run = relay.engine(horizon);
@@ -873,11 +874,7 @@ fn record_dump() {
     let mut out = String::new();
     for seed in first..first + n {
         let relay = relay(seed);
-        let t_end = if seed % 3 == 0 {
-            1.5e-3 + 8.5e-3 * Draw::new(seed ^ 0x7E7D).unit()
-        } else {
-            0.02
-        };
+        let t_end = t_end_of(seed);
         for horizon in [t_end, 2.0 * t_end] {
             match relay.engine(horizon) {
                 Ok(run) => writeln!(
