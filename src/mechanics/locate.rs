@@ -366,6 +366,48 @@ pub(crate) fn first_zero(
     Some((lo, hi))
 }
 
+/// Where a form changes sign over the step, for a search of every zero
+/// (not only the first): intervals `[lo, hi]` of the step's own time,
+/// each holding one zero (the form's Bernstein coefficients there change
+/// sign once and its ends differ), or an interval of `leaf` or less
+/// where the coefficients could not decide (a zero touched, two zeros
+/// closer than `leaf`). Outside them the form keeps one sign. At most
+/// `N` are found (the earliest); `None` when there were more.
+pub(crate) fn sign_changes<const N: usize>(
+    f: &StepForm,
+    leaf: f64,
+) -> Option<([(f64, f64); N], usize)> {
+    let mut out = ([(0.0, 0.0); N], 0);
+    let leaf = leaf.max(0.5f64.powi(MAX_DEPTH as i32));
+    changes(&Bernstein::of(f), (0.0, 1.0), leaf, &mut out).then_some(out)
+}
+
+/// [`sign_changes`] over `[lo, hi]`, its form `b` there, into `out`:
+/// `false` when `out` is full.
+fn changes<const N: usize>(
+    b: &Bernstein,
+    (lo, hi): (f64, f64),
+    leaf: f64,
+    out: &mut ([(f64, f64); N], usize),
+) -> bool {
+    if b.sign() != Sign::Unknown {
+        return true;
+    }
+    let (start, end) = b.ends();
+    let apart = start.abs() > b.noise && end.abs() > b.noise && (start > 0.0) != (end > 0.0);
+    if (apart && b.variations() <= 1) || hi - lo <= leaf {
+        if out.1 == N {
+            return false;
+        }
+        out.0[out.1] = (lo, hi);
+        out.1 += 1;
+        return true;
+    }
+    let mid = 0.5 * (lo + hi);
+    let (left, right) = b.split();
+    changes(&left, (lo, mid), leaf, out) && changes(&right, (mid, hi), leaf, out)
+}
+
 /// Whether the coefficients alone show the guard positive over the whole
 /// step (`f(s) ≥ a_0 − Σ_{k≥1} |a_k|`): the common step, far from every
 /// stop, costs no Bernstein form.

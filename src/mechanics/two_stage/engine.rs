@@ -328,7 +328,9 @@ fn pole_limit<D: DriveModel>(model: &RelayModel<'_, D>, y: &Y, time: f64) -> Opt
 }
 
 /// Peak and minimum contact forces and the largest opening after each
-/// release, sampled on the dense output of a step up to `t1`.
+/// release over a step up to `t1`, on its dense output: at the step's
+/// ends and at [`SAMPLES`] points, and where the watched quantity's rate
+/// on the interpolant vanishes ([`interpolant_extremes`]).
 fn sample<D: DriveModel>(
     model: &RelayModel<'_, D>,
     dense: &Dense<5>,
@@ -336,17 +338,107 @@ fn sample<D: DriveModel>(
     modes: StopModes,
     rec: &mut Tally,
 ) {
+    let force = |y: &Y| match modes.contact {
+        // Pressed on a rigid contact: the blade's spring is the force.
+        StopMode::Pressed => model.blade_force(y),
+        // F_c = max(0, ·) released by force: zero, not a rounding
+        // below it, where the contact lets go.
+        _ if model.build.release == Release::Force => law(&model.contact, y[2], y[3]).max(0.0),
+        _ => law(&model.contact, y[2], y[3]),
+    };
     let t0 = dense.t0;
     for k in 0..=SAMPLES {
         let t = t0 + (t1 - t0) * k as f64 / SAMPLES as f64;
-        rec.observe(model.g(), modes, &dense.at(t), |y| match modes.contact {
-            // Pressed on a rigid contact: the blade's spring is the force.
-            StopMode::Pressed => model.blade_force(y),
-            // F_c = max(0, ·) released by force: zero, not a rounding
-            // below it, where the contact lets go.
-            _ if model.build.release == Release::Force => law(&model.contact, y[2], y[3]).max(0.0),
-            _ => law(&model.contact, y[2], y[3]),
-        });
+        rec.observe(model.g(), modes, &dense.at(t), force);
+    }
+    interpolant_extremes(model, dense, t1, modes, |t| {
+        rec.observe(model.g(), modes, &dense.at(t), force);
+    });
+}
+
+/// Every time in the step up to `t1` where the quantity the record
+/// watches (the open blade's position, or the engaged contact's force)
+/// turns on the step's interpolant, handed to `take`. The interpolant is
+/// a polynomial of degree 7 in `θ = (t − t0)/h`, so the blade's position
+/// and a Kelvin–Voigt or blade force are polynomials too, and a
+/// Hunt–Crossley force `k δⁿ (1 + χ δ̇)` turns where
+/// `n δ' (1 + χ δ̇) + χ δ δ̇'` vanishes (degree 13): their zeros are
+/// isolated on the Bernstein form ([`locate::sign_changes`]) and bisected.
+fn interpolant_extremes<D: DriveModel>(
+    model: &RelayModel<'_, D>,
+    dense: &Dense<5>,
+    t1: f64,
+    modes: StopModes,
+    mut take: impl FnMut(f64),
+) {
+    let h = dense.t1 - dense.t0;
+    if !(h > 0.0 && t1 > dense.t0) {
+        return;
+    }
+    let end = ((t1 - dense.t0) / h).min(1.0);
+    let m = dense.monomial();
+    let poly = |i: usize| -> [f64; 8] { std::array::from_fn(|k| m[k][i]) };
+    let slope = |p: &[f64; 8]| -> [f64; 7] { std::array::from_fn(|k| (k + 1) as f64 * p[k + 1]) };
+    // The rate's coefficients in θ (up to 14).
+    let mut rate = [0.0; 14];
+    let linear = |rate: &mut [f64; 14], c: [f64; 4]| {
+        let p: [[f64; 8]; 4] = std::array::from_fn(poly);
+        for k in 0..7 {
+            rate[k] = (0..4).map(|i| c[i] * (k + 1) as f64 * p[i][k + 1]).sum();
+        }
+        7
+    };
+    let n = match (modes.contact, &model.contact) {
+        (StopMode::Open, _) => linear(&mut rate, [0.0, 0.0, 1.0, 0.0]),
+        (StopMode::Pressed, _) => match &model.build.blade {
+            Some(b) => linear(
+                &mut rate,
+                [b.stiffness, b.damping, -b.stiffness, -b.damping],
+            ),
+            None => return,
+        },
+        (_, Surface::KelvinVoigt { stiffness, damping }) => {
+            linear(&mut rate, [0.0, 0.0, *stiffness, *damping])
+        }
+        (_, Surface::HuntCrossley { exponent, chi, .. }) => {
+            let (p, v) = (poly(2), poly(3));
+            let (dp, dv) = (slope(&p), slope(&v));
+            // n P' (1 + χ V) + χ P V'
+            for i in 0..7 {
+                rate[i] += exponent * dp[i];
+                for j in 0..8 {
+                    rate[i + j] += exponent * chi * dp[i] * v[j] + chi * p[j] * dv[i];
+                }
+            }
+            14
+        }
+        (_, Surface::Rigid { .. }) => return,
+    };
+    let rate = &rate[..n];
+    let value = |theta: f64| rate.iter().rev().fold(0.0, |acc, &c| acc * theta + c);
+    let form = StepForm::scaled(rate, end);
+    let Some((brackets, count)) = locate::sign_changes::<8>(&form, 1e-6) else {
+        // More turns than a step of an accurate integrator has: take the
+        // interpolant at every 1/64 of the step.
+        for k in 1..64 {
+            take(dense.t0 + h * end * k as f64 / 64.0);
+        }
+        return;
+    };
+    for &(lo, hi) in &brackets[..count] {
+        let (mut a, mut b) = (lo * end, hi * end);
+        let (va, vb) = (value(a), value(b));
+        if va != 0.0 && vb != 0.0 && (va > 0.0) != (vb > 0.0) {
+            for _ in 0..60 {
+                let mid = 0.5 * (a + b);
+                if (value(mid) > 0.0) == (va > 0.0) {
+                    a = mid;
+                } else {
+                    b = mid;
+                }
+            }
+        }
+        take(dense.t0 + h * 0.5 * (a + b));
     }
 }
 

@@ -37,7 +37,7 @@ use std::sync::Arc;
 
 use crate::mechanics::linalg::{Matrix4, SMatrix, SVector, Vector4};
 
-use super::linear_mode::{LinearMode, Poly, STEP_NORM, Series, W};
+use super::linear_mode::{LinearMode, Poly, STEP_NORM, Series, StepBernstein, W};
 use super::model::{RelayModel, StopMode, StopModes, Which, Y};
 use super::propagation::{Propagation, check_closing};
 use super::relay::Release;
@@ -215,19 +215,51 @@ impl Reading {
     }
 }
 
-/// The forms' polynomials over one step, each built when first needed.
+/// The forms' polynomials and Bernstein coefficients over one step, each
+/// built when first needed.
 struct StepPolys<'a> {
     kit: &'a ModeKit,
     w0: &'a W,
     y0: &'a Y,
     polys: [Option<Poly>; 4],
+    bern: [Option<StepBernstein>; 4],
 }
 
 impl StepPolys<'_> {
+    fn new<'a>(kit: &'a ModeKit, w0: &'a W, y0: &'a Y) -> StepPolys<'a> {
+        StepPolys {
+            kit,
+            w0,
+            y0,
+            polys: [None; 4],
+            bern: [None; 4],
+        }
+    }
+
     /// The polynomial of form `form` (not negated), built on first use.
     fn of(&mut self, form: usize) -> &Poly {
         let (kit, w0, y0) = (self.kit, self.w0, self.y0);
         self.polys[form].get_or_insert_with(|| kit.forms[form].poly(w0, y0))
+    }
+
+    /// The Bernstein coefficients of form `form` over the mode's full
+    /// step, computed on first use.
+    fn bernstein(&mut self, form: usize) -> StepBernstein {
+        let (kit, w0) = (self.kit, self.w0);
+        *self.bern[form].get_or_insert_with(|| kit.forms[form].step_bernstein(w0))
+    }
+
+    /// Whether `term` stays positive over the step, read as `at0` at its
+    /// start, as its series shows without a polynomial (see
+    /// [`Series::shown_positive`]): most steps need no more.
+    fn stays_positive(&mut self, term: Term, at0: &Reading) -> bool {
+        let form = &self.kit.forms[term.form];
+        form.shown_positive(
+            term.value(at0),
+            self.w0,
+            term.negated,
+            &mut self.bern[term.form],
+        )
     }
 }
 
@@ -444,6 +476,12 @@ impl LinearSystem {
         Some(0.5 * self.s * xa * xa - self.net * xa + 0.5 * series * o * o)
     }
 
+    /// N, the contact's force as recorded from the law's value `f`: not
+    /// below zero for a contact released by force.
+    fn force(&self, f: f64) -> f64 {
+        if self.by_force { f.max(0.0) } else { f }
+    }
+
     fn below(&self, e: f64, bound: f64) -> bool {
         let margin = 1e-9 * (e.abs() + bound.abs() + self.s * self.gap * self.gap);
         e < bound - margin
@@ -515,13 +553,6 @@ fn turns(term: Term, at0: &Reading, at1: &Reading) -> bool {
     r0 != 0.0 && r1 != 0.0 && (r0 > 0.0) != (r1 > 0.0)
 }
 
-/// Whether `term` stays positive over a step from `w0` (read as `at0`),
-/// as its series shows without a polynomial (see
-/// [`Series::shown_positive`]): most steps need no more.
-fn stays_positive(kit: &ModeKit, term: Term, w0: &W, at0: &Reading) -> bool {
-    kit.forms[term.form].shown_positive(term.value(at0), w0, term.negated)
-}
-
 /// The first event over `(0, h]` of a step from `w0` (read as `at0`):
 /// (τ, which). Every guard is searched by the one event locator
 /// ([`crate::mechanics::locate`]), which cannot step over a zero of the
@@ -535,13 +566,12 @@ fn first_event(
     resolution: f64,
 ) -> Option<(f64, Which)> {
     let mut best: Option<(f64, Which)> = None;
-    for &(which, guard) in &polys.kit.guards {
-        let (kit, w0) = (polys.kit, polys.w0);
-        let positive = |t: Term| stays_positive(kit, t, w0, at0);
+    let kit = polys.kit;
+    for &(which, guard) in &kit.guards {
         let quick = match guard {
-            Guard::One(t) => positive(t),
-            Guard::Max(a, b) => positive(a) || positive(b),
-            Guard::Min(a, b) => positive(a) && positive(b),
+            Guard::One(t) => polys.stays_positive(t, at0),
+            Guard::Max(a, b) => polys.stays_positive(a, at0) || polys.stays_positive(b, at0),
+            Guard::Min(a, b) => polys.stays_positive(a, at0) && polys.stays_positive(b, at0),
         };
         if quick {
             continue;
@@ -643,6 +673,10 @@ pub(crate) fn propagate<D: DriveModel>(
         let mode = &kit.mode;
         let mut w = mode.w_of(&p.y);
         let mut at0 = kit.read(&w);
+        // The mode's first state is the record's too: a damped contact's
+        // force can be largest at the touch itself (r0 times the impact
+        // speed), before its spring takes over.
+        observe(system, p, &at0);
         // The steps not yet in a piece: from `t0` and `w0`, each `mode.h`
         // long but the last.
         let (mut t0, mut w0, mut held) = (p.t, w, 0);
@@ -666,12 +700,7 @@ pub(crate) fn propagate<D: DriveModel>(
                 (w1, kit.read(&w1))
             };
             let y0 = p.y;
-            let mut polys = StepPolys {
-                kit: &kit,
-                w0: &w,
-                y0: &y0,
-                polys: [None; 4],
-            };
+            let mut polys = StepPolys::new(&kit, &w, &y0);
             let event = first_event(&mut polys, &at0, h, settings.min_open_time);
             let (tau, w_end, at_end) = match event {
                 Some((tau, _)) => {
@@ -718,6 +747,16 @@ pub(crate) fn propagate<D: DriveModel>(
 /// piece's start by at most this many step propagators and one series.
 const PIECE_STEPS: usize = 16;
 
+/// Take in the state read as `at`: the engaged contact's force, or the
+/// open contact's blade.
+fn observe(system: &LinearSystem, p: &mut Propagation, at: &Reading) {
+    if p.modes.contact == StopMode::Open {
+        p.rec.observe_blade(system.gap, at.value[UB]);
+    } else {
+        p.rec.observe_force(system.force(at.value[FORCE]));
+    }
+}
+
 /// The contact force's extremes and the openings over one step of `h`
 /// read as `at0` and `at1` at its ends, `p.y` the state at its end.
 fn track(
@@ -728,26 +767,51 @@ fn track(
     h: f64,
 ) {
     let open = p.modes.contact == StopMode::Open;
-    let by_force = system.by_force;
-    let force = |f: f64| if by_force { f.max(0.0) } else { f };
-    if open {
-        p.rec.observe_blade(system.gap, at1.value[UB]);
-    } else {
-        p.rec.observe_force(force(at1.value[FORCE]));
-    }
+    observe(system, p, at1);
     // An opening's largest gap (or the reach before the first touch) and
-    // a contact's peak and least force are where their rates turn.
-    let watched = Term::plus(if open { UB } else { FORCE });
-    if !turns(watched, at0, at1) {
+    // a contact's peak and least force are at the step's ends, which are
+    // taken in, or where the rate turns inside it. Most steps show by
+    // their Bernstein coefficients that nothing inside can beat the
+    // record, or that the form is monotone.
+    let watched = if open { UB } else { FORCE };
+    let b = polys.bernstein(watched);
+    let cannot_beat = if open {
+        match p.rec.opening_so_far() {
+            (Some(opening), _) => -b.min() <= opening,
+            (None, reach) => system.gap + b.max() <= reach,
+        }
+    } else {
+        let (peak, least) = p.rec.force_so_far();
+        system.force(b.max()) <= peak && system.force(b.min()) >= least
+    };
+    if cannot_beat || b.monotone() {
         return;
     }
-    let poly = polys.of(watched.form);
-    if let Some(tm) = poly.extremum(h) {
-        let v = poly.value(tm);
+    // Near a turn: the rate's exact coefficients tell how often it turns.
+    let (kit, w0) = (polys.kit, polys.w0);
+    let rate = kit.forms[watched].rate_bernstein(w0);
+    if rate.turns() == Some(0) {
+        return;
+    }
+    let poly = polys.of(watched);
+    let mut take = |v: f64| {
         if open {
             p.rec.observe_blade(system.gap, v);
         } else {
-            p.rec.observe_force(force(v));
+            p.rec.observe_force(system.force(v));
         }
+    };
+    match rate.turns() {
+        Some(0) => {}
+        // One zero of the rate over the full step: inside this one when
+        // the rate's sign differs at its ends.
+        Some(1) => {
+            if turns(Term::plus(watched), at0, at1) {
+                if let Some(tm) = poly.extremum(h) {
+                    take(poly.value(tm));
+                }
+            }
+        }
+        _ => poly.every_extremum(&rate, (h, kit.mode.h), take),
     }
 }

@@ -112,6 +112,9 @@ pub(super) struct Series {
     /// `Σ_{k≥LOW_TERMS} ‖r_k‖₁ h^k`: the series past its first
     /// [`LOW_TERMS`] terms is smaller than this times `‖w0‖∞` over a step.
     pub(super) tail: f64,
+    /// `Σ_{k≥LOW_TERMS} k ‖r_k‖₁ h^k`: the same for its rate in the step's
+    /// own time `s = τ/h`.
+    rate_tail: f64,
     /// The Bernstein coefficients (degree `LOW_TERMS − 1`, over the mode's
     /// full step) of the series' first [`LOW_TERMS`] terms, as rows to dot
     /// with `w0`: `b_j = k + Σ_i bern[i][j] w0_i`. Kept by column, so that
@@ -135,6 +138,178 @@ pub(super) struct Series {
     full: std::sync::OnceLock<(Box<[W; TERMS]>, f64)>,
     /// s, the mode's full step.
     h: f64,
+}
+
+/// A form over a whole step of its mode from one state: the Bernstein
+/// coefficients of its series' first [`LOW_TERMS`] terms, and bounds on
+/// what they leave out, of the form and of its rate. Over the mode's full
+/// step, so what they show holds for a shorter last step too.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct StepBernstein {
+    /// Padded to [`LOW_PADDED`] with the last one repeated.
+    b: [f64; LOW_PADDED],
+    /// The form is within this of the coefficients' polynomial.
+    margin: f64,
+    /// Its rate in the step's own time is within this of theirs.
+    rate_margin: f64,
+}
+
+impl StepBernstein {
+    /// Whether the form, negated when `negated`, is positive over the
+    /// step: every coefficient exceeds the margin.
+    fn positive(&self, negated: bool) -> bool {
+        // Every coefficient clear of the margin (a NaN is not), without a
+        // branch per coefficient.
+        let mut clear = true;
+        if negated {
+            for b in self.b {
+                clear &= -b > self.margin;
+            }
+        } else {
+            for b in self.b {
+                clear &= b > self.margin;
+            }
+        }
+        clear
+    }
+
+    /// The form's largest value over the step is below this.
+    pub(super) fn max(&self) -> f64 {
+        let mut m = self.b[0];
+        for &b in &self.b[1..] {
+            m = if b > m { b } else { m };
+        }
+        m + self.margin
+    }
+
+    /// Its least value over the step is above this.
+    pub(super) fn min(&self) -> f64 {
+        let mut m = self.b[0];
+        for &b in &self.b[1..] {
+            m = if b < m { b } else { m };
+        }
+        m - self.margin
+    }
+
+    /// Whether the form is shown monotone over the step: every
+    /// coefficient of its rate, `n (b_{j+1} − b_j)`, clear of the rate's
+    /// margin and of one sign.
+    pub(super) fn monotone(&self) -> bool {
+        let n = (LOW_TERMS - 1) as f64;
+        let (mut rising, mut falling) = (true, true);
+        for j in 0..LOW_TERMS - 1 {
+            let d = n * (self.b[j + 1] - self.b[j]);
+            rising &= d > self.rate_margin;
+            falling &= d < -self.rate_margin;
+        }
+        rising || falling
+    }
+}
+
+/// A form's rate over a whole step of its mode, exactly: Bernstein
+/// coefficients of degree `TERMS − 2` in the step's own time, and their
+/// rounding.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct RateBernstein {
+    d: [f64; TERMS - 1],
+    noise: f64,
+}
+
+impl RateBernstein {
+    /// The sign changes of the coefficients when every one is clear of
+    /// its rounding: the rate's zeros over the step, or more by an even
+    /// number (Descartes' rule of signs). `None` when one is not clear.
+    pub(super) fn turns(&self) -> Option<usize> {
+        let mut count = 0;
+        for w in self.d.windows(2) {
+            // Within the rounding, or a NaN: not clear.
+            if w[0].abs() <= self.noise || w[0].is_nan() {
+                return None;
+            }
+            count += usize::from((w[0] > 0.0) != (w[1] > 0.0));
+        }
+        (self.d[TERMS - 2].abs() > self.noise).then_some(count)
+    }
+
+    /// Intervals of the full step (in its own time, `[0, 1]`) outside
+    /// which the rate keeps one sign: each holds one zero (its
+    /// coefficients there change sign once, its ends clear and of
+    /// opposite signs) or is no wider than 1/1024 of the step. The
+    /// coefficients are split in halves (de Casteljau) until they tell.
+    /// At most `N`, the earliest; `None` when there were more.
+    pub(super) fn zeros<const N: usize>(&self) -> Option<([(f64, f64); N], usize)> {
+        /// The coefficients `d[..m]` on `[lo, hi]`.
+        fn search<const N: usize>(
+            d: &[f64; TERMS],
+            m: usize,
+            (lo, hi): (f64, f64),
+            noise: f64,
+            out: &mut ([(f64, f64); N], usize),
+        ) -> bool {
+            let d_m = &d[..m];
+            if d_m.iter().all(|&c| c > noise) || d_m.iter().all(|&c| c < -noise) {
+                return true;
+            }
+            let (first, last) = (d_m[0], d_m[m - 1]);
+            let apart = first.abs() > noise && last.abs() > noise && (first > 0.0) != (last > 0.0);
+            let mut changes = 0;
+            let mut previous = 0.0f64;
+            for &c in d_m {
+                if c.abs() <= noise {
+                    continue;
+                }
+                if previous != 0.0 && (c > 0.0) != (previous > 0.0) {
+                    changes += 1;
+                }
+                previous = c;
+            }
+            if (apart && changes == 1) || hi - lo <= 1.0 / 1024.0 {
+                if out.1 == N {
+                    return false;
+                }
+                out.0[out.1] = (lo, hi);
+                out.1 += 1;
+                return true;
+            }
+            // de Casteljau at ½.
+            let (mut left, mut right, mut work) = (*d, *d, *d);
+            for r in 1..m {
+                for j in 0..m - r {
+                    work[j] = 0.5 * (work[j] + work[j + 1]);
+                }
+                left[r] = work[0];
+                right[m - 1 - r] = work[m - 1 - r];
+            }
+            let mid = 0.5 * (lo + hi);
+            search(&left, m, (lo, mid), noise, out) && search(&right, m, (mid, hi), noise, out)
+        }
+        // A rate on its zero at an end of the step (from rest, or a turn
+        // that ends the step): that end's value is taken in already, and
+        // the rate's other zeros are those of the rate divided by `s` (or
+        // by `1 − s`), as often as it vanishes there. Their coefficients
+        // are the rest scaled, `d_{j+1} n/(j + 1)` (or `d_j n/(n − j)`),
+        // n the degree: searched instead, so that the search does not
+        // split down to the end's zero.
+        let mut d = [0.0; TERMS];
+        d[..TERMS - 1].copy_from_slice(&self.d);
+        let mut m = TERMS - 1;
+        while m > 1 && d[0].abs() <= self.noise {
+            let n = (m - 1) as f64;
+            for j in 0..m - 1 {
+                d[j] = d[j + 1] * n / (j + 1) as f64;
+            }
+            m -= 1;
+        }
+        while m > 1 && d[m - 1].abs() <= self.noise {
+            let n = (m - 1) as f64;
+            for (j, c) in d.iter_mut().enumerate().take(m - 1) {
+                *c *= n / (n - j as f64);
+            }
+            m -= 1;
+        }
+        let mut out = ([(0.0, 0.0); N], 0);
+        search(&d, m, (0.0, 1.0), self.noise, &mut out).then_some(out)
+    }
 }
 
 /// Terms of a form's series in its cheap sign test: the polynomial of
@@ -163,6 +338,7 @@ impl Series {
         let norms = scaled.map(|s| s.abs().sum());
         let spread: f64 = norms[1..].iter().sum();
         let tail: f64 = norms[LOW_TERMS..].iter().sum();
+        let rate_tail: f64 = (LOW_TERMS..TERMS).map(|k| k as f64 * norms[k]).sum();
         let rows = bernstein_rows(&scaled[..LOW_TERMS], &LOW_WEIGHTS);
         let bern_norm = rows.iter().map(|b| b.abs().sum()).fold(0.0, f64::max);
         let bern = std::array::from_fn(|i| std::array::from_fn(|j| rows[j.min(LOW_TERMS - 1)][i]));
@@ -175,6 +351,7 @@ impl Series {
             r,
             spread,
             tail,
+            rate_tail,
             bern,
             bern_norm,
             bern_after_zero,
@@ -201,6 +378,25 @@ impl Series {
             let full = Box::new(bernstein_rows(&scaled, &FULL_WEIGHTS));
             (full, magnitude)
         })
+    }
+
+    /// The rate (in the step's own time `s = τ/h`) of the form over a
+    /// whole step of the mode from `w0`, exactly: the differences of the
+    /// whole series' Bernstein coefficients, `n (b_{j+1} − b_j)`.
+    pub(super) fn rate_bernstein(&self, w0: &W) -> RateBernstein {
+        let (rows, magnitude) = self.full();
+        let n = (TERMS - 1) as f64;
+        let mut previous = rows[0].dot(w0);
+        let d = std::array::from_fn(|j| {
+            let next = rows[j + 1].dot(w0);
+            let d = n * (next - previous);
+            previous = next;
+            d
+        });
+        RateBernstein {
+            d,
+            noise: 2.0 * n * 256.0 * f64::EPSILON * magnitude * w0.amax(),
+        }
     }
 
     /// Whether the form, negated when `negated`, has exactly one zero over
@@ -240,16 +436,43 @@ impl Series {
     /// alone; starting on its zero, within the rounding the locator
     /// allows, by [`Series::positive_after_zero`]; else by
     /// [`Series::positive_over_step`].
-    pub(super) fn shown_positive(&self, value: f64, w0: &W, negated: bool) -> bool {
+    /// The coefficients, once computed for the step, are kept in `kept`.
+    pub(super) fn shown_positive(
+        &self,
+        value: f64,
+        w0: &W,
+        negated: bool,
+        kept: &mut Option<StepBernstein>,
+    ) -> bool {
         let scale = w0.amax();
         if value > self.spread * scale * (1.0 + 1e-12) + 1e-300 {
             return true;
         }
-        let rounding = 64.0 * f64::EPSILON * (self.k.abs() + self.bern_norm * scale);
+        let rounding = self.rounding(scale);
         if value.abs() <= rounding {
             self.positive_after_zero(w0, scale, negated)
         } else {
-            self.positive_over_step(w0, scale, rounding, negated)
+            let b = kept.get_or_insert_with(|| self.step_bernstein(w0));
+            b.positive(negated)
+        }
+    }
+
+    /// The rounding of a Bernstein coefficient `k + bern_j·w0`
+    /// (`‖w0‖∞ = scale`).
+    fn rounding(&self, scale: f64) -> f64 {
+        64.0 * f64::EPSILON * (self.k.abs() + self.bern_norm * scale)
+    }
+
+    /// The form's Bernstein coefficients over a whole step of the mode
+    /// from `w0`, with the bounds on what they leave out.
+    pub(super) fn step_bernstein(&self, w0: &W) -> StepBernstein {
+        let scale = w0.amax();
+        let rounding = self.rounding(scale);
+        StepBernstein {
+            b: rows_at(self.k, &self.bern, w0),
+            margin: self.tail * scale * (1.0 + 1e-9) + rounding,
+            rate_margin: self.rate_tail * scale * (1.0 + 1e-9)
+                + 2.0 * (LOW_TERMS - 1) as f64 * rounding,
         }
     }
 
@@ -264,29 +487,6 @@ impl Series {
         self.bern_after_zero
             .iter()
             .all(|b| sign * b.dot(w0) > margin)
-    }
-
-    /// Whether the form, negated when `negated`, is positive over a whole
-    /// step of the mode from `w0` (`‖w0‖∞ = scale`): every Bernstein
-    /// coefficient of its first [`LOW_TERMS`] terms exceeds the bound on
-    /// the rest and the rounding (`rounding`). Over the mode's full step,
-    /// so it holds for a shorter last step too.
-    fn positive_over_step(&self, w0: &W, scale: f64, rounding: f64, negated: bool) -> bool {
-        let margin = self.tail * scale * (1.0 + 1e-9) + rounding;
-        let b = rows_at(self.k, &self.bern, w0);
-        // Every coefficient clear of the margin (a NaN is not), without a
-        // branch per coefficient.
-        let mut clear = true;
-        if negated {
-            for b in b {
-                clear &= -b > margin;
-            }
-        } else {
-            for b in b {
-                clear &= b > margin;
-            }
-        }
-        clear
     }
 
     /// The form along the motion from `w0` (the state `y0`), as a
@@ -498,6 +698,43 @@ impl Poly {
             tau = next;
         }
         tau
+    }
+
+    /// Every extremum inside `(0, h)` of a step of the mode's full step
+    /// `full`, the rate's exact Bernstein coefficients over that full step
+    /// being `rate` ([`Series::rate_bernstein`]): the rate's zeros are
+    /// isolated on them ([`RateBernstein::zeros`]) and each is polished on
+    /// this polynomial to [`EXTREMUM_TOLERANCE`], or, where the rate keeps
+    /// its sign at both ends of an interval too narrow to tell (a zero
+    /// touched, two a thousandth of the step apart), the form is taken at
+    /// its middle. Each value goes to `take`.
+    pub(super) fn every_extremum(
+        &self,
+        rate_form: &RateBernstein,
+        (h, full): (f64, f64),
+        mut take: impl FnMut(f64),
+    ) {
+        let rate = self.derivative();
+        let Some((brackets, n)) = rate_form.zeros::<8>() else {
+            for k in 1..64 {
+                take(self.value(h * k as f64 / 64.0));
+            }
+            return;
+        };
+        let (_, noise) = rate.value_and_noise(h);
+        for &(lo, hi) in &brackets[..n] {
+            let (lo, hi) = (lo * full, (hi * full).min(h));
+            if lo >= hi {
+                break;
+            }
+            let (r_lo, r_hi) = (rate.value(lo), rate.value(hi));
+            let t = if r_lo != 0.0 && r_hi != 0.0 && (r_lo > 0.0) != (r_hi > 0.0) {
+                rate.root_between((lo, hi), (r_lo, r_hi), noise, EXTREMUM_TOLERANCE)
+            } else {
+                0.5 * (lo + hi)
+            };
+            take(self.value(t));
+        }
     }
 
     /// The extremum inside `(0, h)`, where the rate changes sign, to

@@ -51,6 +51,24 @@ impl Tally {
         self.contact.len()
     }
 
+    /// What the open contact's record holds so far: the widest opening
+    /// since the last release (m, `Some`), or before the first touch the
+    /// blade's farthest reach (m, `None` and `reach`).
+    pub(crate) fn opening_so_far(&self) -> (Option<f64>, f64) {
+        let opening = self.contact.last().map(|i| i.max_gap_after.unwrap_or(0.0));
+        (opening, self.reach)
+    }
+
+    /// The engaged contact's largest and least force so far (N), or
+    /// infinities before the first.
+    pub(crate) fn force_so_far(&self) -> (f64, f64) {
+        let last = self.contact.last();
+        (
+            last.and_then(|i| i.peak_force).unwrap_or(f64::NEG_INFINITY),
+            last.and_then(|i| i.min_force).unwrap_or(f64::INFINITY),
+        )
+    }
+
     /// Each release's time and the widest opening after it (m).
     pub(crate) fn openings(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
         self.contact
