@@ -136,6 +136,11 @@ pub(super) struct Series {
     /// magnitude before their terms cancel, for the rounding of
     /// `full_j·w0`).
     full: std::sync::OnceLock<(Box<[W; TERMS]>, f64)>,
+    /// The rate's Bernstein rows (degree `TERMS − 2`, in the step's own
+    /// time), `n (full_{j+1} − full_j)`, kept by column as [`Series::bern`]
+    /// is, with the full rows' magnitude. Built at the first step that
+    /// needs them.
+    rate_rows: std::sync::OnceLock<(Box<[[f64; TERMS - 1]; 4]>, f64)>,
     /// s, the mode's full step.
     h: f64,
 }
@@ -356,6 +361,7 @@ impl Series {
             bern_norm,
             bern_after_zero,
             full: std::sync::OnceLock::new(),
+            rate_rows: std::sync::OnceLock::new(),
             h: mode.h,
         }
     }
@@ -384,18 +390,16 @@ impl Series {
     /// whole step of the mode from `w0`, exactly: the differences of the
     /// whole series' Bernstein coefficients, `n (b_{j+1} − b_j)`.
     pub(super) fn rate_bernstein(&self, w0: &W) -> RateBernstein {
-        let (rows, magnitude) = self.full();
-        let n = (TERMS - 1) as f64;
-        let mut previous = rows[0].dot(w0);
-        let d = std::array::from_fn(|j| {
-            let next = rows[j + 1].dot(w0);
-            let d = n * (next - previous);
-            previous = next;
-            d
+        let (rows, magnitude) = self.rate_rows.get_or_init(|| {
+            let (full, magnitude) = self.full();
+            let n = (TERMS - 1) as f64;
+            let rows =
+                std::array::from_fn(|i| std::array::from_fn(|j| n * (full[j + 1][i] - full[j][i])));
+            (Box::new(rows), *magnitude)
         });
         RateBernstein {
-            d,
-            noise: 2.0 * n * 256.0 * f64::EPSILON * magnitude * w0.amax(),
+            d: rows_at(0.0, rows, w0),
+            noise: 2.0 * (TERMS - 1) as f64 * 256.0 * f64::EPSILON * magnitude * w0.amax(),
         }
     }
 
