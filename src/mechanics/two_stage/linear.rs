@@ -244,9 +244,9 @@ impl StepPolys<'_> {
 
     /// The Bernstein coefficients of form `form` over the mode's full
     /// step, computed on first use.
-    fn bernstein(&mut self, form: usize) -> StepBernstein {
+    fn bernstein(&mut self, form: usize) -> &StepBernstein {
         let (kit, w0) = (self.kit, self.w0);
-        *self.bern[form].get_or_insert_with(|| kit.forms[form].step_bernstein(w0))
+        self.bern[form].get_or_insert_with(|| kit.forms[form].step_bernstein(w0))
     }
 
     /// Whether `term` stays positive over the step, read as `at0` at its
@@ -774,23 +774,27 @@ fn track(
     // their Bernstein coefficients that nothing inside can beat the
     // record, or that the form is monotone.
     let watched = if open { UB } else { FORCE };
-    let b = polys.bernstein(watched);
+    let (least, largest, monotone) = polys.bernstein(watched).bounds();
+    if monotone {
+        return;
+    }
     let cannot_beat = if open {
         match p.rec.opening_so_far() {
-            (Some(opening), _) => -b.min() <= opening,
-            (None, reach) => system.gap + b.max() <= reach,
+            (Some(opening), _) => -least <= opening,
+            (None, reach) => system.gap + largest <= reach,
         }
     } else {
-        let (peak, least) = p.rec.force_so_far();
-        system.force(b.max()) <= peak && system.force(b.min()) >= least
+        let (peak, min) = p.rec.force_so_far();
+        system.force(largest) <= peak && system.force(least) >= min
     };
-    if cannot_beat || b.monotone() {
+    if cannot_beat {
         return;
     }
     // Near a turn: the rate's exact coefficients tell how often it turns.
     let (kit, w0) = (polys.kit, polys.w0);
     let rate = kit.forms[watched].rate_bernstein(w0);
-    if rate.turns() == Some(0) {
+    let turning = rate.turns();
+    if turning == Some(0) {
         return;
     }
     let poly = polys.of(watched);
@@ -801,7 +805,7 @@ fn track(
             p.rec.observe_force(system.force(v));
         }
     };
-    match rate.turns() {
+    match turning {
         Some(0) => {}
         // One zero of the rate over the full step: inside this one when
         // the rate's sign differs at its ends.

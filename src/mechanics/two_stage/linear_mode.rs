@@ -178,36 +178,23 @@ impl StepBernstein {
         clear
     }
 
-    /// The form's largest value over the step is below this.
-    pub(super) fn max(&self) -> f64 {
-        let mut m = self.b[0];
-        for &b in &self.b[1..] {
-            m = if b > m { b } else { m };
-        }
-        m + self.margin
-    }
-
-    /// Its least value over the step is above this.
-    pub(super) fn min(&self) -> f64 {
-        let mut m = self.b[0];
-        for &b in &self.b[1..] {
-            m = if b < m { b } else { m };
-        }
-        m - self.margin
-    }
-
-    /// Whether the form is shown monotone over the step: every
-    /// coefficient of its rate, `n (b_{j+1} − b_j)`, clear of the rate's
-    /// margin and of one sign.
-    pub(super) fn monotone(&self) -> bool {
+    /// Bounds on the form over the step, `(least, largest)`, and whether
+    /// it is shown monotone there (every coefficient of its rate,
+    /// `n (b_{j+1} − b_j)`, clear of the rate's margin and of one sign),
+    /// in one pass.
+    pub(super) fn bounds(&self) -> (f64, f64, bool) {
         let n = (LOW_TERMS - 1) as f64;
+        let (mut lo, mut hi) = (self.b[0], self.b[0]);
         let (mut rising, mut falling) = (true, true);
         for j in 0..LOW_TERMS - 1 {
-            let d = n * (self.b[j + 1] - self.b[j]);
+            let next = self.b[j + 1];
+            lo = if next < lo { next } else { lo };
+            hi = if next > hi { next } else { hi };
+            let d = n * (next - self.b[j]);
             rising &= d > self.rate_margin;
             falling &= d < -self.rate_margin;
         }
-        rising || falling
+        (lo - self.margin, hi + self.margin, rising || falling)
     }
 }
 
