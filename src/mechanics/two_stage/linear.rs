@@ -6,8 +6,7 @@
 //! mode's equilibrium and the state scaled (`w = D⁻¹ (y − y*)`, `D`
 //! diagonal, chosen so that `‖a‖∞` of `a = D⁻¹ A D` is least: see
 //! [`balance`]), the motion is `w(τ) = exp(a τ) w(0)`. A mode is stepped
-//! by `h = 2.5/‖a‖∞`, under half its fastest period, so that no linear
-//! function of the state turns twice in a step; the propagator
+//! by `h = 3/‖a‖∞`, under half its fastest period; the propagator
 //! `Φ = exp(a h)` comes from the Taylor series (28 terms, `a^k/k!` kept for
 //! the mode), and a step costs one 4 × 4 product.
 //!
@@ -21,8 +20,15 @@
 //! sign change over a step, or a minimum inside it below zero (found where
 //! the function's rate changes sign), is polished by Newton's method from
 //! the secant, safeguarded by bisection, until the value is lost in its
-//! rounding. The contact force's peak and minimum and the largest opening
-//! are found the same way, at the zeros of their rates.
+//! rounding. The contact force's peak and minimum and the widest opening
+//! are taken at every step's ends, at the first state of every mode (a
+//! damped contact's force can be largest at the touch), and at the zeros
+//! of their rates inside a step: a step whose Bernstein coefficients show
+//! that nothing inside it can beat the record so far, or that the form
+//! is monotone, needs none; else the rate's exact Bernstein coefficients
+//! count its turns (Descartes' rule of signs), and every one is found and
+//! polished (see [`track`]). Two turns in one step (a blade ringing on its
+//! slow swing) are not missed.
 //!
 //! The motion is kept in pieces of up to 16 steps, each a mode, a start
 //! and its scaled state: a state inside one is had again by the same
@@ -527,7 +533,7 @@ impl LinearSystem {
 
 /// The diagonal scaling `d` that makes `‖D⁻¹ A D‖∞` least: the Perron
 /// vector of `|A|`, for which every row of `D⁻¹ |A| D` sums to the
-/// spectral radius of `|A|` (Perron–Frobenius). The step, `2.5/‖D⁻¹ A D‖∞`,
+/// spectral radius of `|A|` (Perron–Frobenius). The step, `3/‖D⁻¹ A D‖∞`,
 /// is then as long as the Taylor series' accuracy allows; on a blade as
 /// stiff as the contact it is 1.4–1.9 times the step of one velocity scale
 /// `ω` for both bodies. Found by power iteration on `|A₀| + σI`, where

@@ -87,8 +87,8 @@ impl LinearMode {
 
 /// The step's size in the mode's own time: `‖a h‖∞`. Under π, so that a
 /// step is under half the fastest period (the spectral radius is at most
-/// the norm).
-pub(super) const STEP_NORM: f64 = 2.5;
+/// the norm), and at most 3, to which the series' [`TERMS`] are exact.
+pub(super) const STEP_NORM: f64 = 3.0;
 
 /// Terms of the Taylor series kept per step (a multiple of 4, for
 /// [`evaluate`]): with `‖a h‖ ≤ 3` the first one left out is below 1e-20
