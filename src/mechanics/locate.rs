@@ -522,6 +522,38 @@ mod tests {
         StepForm::new(&a)
     }
 
+    /// Every zero is bracketed alone, two a hair apart included, and a
+    /// zero the form only touches is left in an interval of the leaf's
+    /// width; `None` when the brackets would not fit.
+    #[test]
+    fn sign_changes_bracket_every_zero() {
+        let roots = [0.1, 0.35, 0.3505, 0.8];
+        let (brackets, n) = sign_changes::<8>(&product(&roots, 1.0), 1e-6).unwrap();
+        assert_eq!(n, 4, "{:?}", &brackets[..n]);
+        for (&(lo, hi), &r) in brackets[..n].iter().zip(&roots) {
+            assert!(lo <= r && r <= hi, "{r} outside [{lo}, {hi}]");
+            let inside = roots.iter().filter(|&&q| lo <= q && q <= hi).count();
+            assert_eq!(inside, 1, "[{lo}, {hi}]");
+        }
+        // (s − 0.2)(s − 0.5)²: one crossing, one touch.
+        let (brackets, n) = sign_changes::<8>(&product(&[0.2, 0.5, 0.5], -1.0), 1e-4).unwrap();
+        assert!(n >= 2, "{:?}", &brackets[..n]);
+        assert!(brackets[0].0 <= 0.2 && 0.2 <= brackets[0].1);
+        let touch = brackets[1..n]
+            .iter()
+            .any(|&(lo, hi)| lo <= 0.5 && 0.5 <= hi && hi - lo <= 1e-4);
+        assert!(touch, "{:?}", &brackets[..n]);
+        // A positive form has none; nine zeros do not fit in eight.
+        assert_eq!(
+            sign_changes::<8>(&product(&[-0.5, 1.5], 1.0), 1e-6)
+                .unwrap()
+                .1,
+            0
+        );
+        let nine: Vec<f64> = (1..=9).map(|k| k as f64 / 10.0).collect();
+        assert!(sign_changes::<8>(&product(&nine, 1.0), 1e-6).is_none());
+    }
+
     #[test]
     fn bernstein_form_reproduces_the_polynomial() {
         let f = StepForm::new(&[0.3, -2.0, 5.0, -1.0, 0.25, 3.0]);

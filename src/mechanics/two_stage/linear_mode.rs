@@ -747,6 +747,56 @@ impl Poly {
 mod tests {
     use super::*;
 
+    /// A slow and a fast oscillator side by side (ω = 1 and 10, `h` =
+    /// 0.3), and the form `x₁ + x₂` along a step in which the fast one's
+    /// rate twice outweighs the slow one's: the rate is positive at both
+    /// ends of the step and turns twice inside it. Every extremum is
+    /// found, and the largest value over the step is the closed form's.
+    #[test]
+    fn two_turns_in_one_step_are_both_found() {
+        let mut a = Matrix4::zeros();
+        a[(0, 1)] = 1.0;
+        a[(1, 0)] = -1.0;
+        a[(2, 3)] = 10.0;
+        a[(3, 2)] = -10.0;
+        let h = 0.3;
+        let mode = LinearMode::new(a, Vector4::zeros(), [1.0; 4], h);
+        // x₁ = cos(τ + φ₁), x₂ = B cos(10τ + φ₂); the slow rate is 0.3 at
+        // mid-step, the fast one's −sin peaks there at 10 B = 1.
+        let (phi1, b, phi2) = (
+            -(0.3f64).asin() - 0.15,
+            0.1,
+            std::f64::consts::FRAC_PI_2 - 1.5,
+        );
+        let f = |t: f64| (t + phi1).cos() + b * (10.0 * t + phi2).cos();
+        let rate = |t: f64| -(t + phi1).sin() - 10.0 * b * (10.0 * t + phi2).sin();
+        assert!(
+            rate(0.0) > 0.0 && rate(h) > 0.0,
+            "{} {}",
+            rate(0.0),
+            rate(h)
+        );
+        let w0 = W::new(phi1.cos(), -phi1.sin(), b * phi2.cos(), -b * phi2.sin());
+        let y0 = Y::new(w0[0], w0[1], w0[2], w0[3], 0.0);
+        let series = Series::new(&mode, [1.0, 0.0, 1.0, 0.0], 0.0);
+        let poly = series.poly(&w0, &y0);
+        let rate_form = series.rate_bernstein(&w0);
+        assert_eq!(rate_form.turns(), Some(2));
+        let mut found = Vec::new();
+        poly.every_extremum(&rate_form, (h, h), |v| found.push(v));
+        assert_eq!(found.len(), 2, "{found:?}");
+        let sampled = (0..=100_000)
+            .map(|k| f(h * k as f64 / 100_000.0))
+            .fold(f64::NEG_INFINITY, f64::max);
+        let largest = found.iter().copied().fold(f(0.0).max(f(h)), f64::max);
+        assert!(
+            (largest - sampled).abs() < 1e-9,
+            "{largest} against {sampled}"
+        );
+        // The interior maximum is what the ends alone would miss.
+        assert!(sampled > f(0.0).max(f(h)) + 1e-4);
+    }
+
     /// `Σ_j b_j C(n, j) s^j (1 − s)^(n − j)`, the Bernstein form at `s`.
     fn bernstein_at(b: &[f64], s: f64) -> f64 {
         let n = b.len() - 1;
