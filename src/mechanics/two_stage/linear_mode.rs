@@ -130,12 +130,12 @@ pub(super) struct Series {
     /// coefficients of its first `LOW_TERMS − 1` terms.
     pub(super) bern_after_zero: [W; LOW_TERMS - 1],
     /// The Bernstein coefficients of the whole series (degree
-    /// `TERMS − 1`, over the mode's full step) as rows to dot with `w0`:
-    /// `b_j = k + full_j·w0`, the same polynomial the locator converts.
-    /// Built at the mode's first event, with `Σ_k ‖r_k‖₁ h^k` (the rows'
-    /// magnitude before their terms cancel, for the rounding of
-    /// `full_j·w0`).
-    full: std::sync::OnceLock<(Box<[W; TERMS]>, f64)>,
+    /// `TERMS − 1`, over the mode's full step) as rows to dot with `w0`,
+    /// kept by column as [`Series::bern`] is: `b_j = k + full_j·w0`, the
+    /// same polynomial the locator converts. Built at the mode's first
+    /// event or turn, with `Σ_k ‖r_k‖₁ h^k` (the rows' magnitude before
+    /// their terms cancel, for the rounding of `full_j·w0`).
+    full: std::sync::OnceLock<(Box<[[f64; TERMS]; 4]>, f64)>,
     /// The rate's Bernstein rows (degree `TERMS − 2`, in the step's own
     /// time), `n (full_{j+1} − full_j)`, kept by column as [`Series::bern`]
     /// is, with the full rows' magnitude. Built at the first step that
@@ -356,7 +356,7 @@ impl Series {
     /// The Bernstein rows of the whole series over the mode's full step,
     /// `b_j = Σ_{k ≤ j} C(j, k)/C(n, k) r_k h^k` (n = `TERMS − 1`), and
     /// their magnitude.
-    fn full(&self) -> &(Box<[W; TERMS]>, f64) {
+    fn full(&self) -> &(Box<[[f64; TERMS]; 4]>, f64) {
         self.full.get_or_init(|| {
             let mut scaled = [W::zeros(); TERMS];
             let mut hk = 1.0;
@@ -368,8 +368,9 @@ impl Series {
                 *s = rk * hk;
                 magnitude += s.abs().sum();
             }
-            let full = Box::new(bernstein_rows(&scaled, &FULL_WEIGHTS));
-            (full, magnitude)
+            let rows = bernstein_rows(&scaled, &FULL_WEIGHTS);
+            let by_column = std::array::from_fn(|i| std::array::from_fn(|j| rows[j][i]));
+            (Box::new(by_column), magnitude)
         })
     }
 
@@ -381,7 +382,7 @@ impl Series {
             let (full, magnitude) = self.full();
             let n = (TERMS - 1) as f64;
             let rows =
-                std::array::from_fn(|i| std::array::from_fn(|j| n * (full[j + 1][i] - full[j][i])));
+                std::array::from_fn(|i| std::array::from_fn(|j| n * (full[i][j + 1] - full[i][j])));
             (Box::new(rows), *magnitude)
         });
         RateBernstein {
@@ -405,8 +406,8 @@ impl Series {
         let noise = 256.0 * f64::EPSILON * (self.k.abs() + magnitude * w0.amax());
         let mut changes = 0;
         let mut last = 1.0;
-        for row in rows.iter() {
-            let b = sign * (self.k + row.dot(w0));
+        for b in rows_at(self.k, rows, w0) {
+            let b = sign * b;
             if b.abs() <= noise {
                 return false;
             }
@@ -443,7 +444,7 @@ impl Series {
         if value.abs() <= rounding {
             self.positive_after_zero(w0, scale, negated)
         } else {
-            let b = kept.get_or_insert_with(|| self.step_bernstein(w0));
+            let b = kept.get_or_insert_with(|| self.bernstein_at(w0, scale, rounding));
             b.positive(negated)
         }
     }
@@ -458,7 +459,12 @@ impl Series {
     /// from `w0`, with the bounds on what they leave out.
     pub(super) fn step_bernstein(&self, w0: &W) -> StepBernstein {
         let scale = w0.amax();
-        let rounding = self.rounding(scale);
+        self.bernstein_at(w0, scale, self.rounding(scale))
+    }
+
+    /// [`Series::step_bernstein`] with `‖w0‖∞` and the coefficients'
+    /// rounding known.
+    fn bernstein_at(&self, w0: &W, scale: f64, rounding: f64) -> StepBernstein {
         StepBernstein {
             b: rows_at(self.k, &self.bern, w0),
             margin: self.tail * scale * (1.0 + 1e-9) + rounding,
