@@ -43,6 +43,7 @@ mod run;
 mod safety;
 mod scenario_base;
 mod schema;
+mod source_paths;
 mod spice_runner;
 mod sweep;
 mod timing;

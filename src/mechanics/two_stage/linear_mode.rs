@@ -791,6 +791,17 @@ impl Poly {
 mod tests {
     use super::*;
 
+    /// Undamped oscillators of ω = 1 (`w₀, w₁`) and ω = 10 (`w₂, w₃`)
+    /// side by side, at rest about 0, unscaled, stepped by `h`.
+    fn two_oscillators(h: f64) -> LinearMode {
+        let mut a = Matrix4::zeros();
+        a[(0, 1)] = 1.0;
+        a[(1, 0)] = -1.0;
+        a[(2, 3)] = 10.0;
+        a[(3, 2)] = -10.0;
+        LinearMode::new(a, Vector4::zeros(), [1.0; 4], h)
+    }
+
     /// A slow and a fast oscillator side by side (ω = 1 and 10, `h` =
     /// 0.3), and the form `x₁ + x₂` along a step in which the fast one's
     /// rate twice outweighs the slow one's: the rate is positive at both
@@ -798,13 +809,8 @@ mod tests {
     /// found, and the largest value over the step is the closed form's.
     #[test]
     fn two_turns_in_one_step_are_both_found() {
-        let mut a = Matrix4::zeros();
-        a[(0, 1)] = 1.0;
-        a[(1, 0)] = -1.0;
-        a[(2, 3)] = 10.0;
-        a[(3, 2)] = -10.0;
         let h = 0.3;
-        let mode = LinearMode::new(a, Vector4::zeros(), [1.0; 4], h);
+        let mode = two_oscillators(h);
         // x₁ = cos(τ + φ₁), x₂ = B cos(10τ + φ₂); the slow rate is 0.3 at
         // mid-step, the fast one's −sin peaks there at 10 B = 1.
         let (phi1, b, phi2) = (
@@ -847,13 +853,8 @@ mod tests {
     /// in a last step cut short of it.
     #[test]
     fn a_turn_after_a_start_at_rest_is_found_and_none_past_a_short_step() {
-        let mut a = Matrix4::zeros();
-        a[(0, 1)] = 1.0;
-        a[(1, 0)] = -1.0;
-        a[(2, 3)] = 10.0;
-        a[(3, 2)] = -10.0;
         let full = 0.3;
-        let mode = LinearMode::new(a, Vector4::zeros(), [1.0; 4], full);
+        let mode = two_oscillators(full);
         let w0 = W::new(1.0, 0.0, -0.1, 0.0);
         let y0 = Y::new(1.0, 0.0, -0.1, 0.0, 0.0);
         let series = Series::new(&mode, [1.0, 0.0, 1.0, 0.0], 0.0);
