@@ -377,9 +377,31 @@ pub(crate) fn sign_changes<const N: usize>(
     f: &StepForm,
     leaf: f64,
 ) -> Option<([(f64, f64); N], usize)> {
+    changes_of(&Bernstein::of(f), leaf)
+}
+
+/// [`sign_changes`] of a form given by its Bernstein coefficients on
+/// `[0, 1]` (at most [`MAX_COEFFS`]) and their rounding.
+pub(crate) fn sign_changes_of_coefficients<const N: usize>(
+    coefficients: &[f64],
+    noise: f64,
+    leaf: f64,
+) -> Option<([(f64, f64); N], usize)> {
+    assert!(!coefficients.is_empty() && coefficients.len() <= MAX_COEFFS);
+    let mut b = [0.0; MAX_COEFFS];
+    b[..coefficients.len()].copy_from_slice(coefficients);
+    let form = Bernstein {
+        b,
+        n: coefficients.len(),
+        noise,
+    };
+    changes_of(&form, leaf)
+}
+
+fn changes_of<const N: usize>(b: &Bernstein, leaf: f64) -> Option<([(f64, f64); N], usize)> {
     let mut out = ([(0.0, 0.0); N], 0);
     let leaf = leaf.max(0.5f64.powi(MAX_DEPTH as i32));
-    changes(&Bernstein::of(f), (0.0, 1.0), leaf, &mut out).then_some(out)
+    changes(b, (0.0, 1.0), leaf, &mut out).then_some(out)
 }
 
 /// [`sign_changes`] over `[lo, hi]`, its form `b` there, into `out`:

@@ -228,54 +228,10 @@ impl RateBernstein {
     /// which the rate keeps one sign: each holds one zero (its
     /// coefficients there change sign once, its ends clear and of
     /// opposite signs) or is no wider than 1/1024 of the step. The
-    /// coefficients are split in halves (de Casteljau) until they tell.
+    /// coefficients are split in halves (de Casteljau) until they tell
+    /// ([`crate::mechanics::locate::sign_changes_of_coefficients`]).
     /// At most `N`, the earliest; `None` when there were more.
     pub(super) fn zeros<const N: usize>(&self) -> Option<([(f64, f64); N], usize)> {
-        /// The coefficients `d[..m]` on `[lo, hi]`.
-        fn search<const N: usize>(
-            d: &[f64; TERMS],
-            m: usize,
-            (lo, hi): (f64, f64),
-            noise: f64,
-            out: &mut ([(f64, f64); N], usize),
-        ) -> bool {
-            let d_m = &d[..m];
-            if d_m.iter().all(|&c| c > noise) || d_m.iter().all(|&c| c < -noise) {
-                return true;
-            }
-            let (first, last) = (d_m[0], d_m[m - 1]);
-            let apart = first.abs() > noise && last.abs() > noise && (first > 0.0) != (last > 0.0);
-            let mut changes = 0;
-            let mut previous = 0.0f64;
-            for &c in d_m {
-                if c.abs() <= noise {
-                    continue;
-                }
-                if previous != 0.0 && (c > 0.0) != (previous > 0.0) {
-                    changes += 1;
-                }
-                previous = c;
-            }
-            if (apart && changes == 1) || hi - lo <= 1.0 / 1024.0 {
-                if out.1 == N {
-                    return false;
-                }
-                out.0[out.1] = (lo, hi);
-                out.1 += 1;
-                return true;
-            }
-            // de Casteljau at ½.
-            let (mut left, mut right, mut work) = (*d, *d, *d);
-            for r in 1..m {
-                for j in 0..m - r {
-                    work[j] = 0.5 * (work[j] + work[j + 1]);
-                }
-                left[r] = work[0];
-                right[m - 1 - r] = work[m - 1 - r];
-            }
-            let mid = 0.5 * (lo + hi);
-            search(&left, m, (lo, mid), noise, out) && search(&right, m, (mid, hi), noise, out)
-        }
         // A rate on its zero at an end of the step (from rest, or a turn
         // that ends the step): that end's value is taken in already, and
         // the rate's other zeros are those of the rate divided by `s` (or
@@ -301,13 +257,12 @@ impl RateBernstein {
             }
             m -= 1;
         }
-        let mut out = ([(0.0, 0.0); N], 0);
         // A rate within its rounding everywhere: the form is constant
         // over the step, its ends taken in already.
         if m == 1 && d[0].abs() <= noise {
-            return Some(out);
+            return Some(([(0.0, 0.0); N], 0));
         }
-        search(&d, m, (0.0, 1.0), noise, &mut out).then_some(out)
+        crate::mechanics::locate::sign_changes_of_coefficients(&d[..m], noise, 1.0 / 1024.0)
     }
 }
 
