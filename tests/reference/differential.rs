@@ -220,6 +220,13 @@ impl Relay {
 
     /// Every event up to `t_end`, and each contact's extremes.
     fn reference_at(&self, t_end: f64, step: f64) -> (Vec<Ev>, Vec<Extremes>) {
+        let (events, extremes, _) = self.reference_with_reach(t_end, step);
+        (events, extremes)
+    }
+
+    /// [`Relay::reference_at`], with the blade's farthest reach before its
+    /// first touch (m, from rest).
+    fn reference_with_reach(&self, t_end: f64, step: f64) -> (Vec<Ev>, Vec<Extremes>, f64) {
         let mut y: S = [0.0; 4];
         let (mut c, mut p) = (false, false);
         let mut t = 0.0;
@@ -236,6 +243,7 @@ impl Relay {
         // the surface since: an opening shorter than `MIN_OPEN` or
         // shallower than `MIN_GAP` is merged into the contact.
         let (mut released, mut deepest) = (f64::NAN, 0.0f64);
+        let mut reach = y[2];
         // Where the equations are linear (every mode but a Hunt–Crossley
         // contact engaged), one RK4 step is an affine map of the state:
         // found once per mode from the step itself, applied as a product.
@@ -257,6 +265,9 @@ impl Relay {
                     observe(&mut contacts, &y);
                 } else {
                     deepest = deepest.max(self.g - y[2]);
+                    if contacts.is_empty() {
+                        reach = reach.max(y[2]);
+                    }
                 }
                 continue;
             }
@@ -328,7 +339,10 @@ impl Relay {
         if let Some(last) = contacts.last_mut().filter(|_| !c) {
             last.gap = Some(deepest.max(0.0));
         }
-        (out, contacts)
+        if contacts.is_empty() && !c {
+            reach = reach.max(y[2]);
+        }
+        (out, contacts, reach)
     }
 
     fn mechanics(&self) -> Mechanics {
@@ -523,7 +537,14 @@ pub fn compare(seed: u64) -> Result<(usize, Outcome), String> {
     // event there would be one the engine's ending said could not happen.
     // The pole face's record runs to `t_end` whatever the contact does:
     // every pole-face event up to the horizon is compared too.
-    let horizon = (settle * 1.1 + 3e-4).min(t_end);
+    // A contact that ends open is followed to `t_end`: its last opening's
+    // widest is over the whole run, however early the energy proved the
+    // ending.
+    let horizon = if run.contact.outcome == Outcome::EndsOpen {
+        t_end
+    } else {
+        (settle * 1.1 + 3e-4).min(t_end)
+    };
     let (reference, extremes) = relay.reference_at(horizon, STEP);
     let engine = engine_events(&run, horizon);
     let kinds = |v: &[Ev]| v.iter().map(|e| e.kind).collect::<Vec<_>>();
@@ -571,6 +592,33 @@ pub fn compare(seed: u64) -> Result<(usize, Outcome), String> {
         }
     }
     extremes_agree(&run, &extremes, horizon).map_err(|e| format!("{e}\n{}", describe()))?;
+    // A contact never reached: the shortfall is the least distance over
+    // the whole run, however early the energy proved it.
+    if run.contact.outcome == Outcome::NeverCloses {
+        let (_, _, reach) = relay.reference_with_reach(t_end, STEP);
+        let shortfall = run.contact.shortfall.unwrap_or(f64::NAN);
+        if (shortfall - (relay.g - reach)).abs() > 1e-6 * relay.g {
+            return Err(format!(
+                "shortfall {shortfall:e} m against {:e} m\n{}",
+                relay.g - reach,
+                describe()
+            ));
+        }
+    }
+    // A contact that ends open: the widest of its last opening, against
+    // the reference's over the whole run.
+    if run.contact.outcome == Outcome::EndsOpen {
+        let engine_gap = run.contact.impacts.last().and_then(|i| i.max_gap_after);
+        let reference_gap = extremes.last().and_then(|e| e.gap);
+        if let (Some(a), Some(b)) = (engine_gap, reference_gap) {
+            if (a - b).abs() > 1e-6 * relay.g {
+                return Err(format!(
+                    "last opening {a:e} m against {b:e} m\n{}",
+                    describe()
+                ));
+            }
+        }
+    }
     // The ending does not depend on how long the run was allowed: the
     // same with `t_end` doubled, unless the longer run's contact was still
     // moving at the first one's end.

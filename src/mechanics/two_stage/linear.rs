@@ -528,6 +528,7 @@ impl LinearSystem {
                 .pole_bound
                 .is_none_or(|bound| self.below(self.energy(&p.y), bound));
         }
+        p.settle_opening(model);
     }
 }
 

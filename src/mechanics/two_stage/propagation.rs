@@ -5,7 +5,7 @@
 //! a closing's ending is decided ([`check_closing`]), and the records it
 //! returns.
 
-use super::energy::{EnergyBound, step_energy};
+use super::energy::{EnergyBound, step_energy, widest_opening};
 use super::model::{RelayModel, StopMode, StopModes, Which, Y};
 use super::relay::Release;
 use super::run::{Horizon, TwoStageRun};
@@ -230,6 +230,9 @@ pub(crate) struct Propagation {
     /// Whether the pole face can no longer change (after the contact's
     /// ending).
     pub pole_settled: bool,
+    /// Whether the contact's last opening can grow no wider (false only
+    /// after an `ends_open` ending, until the energy shows it).
+    pub opening_settled: bool,
     /// J, the energy at the start, under a constant force with every stop
     /// released by position (when the energy can only fall).
     pub energy0: Option<f64>,
@@ -258,6 +261,7 @@ impl Propagation {
             proven_at: None,
             follow_pole: false,
             pole_settled: false,
+            opening_settled: true,
             energy0: self.energy0,
             violation: None,
             give_up_past: None,
@@ -267,7 +271,7 @@ impl Propagation {
 
     /// Whether the run is over before its horizon: the event limit, or
     /// the contact's ending decided and (when followed) the pole face
-    /// settled.
+    /// settled and an open contact's last opening at its widest.
     pub(crate) fn over(&self) -> bool {
         if self.gave_up {
             return true;
@@ -275,7 +279,7 @@ impl Propagation {
         match self.ending {
             None => false,
             Some(Outcome::EventLimit) => true,
-            Some(_) => !self.follow_pole || self.pole_settled,
+            Some(_) => !self.follow_pole || (self.pole_settled && self.opening_settled),
         }
     }
 
@@ -283,6 +287,24 @@ impl Propagation {
     pub(crate) fn decide(&mut self, ending: Outcome) {
         self.ending = Some(ending);
         self.proven_at = Some(self.t);
+        self.opening_settled = ending != Outcome::EndsOpen;
+    }
+
+    /// After an `ends_open` ending: whether the last opening can grow no
+    /// wider than its record, by more than 1e-9 of the gap. The energy
+    /// only falls, so the blade stays where the least potential over the
+    /// armature's positions is below it ([`widest_opening`]); under a
+    /// drive that varies there is no such bound in closed form, and the
+    /// opening is not followed.
+    pub(crate) fn settle_opening<D: DriveModel>(&mut self, model: &RelayModel<'_, D>) {
+        if self.opening_settled {
+            return;
+        }
+        let widest = step_energy(model, &self.y).and_then(|j| widest_opening(model, j));
+        self.opening_settled = match (widest, self.rec.opening_so_far().0) {
+            (Some(widest), Some(record)) => widest <= record + 1e-9 * model.m.gap,
+            _ => true,
+        };
     }
 
     /// Apply the event of `which` at `t` (state `y` there, before it).
@@ -408,6 +430,7 @@ pub(super) fn start<D: DriveModel>(model: &RelayModel<'_, D>, e0: f64) -> Propag
         proven_at: None,
         follow_pole: true,
         pole_settled: false,
+        opening_settled: true,
         energy0,
         violation: None,
         give_up_past: None,
@@ -555,6 +578,7 @@ pub(crate) fn check_closing<D: DriveModel>(model: &RelayModel<'_, D>, p: &mut Pr
     if p.follow_pole && !p.pole_settled {
         p.pole_settled = p.bound.pole_settled(model, p.t, &p.y);
     }
+    p.settle_opening(model);
 }
 
 /// Whether every stop of `model` is released by position (or rigid), so
