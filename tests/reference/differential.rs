@@ -619,6 +619,33 @@ pub fn compare(seed: u64) -> Result<(usize, Outcome), String> {
             }
         }
     }
+    // The contact's last closure, stuck or resolved: the engine follows
+    // it past the proof until its force can reach no further than its
+    // record, so its record holds every force the reference saw to the
+    // horizon (and more, where the engine followed it beyond).
+    if matches!(run.contact.outcome, Outcome::Stuck | Outcome::Resolved)
+        && run.contact.impacts.len() == extremes.len()
+    {
+        let scale = extremes
+            .iter()
+            .map(|e| e.peak.abs().max(e.min.abs()))
+            .fold(0.0, f64::max);
+        if let (Some(i), Some(r)) = (run.contact.impacts.last(), extremes.last()) {
+            let tolerance = 1e-6 * scale;
+            let holds = i.peak_force.is_some_and(|p| p >= r.peak - tolerance)
+                && i.min_force.is_some_and(|m| m <= r.min + tolerance);
+            if !holds {
+                return Err(format!(
+                    "last closure: force from {:?} to {:?} N, the reference's from {:e} to {:e} N\n{}",
+                    i.min_force,
+                    i.peak_force,
+                    r.min,
+                    r.peak,
+                    describe()
+                ));
+            }
+        }
+    }
     // The ending does not depend on how long the run was allowed: the
     // same with `t_end` doubled, unless the longer run's contact was still
     // moving at the first one's end.

@@ -342,6 +342,12 @@ impl<'m, 'a, D: DriveModel> Frozen<'m, 'a, D> {
 
 /// (x, f(x)) at the minimum of a convex `f` on `[lo, hi]`.
 fn golden(f: impl Fn(f64) -> f64, lo: f64, hi: f64) -> (f64, f64) {
+    golden_to(f, lo, hi, 1e-15)
+}
+
+/// [`golden`], stopped once the bracket is within `relative` of its
+/// ends' size.
+fn golden_to(f: impl Fn(f64) -> f64, lo: f64, hi: f64, relative: f64) -> (f64, f64) {
     const R: f64 = 0.618_033_988_749_894_9;
     let (mut a, mut b) = (lo, hi);
     let mut c = b - R * (b - a);
@@ -361,7 +367,7 @@ fn golden(f: impl Fn(f64) -> f64, lo: f64, hi: f64) -> (f64, f64) {
             d = a + R * (b - a);
             fd = f(d);
         }
-        if b - a <= 1e-15 * (a.abs() + b.abs()) {
+        if b - a <= relative * (a.abs() + b.abs()) {
             break;
         }
     }
@@ -410,6 +416,165 @@ pub(crate) fn widest_opening<D: DriveModel>(model: &RelayModel<'_, D>, j: f64) -
     }
     let back = (-b - disc.sqrt()) / (2.0 * a);
     Some((m.gap - back).max(0.0))
+}
+
+/// After a `stuck` ending under a constant force: the least and largest
+/// force the closed contact's law can still give, from the energy `j` of
+/// state `y` (the energy only falls). The contact point stays where the
+/// least potential over the armature's positions, plus the contact's own
+/// energy, is below `j`: a convex function of the penetration `δ`, whose
+/// sublevel set `[δ_lo, δ_hi]` is bracketed from the present `δ` and
+/// bisected; the blade's speed is at most `√(2 (j − min V)/m_b)`. `None`
+/// where there is no such bound (a drive that varies, a rest stop, a
+/// rigid contact, whose force is the blade's spring).
+pub(crate) fn force_reach<D: DriveModel>(model: &RelayModel<'_, D>, y: &Y) -> Option<(f64, f64)> {
+    let force = model.drive.constant()?;
+    if model.rest || matches!(model.contact, Surface::Rigid { .. }) {
+        return None;
+    }
+    let j = step_energy(model, y)?;
+    let m = model.m;
+    let (g, s, net) = (m.gap, m.stiffness, force - m.preload);
+    let pole = model.build.pole_face.map(|p| (g + p.overtravel, p.surface));
+    // The armature's part of the potential at x_a, the blade's spring
+    // to x_b included.
+    let armature = |xa: f64, xb: f64, sb: f64| {
+        let mut v = 0.5 * s * xa * xa - net * xa + 0.5 * sb * (xa - xb) * (xa - xb);
+        if let Some((plane, surface)) = &pole {
+            v += surface_energy(surface, xa - plane);
+        }
+        v
+    };
+    // Its least value over x_a, at x_b: the unconstrained minimum when
+    // the pole face is not pressed there, else searched between the pole
+    // face's plane and that minimum (convex).
+    let least = |xb: f64| -> f64 {
+        let Some(blade) = &model.build.blade else {
+            return armature(xb, xb, 0.0);
+        };
+        let sb = blade.stiffness;
+        let free = (net + sb * xb) / (s + sb);
+        match &pole {
+            Some((plane, _)) if free > *plane => golden(|xa| armature(xa, xb, sb), *plane, free).1,
+            _ => armature(free, xb, sb),
+        }
+    };
+    let h = |delta: f64| least(g + delta) + surface_energy(&model.contact, delta);
+    let now = if model.build.blade.is_some() {
+        y[2]
+    } else {
+        y[0]
+    };
+    // Not inside its own set (a NaN, or rounding past the edge): no
+    // bound.
+    if !matches!(
+        h(now).partial_cmp(&j),
+        Some(std::cmp::Ordering::Less | std::cmp::Ordering::Equal)
+    ) {
+        return None;
+    }
+    let mass = model.build.blade.map_or(m.mass, |b| b.mass);
+    // Without a pole face, with a Kelvin–Voigt contact pressed in over
+    // the whole set: `h` is the quadratic `A δ² + B δ + C` there, and
+    // the set and its least energy are had in closed form.
+    if let (None, Surface::KelvinVoigt { stiffness, damping }) = (&pole, model.contact) {
+        let (a, b, c) = match &model.build.blade {
+            Some(blade) => {
+                let sb = blade.stiffness;
+                (
+                    0.5 * sb * s / (s + sb),
+                    -net * sb / (s + sb),
+                    -net * net / (2.0 * (s + sb)),
+                )
+            }
+            None => (0.5 * s, -net, 0.0),
+        };
+        let qa = a + 0.5 * stiffness;
+        let qb = 2.0 * a * g + b;
+        let qc = a * g * g + b * g + c;
+        let floor = qc - qb * qb / (4.0 * qa);
+        let disc = qb * qb - 4.0 * qa * (qc - j);
+        if disc >= 0.0 {
+            let root = disc.sqrt();
+            // Each root from the form that does not cancel.
+            let far = if qb >= 0.0 {
+                (-qb - root) / (2.0 * qa)
+            } else {
+                (-qb + root) / (2.0 * qa)
+            };
+            let near = if far != 0.0 {
+                (qc - j) / (qa * far)
+            } else {
+                0.0
+            };
+            let (lo, hi) = (far.min(near), far.max(near));
+            if lo > 0.0 {
+                // Widened by the rounding of the quadratic's coefficients.
+                let pad = 1e-12 * (hi.abs() + g);
+                let (lo, hi) = (lo - pad, hi + pad);
+                let speed = (2.0 * (j - floor).max(0.0) / mass).sqrt();
+                return Some((
+                    stiffness * lo - damping * speed,
+                    stiffness * hi + damping * speed,
+                ));
+            }
+        }
+    }
+    // The sublevel set's end on one side of `now`: widened until above
+    // `j`, then bisected.
+    let edge = |dir: f64| {
+        let mut step = now.abs().max(1e-6 * g);
+        let mut inside = now;
+        let mut outside = now + dir * step;
+        let mut widenings = 0;
+        while h(outside) <= j {
+            inside = outside;
+            step *= 2.0;
+            outside = now + dir * step;
+            widenings += 1;
+            if widenings > 200 {
+                return None;
+            }
+        }
+        // To 1e-11 of the penetration: the force's bound to well under
+        // the 1e-9 it is held to.
+        let resolution = 1e-11 * now.abs().max(1e-6 * g);
+        while (outside - inside).abs() > resolution {
+            let mid = 0.5 * (inside + outside);
+            if mid == inside || mid == outside {
+                break;
+            }
+            if h(mid) <= j {
+                inside = mid;
+            } else {
+                outside = mid;
+            }
+        }
+        Some(outside)
+    };
+    let (lo, hi) = (edge(-1.0)?, edge(1.0)?);
+    // The least energy to 1e-16 of its scale: its minimiser to 1e-8.
+    let floor = golden_to(h, lo, hi, 1e-8).1;
+    let speed = (2.0 * (j - floor).max(0.0) / mass).sqrt();
+    let (least_force, largest) = match model.contact {
+        Surface::KelvinVoigt { stiffness, damping } => (
+            stiffness * lo - damping * speed,
+            stiffness * hi + damping * speed,
+        ),
+        Surface::HuntCrossley {
+            stiffness,
+            exponent,
+            chi,
+        } => {
+            let spring = |d: f64| stiffness * d.max(0.0).powf(exponent);
+            (
+                spring(lo) * (1.0 - chi * speed),
+                spring(hi) * (1.0 + chi * speed),
+            )
+        }
+        Surface::Rigid { .. } => return None,
+    };
+    Some((least_force, largest))
 }
 
 #[cfg(test)]

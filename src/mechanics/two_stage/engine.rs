@@ -657,7 +657,7 @@ pub fn driven_run(
 #[cfg(test)]
 mod invariant_tests {
     use super::*;
-    use crate::mechanics::two_stage::energy::step_energy;
+    use crate::mechanics::two_stage::energy::{force_reach, step_energy};
     use crate::mechanics::two_stage::propagation::invariants;
     use crate::mechanics::two_stage::{Blade, PoleFace};
 
@@ -783,5 +783,98 @@ mod invariant_tests {
             assert!((least - j).abs() < 1e-9, "{least} against {j}");
             assert!(opening > m.gap);
         });
+    }
+
+    /// The force a closed contact can still reach from a state, against
+    /// a brute-force search over every state of no more energy: the
+    /// bound holds it, and is no wider than its two parts' own maxima.
+    #[test]
+    fn the_force_reach_holds_every_state_of_no_more_energy() {
+        let check = |model: &RelayModel<'_, Constant>| {
+            let (m, build) = (model.m, model.build);
+            let blade = build.blade.unwrap();
+            let Surface::KelvinVoigt {
+                stiffness: s0,
+                damping: r0,
+            } = model.contact
+            else {
+                unreachable!()
+            };
+            // Near the closed contact's rest (pressed in by 0.23 µm, the
+            // armature 37 µm past the gap) and moving: stuck.
+            let y = Y::new(3.8e-5, 0.005, 3e-7, 0.001, 0.0);
+            let j = step_energy(model, &y).unwrap();
+            let (lo, hi) = force_reach(model, &y).expect("a bound");
+            let potential = |xa: f64, delta: f64| {
+                let xb = m.gap + delta;
+                let mut v = 0.5 * m.stiffness * xa * xa - m.force * xa
+                    + 0.5 * blade.stiffness * (xa - xb) * (xa - xb)
+                    + 0.5 * s0 * delta.max(0.0).powi(2);
+                if let Some(p) = &build.pole_face {
+                    let d = xa - m.gap - p.overtravel;
+                    if let Surface::KelvinVoigt { stiffness, .. } = p.surface {
+                        v += 0.5 * stiffness * d.max(0.0).powi(2);
+                    }
+                }
+                v
+            };
+            let (mut deepest, mut shallowest, mut slack) = (f64::MIN, f64::MAX, 0.0f64);
+            let n = 800;
+            for i in 0..=n {
+                let delta = -1e-6 + 3e-6 * i as f64 / n as f64;
+                for k in 0..=n {
+                    let xa = 1e-4 + 1.5e-4 * k as f64 / n as f64;
+                    let room = j - potential(xa, delta);
+                    if room >= 0.0 {
+                        deepest = deepest.max(delta);
+                        shallowest = shallowest.min(delta);
+                        slack = slack.max(room);
+                    }
+                }
+            }
+            let speed = (2.0 * slack / blade.mass).sqrt();
+            let (brute_lo, brute_hi) = (s0 * shallowest - r0 * speed, s0 * deepest + r0 * speed);
+            // Pressed in over the whole set, inside the grid, which then
+            // stands for the whole plane.
+            assert!(
+                shallowest > 0.0 && deepest < 1.9e-6,
+                "{shallowest} {deepest}"
+            );
+            // The grid's spacing (3.75 nm, and the energy between its
+            // points) is what the brute force may miss.
+            let grid = s0 * 4e-9 + r0 * speed * 0.02;
+            assert!(
+                hi >= brute_hi - grid && hi <= brute_hi + grid,
+                "{hi} against {brute_hi}"
+            );
+            assert!(
+                lo <= brute_lo + grid && lo >= brute_lo - grid,
+                "{lo} against {brute_lo}"
+            );
+            // The force there now is inside.
+            let now = s0 * y[2] + r0 * y[3];
+            assert!(lo < now && now < hi, "{lo} {now} {hi}");
+        };
+        // With the pole face (the bracketed search) and without it (the
+        // closed form).
+        with_model(check);
+        let (m, mut build) = relay();
+        build.pole_face = None;
+        let constant = Constant {
+            force: m.force,
+            time_scale: (m.mass / m.stiffness).sqrt(),
+        };
+        let model = RelayModel {
+            m: &m,
+            build: &build,
+            contact: Surface::KelvinVoigt {
+                stiffness: 5e5,
+                damping: 0.3,
+            },
+            back: None,
+            rest: false,
+            drive: &constant,
+        };
+        check(&model);
     }
 }

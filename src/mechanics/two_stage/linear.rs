@@ -529,6 +529,7 @@ impl LinearSystem {
                 .is_none_or(|bound| self.below(self.energy(&p.y), bound));
         }
         p.settle_opening(model);
+        p.settle_force(model);
     }
 }
 

@@ -5,7 +5,7 @@
 //! a closing's ending is decided ([`check_closing`]), and the records it
 //! returns.
 
-use super::energy::{EnergyBound, step_energy, widest_opening};
+use super::energy::{EnergyBound, force_reach, step_energy, widest_opening};
 use super::model::{RelayModel, StopMode, StopModes, Which, Y};
 use super::relay::Release;
 use super::run::{Horizon, TwoStageRun};
@@ -233,6 +233,10 @@ pub(crate) struct Propagation {
     /// Whether the contact's last opening can grow no wider (false only
     /// after an `ends_open` ending, until the energy shows it).
     pub opening_settled: bool,
+    /// Whether the closed contact's force can reach no further than its
+    /// record (false only after a `stuck` or `resolved` ending, until the
+    /// energy shows it).
+    pub force_settled: bool,
     /// J, the energy at the start, under a constant force with every stop
     /// released by position (when the energy can only fall).
     pub energy0: Option<f64>,
@@ -262,6 +266,7 @@ impl Propagation {
             follow_pole: false,
             pole_settled: false,
             opening_settled: true,
+            force_settled: true,
             energy0: self.energy0,
             violation: None,
             give_up_past: None,
@@ -279,7 +284,10 @@ impl Propagation {
         match self.ending {
             None => false,
             Some(Outcome::EventLimit) => true,
-            Some(_) => !self.follow_pole || (self.pole_settled && self.opening_settled),
+            Some(_) => {
+                !self.follow_pole
+                    || (self.pole_settled && self.opening_settled && self.force_settled)
+            }
         }
     }
 
@@ -288,6 +296,28 @@ impl Propagation {
         self.ending = Some(ending);
         self.proven_at = Some(self.t);
         self.opening_settled = ending != Outcome::EndsOpen;
+        self.force_settled = !matches!(ending, Outcome::Stuck | Outcome::Resolved);
+    }
+
+    /// After a `stuck` or `resolved` ending: whether the closed contact's
+    /// force can reach no further than its peak and least so far, by more
+    /// than 1e-9 of the larger ([`force_reach`]); recorded `by_force`, the
+    /// law's negative values read as zero. Where there is no such bound
+    /// the force is recorded to the proof.
+    pub(crate) fn settle_force<D: DriveModel>(&mut self, model: &RelayModel<'_, D>) {
+        if self.force_settled {
+            return;
+        }
+        let Some((mut lo, mut hi)) = force_reach(model, &self.y) else {
+            self.force_settled = true;
+            return;
+        };
+        if model.build.release == Release::Force {
+            (lo, hi) = (lo.max(0.0), hi.max(0.0));
+        }
+        let (peak, min) = self.rec.force_so_far();
+        let tolerance = 1e-9 * peak.abs().max(min.abs());
+        self.force_settled = hi <= peak + tolerance && lo >= min - tolerance;
     }
 
     /// After an `ends_open` ending: whether the last opening can grow no
@@ -431,6 +461,7 @@ pub(super) fn start<D: DriveModel>(model: &RelayModel<'_, D>, e0: f64) -> Propag
         follow_pole: true,
         pole_settled: false,
         opening_settled: true,
+        force_settled: true,
         energy0,
         violation: None,
         give_up_past: None,
@@ -579,6 +610,7 @@ pub(crate) fn check_closing<D: DriveModel>(model: &RelayModel<'_, D>, p: &mut Pr
         p.pole_settled = p.bound.pole_settled(model, p.t, &p.y);
     }
     p.settle_opening(model);
+    p.settle_force(model);
 }
 
 /// Whether every stop of `model` is released by position (or rigid), so
