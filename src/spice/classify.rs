@@ -229,12 +229,13 @@ pub fn classify(exit: Exit, log: &str) -> Option<Failure> {
 }
 
 fn netlist_failure(lines: &[&str]) -> Option<Failure> {
-    // stdout and stderr arrive on two pipes: ngspice's stdout banner can
-    // land between an error and its text.
+    // stdout and stderr arrive on two pipes: ngspice's stdout banner (its
+    // notes, the circuit's title and the blank lines around them) can land
+    // between an error and its text, in any order.
     let lines: Vec<&str> = lines
         .iter()
         .copied()
-        .filter(|l| !l.starts_with("Note: ") && !l.starts_with("Circuit: "))
+        .filter(|l| !l.trim().is_empty() && !l.starts_with("Note: ") && !l.starts_with("Circuit: "))
         .collect();
     for (i, l) in lines.iter().enumerate() {
         if let Some(rest) = l.strip_prefix("Error on line ") {
@@ -390,6 +391,36 @@ mod tests {
             classify(Exit::Code(0), &log("bad_value")),
             Some(Failure::Netlist { line: Some(3), .. })
         ));
+    }
+
+    /// The banner ngspice writes on stdout, landing anywhere among the
+    /// error's lines on stderr, changes nothing.
+    #[test]
+    fn a_parse_error_reads_the_same_however_the_two_pipes_interleave() {
+        let alone = classify(Exit::Code(1), &log("bad_model_line"));
+        assert!(matches!(
+            alone,
+            Some(Failure::Netlist { text: Some(_), .. })
+        ));
+        let text = log("bad_model_line");
+        let lines: Vec<&str> = text.lines().collect();
+        let at = lines
+            .iter()
+            .position(|l| l.starts_with("Error on line"))
+            .expect("the log has the error");
+        for banner in [
+            "",
+            "Note: No compatibility mode selected!",
+            "Circuit: broken",
+        ] {
+            for after in [at, at + 1] {
+                let mut mixed = lines.clone();
+                mixed.insert(after + 1, banner);
+                mixed.insert(after + 1, "");
+                let mixed = mixed.join("\n");
+                assert_eq!(classify(Exit::Code(1), &mixed), alone, "{mixed}");
+            }
+        }
     }
 
     #[test]
