@@ -392,14 +392,13 @@ pub(crate) fn step_energy<D: DriveModel>(model: &RelayModel<'_, D>, y: &Y) -> Op
 /// at which the least potential over the armature, `min V(·, x_b)`, is at
 /// most `j`. The pole face is left out (it only adds energy), so the bound
 /// is loose but never wrong.
-pub(crate) fn widest_opening<D: DriveModel>(model: &RelayModel<'_, D>, j: f64) -> Option<f64> {
-    let force = model.drive.constant()?;
-    let m = model.m;
-    let net = force - m.preload;
-    let s = m.stiffness;
-    // min over x_a of ½ s x_a² − net x_a + ½ s_b (x_a − x_b)²: a quadratic
-    // a x_b² + b x_b + c in x_b (with no blade, ½ s x² − net x itself).
-    let (a, b, c) = match &model.build.blade {
+/// `(a, b, c)`: the least over `x_a` of `½ s x_a² − net x_a + ½ s_b (x_a − x_b)²`
+/// (the armature's spring, the force's work and the blade) is the
+/// quadratic `a x_b² + b x_b + c` in `x_b`; with no blade, `½ s x² − net x`
+/// itself.
+fn least_over_armature<D: DriveModel>(model: &RelayModel<'_, D>, net: f64) -> (f64, f64, f64) {
+    let s = model.m.stiffness;
+    match &model.build.blade {
         Some(blade) => {
             let sb = blade.stiffness;
             (
@@ -409,7 +408,14 @@ pub(crate) fn widest_opening<D: DriveModel>(model: &RelayModel<'_, D>, j: f64) -
             )
         }
         None => (0.5 * s, -net, 0.0),
-    };
+    }
+}
+
+pub(crate) fn widest_opening<D: DriveModel>(model: &RelayModel<'_, D>, j: f64) -> Option<f64> {
+    let force = model.drive.constant()?;
+    let m = model.m;
+    let net = force - m.preload;
+    let (a, b, c) = least_over_armature(model, net);
     let disc = b * b - 4.0 * a * (c - j);
     if disc < 0.0 {
         return Some(0.0);
@@ -478,17 +484,7 @@ pub(crate) fn force_reach<D: DriveModel>(model: &RelayModel<'_, D>, y: &Y) -> Op
     // the whole set: `h` is the quadratic `A δ² + B δ + C` there, and
     // the set and its least energy are had in closed form.
     if let (None, Surface::KelvinVoigt { stiffness, damping }) = (&pole, model.contact) {
-        let (a, b, c) = match &model.build.blade {
-            Some(blade) => {
-                let sb = blade.stiffness;
-                (
-                    0.5 * sb * s / (s + sb),
-                    -net * sb / (s + sb),
-                    -net * net / (2.0 * (s + sb)),
-                )
-            }
-            None => (0.5 * s, -net, 0.0),
-        };
+        let (a, b, c) = least_over_armature(model, net);
         let qa = a + 0.5 * stiffness;
         let qb = 2.0 * a * g + b;
         let qc = a * g * g + b * g + c;

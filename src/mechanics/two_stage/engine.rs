@@ -693,13 +693,18 @@ mod invariant_tests {
 
     fn with_model(check: impl Fn(&RelayModel<'_, Constant>)) {
         let (m, build) = relay();
+        with_build(&m, &build, check);
+    }
+
+    /// The relay `m` built as `build`, on the test's contact and force.
+    fn with_build(m: &Mechanics, build: &TwoStage, check: impl Fn(&RelayModel<'_, Constant>)) {
         let constant = Constant {
             force: m.force,
             time_scale: (m.mass / m.stiffness).sqrt(),
         };
         let model = RelayModel {
-            m: &m,
-            build: &build,
+            m,
+            build,
             contact: Surface::KelvinVoigt {
                 stiffness: 5e5,
                 damping: 0.3,
@@ -860,21 +865,6 @@ mod invariant_tests {
         with_model(check);
         let (m, mut build) = relay();
         build.pole_face = None;
-        let constant = Constant {
-            force: m.force,
-            time_scale: (m.mass / m.stiffness).sqrt(),
-        };
-        let model = RelayModel {
-            m: &m,
-            build: &build,
-            contact: Surface::KelvinVoigt {
-                stiffness: 5e5,
-                damping: 0.3,
-            },
-            back: None,
-            rest: false,
-            drive: &constant,
-        };
-        check(&model);
+        with_build(&m, &build, check);
     }
 }
