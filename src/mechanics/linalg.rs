@@ -476,8 +476,9 @@ impl<const R: usize, const C: usize> Div<f64> for &SMatrix<f64, R, C> {
     }
 }
 
-/// A·B: entry (i, j) adds aᵢₖ·bₖⱼ in the order of k.
-#[inline]
+/// A·B: entry (i, j) adds aᵢₖ·bₖⱼ in the order of k. Always inlined,
+/// so that it takes the instruction set of the code that calls it.
+#[inline(always)]
 fn product<const R: usize, const K: usize, const C: usize>(
     a: &SMatrix<f64, R, K>,
     b: &SMatrix<f64, K, C>,

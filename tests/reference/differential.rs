@@ -804,6 +804,33 @@ fn the_engine_agrees_with_a_brute_force_reference_on_random_relays() {
     );
 }
 
+/// The engine's linear steps are compiled twice, for the baseline
+/// processor and with AVX2 where the processor has it (chosen at run
+/// time). Both must give the same runs to the last bit: every relay of
+/// the Kelvin–Voigt families (the linear ones) is run both ways at both
+/// horizons and its whole record compared as its `Debug` text, each
+/// number printed to its shortest exact form. On a processor without
+/// AVX2 both ways are the baseline and this shows nothing; optimised
+/// (`scripts/differential`), it checks the vectorised code.
+#[test]
+fn the_wide_and_the_baseline_steps_agree_to_the_bit() {
+    use chatterspice::mechanics::two_stage::with_baseline_steps;
+    let (n, first) = (count(), first_seed());
+    let mut compared = 0;
+    for seed in (first..first + n).filter(|seed| seed & 4 == 0) {
+        let relay = relay(seed);
+        let t_end = t_end_of(seed);
+        for horizon in [t_end, 2.0 * t_end] {
+            let wide = format!("{:?}", relay.engine(horizon));
+            let baseline = format!("{:?}", with_baseline_steps(|| relay.engine(horizon)));
+            assert!(wide.contains("impact_time"), "seed {seed}: {wide}");
+            assert_eq!(wide, baseline, "seed {seed}, t_end {horizon:e}");
+            compared += 1;
+        }
+    }
+    assert!(compared >= n / 2, "{compared} runs compared");
+}
+
 /// The bundled two-stage example released by position with a 3 200 N/m
 /// blade: the case that once stepped over a 4 µs re-closure.
 #[test]

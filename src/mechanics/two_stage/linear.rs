@@ -70,6 +70,7 @@ struct Term {
 }
 
 impl Term {
+    #[inline(always)]
     fn plus(form: usize) -> Term {
         Term {
             form,
@@ -77,6 +78,7 @@ impl Term {
         }
     }
 
+    #[inline(always)]
     fn minus(form: usize) -> Term {
         Term {
             form,
@@ -84,6 +86,7 @@ impl Term {
         }
     }
 
+    #[inline(always)]
     fn sign(&self) -> f64 {
         if self.negated { -1.0 } else { 1.0 }
     }
@@ -92,6 +95,7 @@ impl Term {
         self.sign() * at.value[self.form]
     }
 
+    #[inline(always)]
     fn rate(&self, at: &Reading) -> f64 {
         self.sign() * at.rate[self.form]
     }
@@ -180,6 +184,7 @@ impl ModeKit {
 
     /// The forms' values and rates at `w` (zero for forms the mode has
     /// not).
+    #[inline(always)]
     fn read(&self, w: &W) -> Reading {
         match &self.readout {
             Readout::Two { at, offset, .. } => Reading::two(&(at * w + offset)),
@@ -188,6 +193,7 @@ impl ModeKit {
     }
 
     /// The forms' values and rates after a full step of the mode from `w`.
+    #[inline(always)]
     fn read_after_step(&self, w: &W) -> Reading {
         match &self.readout {
             Readout::Two { after, offset, .. } => Reading::two(&(after * w + offset)),
@@ -205,6 +211,7 @@ struct Reading {
 
 impl Reading {
     /// Two forms' values and rates (the others zero).
+    #[inline(always)]
     fn two(v: &Vector4<f64>) -> Reading {
         Reading {
             value: [v[0], v[1], 0.0, 0.0],
@@ -213,6 +220,7 @@ impl Reading {
     }
 
     /// Four forms' values and rates.
+    #[inline(always)]
     fn four(v: &SVector<f64, 8>) -> Reading {
         Reading {
             value: [v[0], v[1], v[2], v[3]],
@@ -243,21 +251,34 @@ impl StepPolys<'_> {
     }
 
     /// The polynomial of form `form` (not negated), built on first use.
+    #[inline(always)]
     fn of(&mut self, form: usize) -> &Poly {
         let (kit, w0, y0) = (self.kit, self.w0, self.y0);
-        self.polys[form].get_or_insert_with(|| kit.forms[form].poly(w0, y0))
+        // Not `get_or_insert_with`: its closure would be compiled apart,
+        // outside the wide steps.
+        let slot = &mut self.polys[form];
+        if slot.is_none() {
+            *slot = Some(kit.forms[form].poly(w0, y0));
+        }
+        slot.as_ref().expect("built just above")
     }
 
     /// The Bernstein coefficients of form `form` over the mode's full
     /// step, computed on first use.
+    #[inline(always)]
     fn bernstein(&mut self, form: usize) -> &StepBernstein {
         let (kit, w0) = (self.kit, self.w0);
-        self.bern[form].get_or_insert_with(|| kit.forms[form].step_bernstein(w0))
+        let slot = &mut self.bern[form];
+        if slot.is_none() {
+            *slot = Some(kit.forms[form].step_bernstein(w0));
+        }
+        slot.as_ref().expect("computed just above")
     }
 
     /// Whether `term` stays positive over the step, read as `at0` at its
     /// start, as its series shows without a polynomial (see
     /// [`Series::shown_positive`]): most steps need no more.
+    #[inline(always)]
     fn stays_positive(&mut self, term: Term, at0: &Reading) -> bool {
         let form = &self.kit.forms[term.form];
         form.shown_positive(
@@ -347,6 +368,7 @@ impl LinearSystem {
     }
 
     /// The mode with the contact and the pole face `engaged` or not.
+    #[inline(always)]
     fn mode(&self, contact: bool, pole: bool) -> LinearMode {
         let (o, sp, rp) = match (self.pole, pole) {
             (Some((o, sp, rp, _)), true) => (o, sp, rp),
@@ -392,6 +414,7 @@ impl LinearSystem {
 
     /// The mode with the contact and the pole face engaged as in `modes`,
     /// with its event functions, each positive while the mode lasts.
+    #[inline(always)]
     fn kit(&self, modes: StopModes) -> ModeKit {
         let mode = self.mode(
             modes.contact != StopMode::Open,
@@ -431,12 +454,14 @@ impl LinearSystem {
     }
 
     /// J, the energy of state `y` with the force frozen.
+    #[inline(always)]
     fn energy(&self, y: &Y) -> f64 {
         let g = self.gap;
         let (xa, xb) = (g + y[0], g + y[2]);
         0.5 * self.m * y[1] * y[1] + 0.5 * self.mb * y[3] * y[3] + self.potential(xa, xb)
     }
 
+    #[inline(always)]
     fn potential(&self, xa: f64, xb: f64) -> f64 {
         let g = self.gap;
         let mut v = 0.5 * self.s * xa * xa - self.net * xa + 0.5 * self.sb * (xa - xb).powi(2);
@@ -484,10 +509,12 @@ impl LinearSystem {
 
     /// N, the contact's force as recorded from the law's value `f`: not
     /// below zero for a contact released by force.
+    #[inline(always)]
     fn force(&self, f: f64) -> f64 {
         if self.by_force { f.max(0.0) } else { f }
     }
 
+    #[inline(always)]
     fn below(&self, e: f64, bound: f64) -> bool {
         let margin = 1e-9 * (e.abs() + bound.abs() + self.s * self.gap * self.gap);
         e < bound - margin
@@ -495,6 +522,7 @@ impl LinearSystem {
 
     /// The contact's ending, when the energy bound decides it at state
     /// `y` (a contact released by position).
+    #[inline(always)]
     fn decided(&self, y: &Y, modes: StopModes) -> Option<Outcome> {
         if !self.below(self.energy(y), self.bound) {
             return None;
@@ -509,6 +537,7 @@ impl LinearSystem {
     /// Check the closing at the present state of `p` (every fourth step):
     /// in closed form for stops released by position, else by the
     /// general bound.
+    #[inline(always)]
     fn check<D: DriveModel>(&self, model: &RelayModel<'_, D>, p: &mut Propagation) {
         let closed_form = !self.by_force && (self.pole.is_none() || self.pole_bound.is_some());
         if !closed_form {
@@ -542,6 +571,7 @@ impl LinearSystem {
 /// `A₀` is `A` with the velocities scaled by `ω` (all its entries of
 /// order ω, so that a few dozen iterations settle) and `|A₀|` irreducible,
 /// the blade's spring coupling the two bodies.
+#[inline(always)]
 fn balance(a: &Matrix4<f64>, omega: f64) -> [f64; 4] {
     let d0 = [1.0, omega, 1.0, omega];
     let b = Matrix4::from_fn(|i, j| (a[(i, j)] * d0[j] / d0[i]).abs());
@@ -556,6 +586,7 @@ fn balance(a: &Matrix4<f64>, omega: f64) -> [f64; 4] {
 }
 
 /// Whether `term`'s rate changes sign inside the step from `at0` to `at1`.
+#[inline(always)]
 fn turns(term: Term, at0: &Reading, at1: &Reading) -> bool {
     let (r0, r1) = (term.rate(at0), term.rate(at1));
     r0 != 0.0 && r1 != 0.0 && (r0 > 0.0) != (r1 > 0.0)
@@ -567,7 +598,8 @@ fn turns(term: Term, at0: &Reading, at1: &Reading) -> bool {
 /// exact polynomial, and the zero it brackets is polished on it. Most
 /// steps end here, every guard shown positive over the step by its
 /// Bernstein rows alone; the search itself is [`guard_event`].
-fn first_event(
+#[inline(always)]
+fn first_event<const WIDE: bool>(
     polys: &mut StepPolys<'_>,
     at0: &Reading,
     h: f64,
@@ -584,7 +616,14 @@ fn first_event(
         if quick {
             continue;
         }
-        let Some(tau) = guard_event(polys, guard, h, resolution) else {
+        let tau = if WIDE {
+            // SAFETY: the wide steps run only where the processor has
+            // AVX2 and FMA (see `propagate`).
+            unsafe { guard_event_wide(polys, guard, h, resolution) }
+        } else {
+            guard_event(polys, guard, h, resolution)
+        };
+        let Some(tau) = tau else {
             continue;
         };
         if best.is_none_or(|(tb, _)| tau < tb) {
@@ -602,6 +641,36 @@ fn first_event(
 /// ends there.
 #[inline(never)]
 fn guard_event(polys: &mut StepPolys<'_>, guard: Guard, h: f64, resolution: f64) -> Option<f64> {
+    search_guard(polys, guard, h, resolution)
+}
+
+/// [`guard_event`] compiled with AVX2 and FMA, for the wide steps.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline(never)]
+fn guard_event_wide(
+    polys: &mut StepPolys<'_>,
+    guard: Guard,
+    h: f64,
+    resolution: f64,
+) -> Option<f64> {
+    search_guard(polys, guard, h, resolution)
+}
+
+/// Elsewhere than on x86-64 there are no wide steps.
+#[cfg(not(target_arch = "x86_64"))]
+fn guard_event_wide(
+    polys: &mut StepPolys<'_>,
+    guard: Guard,
+    h: f64,
+    resolution: f64,
+) -> Option<f64> {
+    guard_event(polys, guard, h, resolution)
+}
+
+/// [`guard_event`]'s search, inlined into each of its compilations.
+#[inline(always)]
+fn search_guard(polys: &mut StepPolys<'_>, guard: Guard, h: f64, resolution: f64) -> Option<f64> {
     let (kit, w0) = (polys.kit, polys.w0);
     let combine = match guard {
         Guard::One(_) => Combine::One,
@@ -640,31 +709,106 @@ fn guard_event(polys: &mut StepPolys<'_>, guard: Guard, h: f64, resolution: f64)
     let (lo, hi) = (lo * h, hi * h);
     // Polish on the exact polynomial: the zero of each form that
     // crosses in the bracket; for a max the last, else the first.
-    let crossings = step_polys.filter_map(|(poly, sign)| {
+    // (A loop, not an iterator's closure, which would be compiled apart,
+    // outside the wide steps.)
+    let mut tau: Option<f64> = None;
+    for (poly, sign) in step_polys {
         // The value at the bracket's end and the rounding of the form's
         // values over the bracket (0 ≤ lo < hi).
         let (f_hi, noise) = poly.value_and_noise(hi);
         let f_lo = poly.value(lo);
         let (v_lo, v_hi) = (sign * f_lo, sign * f_hi);
         if v_hi >= 0.0 || v_lo < 0.0 {
-            return None;
+            continue;
         }
         // A form on its zero at the step's start is past that zero.
-        if lo == 0.0 && v_lo.abs() <= noise {
-            return Some(hi);
-        }
-        Some(poly.root_within((lo, hi), (f_lo, f_hi), noise))
-    });
-    let tau = match combine {
-        Combine::Max => crossings.reduce(f64::max),
-        _ => crossings.reduce(f64::min),
+        let crossing = if lo == 0.0 && v_lo.abs() <= noise {
+            hi
+        } else {
+            poly.root_within((lo, hi), (f_lo, f_hi), noise)
+        };
+        tau = Some(match (tau, combine) {
+            (None, _) => crossing,
+            (Some(t), Combine::Max) => t.max(crossing),
+            (Some(t), _) => t.min(crossing),
+        });
     }
-    .unwrap_or(hi);
-    Some(tau)
+    Some(tau.unwrap_or(hi))
 }
 
 /// Propagate `p` exactly from event to event, to the horizon.
+///
+/// The steps are compiled twice: for the baseline x86-64 (SSE2) and,
+/// chosen at run time where the processor has them, with AVX2 and FMA
+/// enabled, whose wider vectors and three-operand instructions take the
+/// step's dot products in about two thirds of the instructions. The
+/// arithmetic is the same operation for operation (Rust never fuses a
+/// multiplication and an addition it is not asked to, and reorders no
+/// floating-point sum), so both give the same records to the last bit:
+/// the reference tests check it.
 pub(crate) fn propagate<D: DriveModel>(
+    system: &LinearSystem,
+    model: &RelayModel<'_, D>,
+    settings: &Settings,
+    horizon: Horizon,
+    p: &mut Propagation,
+) -> Result<(), DriveError> {
+    #[cfg(target_arch = "x86_64")]
+    if wide_steps() {
+        // SAFETY: the processor has AVX2 and FMA, checked just above.
+        return unsafe { propagate_wide(system, model, settings, horizon, p) };
+    }
+    propagate_steps::<false, _>(system, model, settings, horizon, p)
+}
+
+/// Whether this processor runs the wide steps (AVX2 and FMA), unless
+/// the baseline ones are asked for ([`with_baseline_steps`]).
+#[cfg(target_arch = "x86_64")]
+fn wide_steps() -> bool {
+    !BASELINE_ONLY.with(std::cell::Cell::get)
+        && std::arch::is_x86_feature_detected!("avx2")
+        && std::arch::is_x86_feature_detected!("fma")
+}
+
+thread_local! {
+    /// Set to run this thread's propagations on the baseline steps
+    /// whatever the processor has.
+    static BASELINE_ONLY: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// `f` with this thread's linear propagations on the baseline steps, as
+/// on a processor without AVX2: for checking that the wide steps give the
+/// same runs.
+pub fn with_baseline_steps<T>(f: impl FnOnce() -> T) -> T {
+    /// Puts the flag back as it was, also when `f` panics.
+    struct Restore(bool);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            BASELINE_ONLY.with(|b| b.set(self.0));
+        }
+    }
+    let _restore = Restore(BASELINE_ONLY.with(|b| b.replace(true)));
+    f()
+}
+
+/// [`propagate_steps`] compiled with AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn propagate_wide<D: DriveModel>(
+    system: &LinearSystem,
+    model: &RelayModel<'_, D>,
+    settings: &Settings,
+    horizon: Horizon,
+    p: &mut Propagation,
+) -> Result<(), DriveError> {
+    propagate_steps::<true, _>(system, model, settings, horizon, p)
+}
+
+/// [`propagate`]'s steps, inlined into each of its two compilations
+/// with everything a step calls (`WIDE`: the AVX2 one, which calls the
+/// AVX2 compilation of the event search).
+#[inline(always)]
+fn propagate_steps<const WIDE: bool, D: DriveModel>(
     system: &LinearSystem,
     model: &RelayModel<'_, D>,
     settings: &Settings,
@@ -675,9 +819,12 @@ pub(crate) fn propagate<D: DriveModel>(
     while p.t < settings.t_end && !p.over() {
         let key = usize::from(p.modes.contact != StopMode::Open)
             + 2 * usize::from(p.modes.pole != StopMode::Open);
-        let kit = cache[key]
-            .get_or_insert_with(|| Arc::new(system.kit(p.modes)))
-            .clone();
+        // Not `get_or_insert_with`: its closure would be compiled apart,
+        // outside the wide steps.
+        if cache[key].is_none() {
+            cache[key] = Some(Arc::new(system.kit(p.modes)));
+        }
+        let kit = cache[key].clone().expect("built just above");
         let mode = &kit.mode;
         let mut w = mode.w_of(&p.y);
         let mut at0 = kit.read(&w);
@@ -709,7 +856,7 @@ pub(crate) fn propagate<D: DriveModel>(
             };
             let y0 = p.y;
             let mut polys = StepPolys::new(&kit, &w, &y0);
-            let event = first_event(&mut polys, &at0, h, settings.min_open_time);
+            let event = first_event::<WIDE>(&mut polys, &at0, h, settings.min_open_time);
             let (tau, w_end, at_end) = match event {
                 Some((tau, _)) => {
                     let w_end = mode.at(&w, tau);
@@ -757,6 +904,7 @@ const PIECE_STEPS: usize = 16;
 
 /// Take in the state read as `at`: the engaged contact's force, or the
 /// open contact's blade.
+#[inline(always)]
 fn observe(system: &LinearSystem, p: &mut Propagation, at: &Reading) {
     if p.modes.contact == StopMode::Open {
         p.rec.observe_blade(system.gap, at.value[UB]);
@@ -767,6 +915,7 @@ fn observe(system: &LinearSystem, p: &mut Propagation, at: &Reading) {
 
 /// The contact force's extremes and the openings over one step of `h`
 /// read as `at0` and `at1` at its ends, `p.y` the state at its end.
+#[inline(always)]
 fn track(
     system: &LinearSystem,
     p: &mut Propagation,
@@ -782,18 +931,21 @@ fn track(
     // their Bernstein coefficients that nothing inside can beat the
     // record, or that the form is monotone.
     let watched = if open { UB } else { FORCE };
-    let (least, largest, monotone) = polys.bernstein(watched).bounds();
-    if monotone {
+    let b = polys.bernstein(watched);
+    if b.monotone() {
         return;
     }
+    // The bounds' tests are monotone, so that each is asked of every
+    // coefficient (see `StepBernstein::least_is`).
     let cannot_beat = if open {
         match p.rec.opening_so_far() {
-            (Some(opening), _) => -least <= opening,
-            (None, reach) => system.gap + largest <= reach,
+            (Some(opening), _) => b.least_is(|least| -least <= opening),
+            (None, reach) => b.largest_is(|largest| system.gap + largest <= reach),
         }
     } else {
         let (peak, min) = p.rec.force_so_far();
-        system.force(largest) <= peak && system.force(least) >= min
+        b.largest_is(|largest| system.force(largest) <= peak)
+            && b.least_is(|least| system.force(least) >= min)
     };
     if cannot_beat {
         return;

@@ -30,6 +30,7 @@ pub(crate) struct LinearMode {
 impl LinearMode {
     /// The mode of scaled matrix `a`, equilibrium `eq`, scales `d` and
     /// step `h` (`‖a h‖∞ ≤` [`STEP_NORM`]).
+    #[inline(always)]
     pub(super) fn new(a: Matrix4<f64>, eq: Vector4<f64>, d: [f64; 4], h: f64) -> LinearMode {
         let mut powers = Box::new([Matrix4::identity(); TERMS]);
         for k in 1..TERMS {
@@ -48,6 +49,7 @@ impl LinearMode {
     }
 
     /// `exp(a τ)` for τ within a step, by Horner's rule on the series.
+    #[inline(always)]
     fn propagator(&self, tau: f64) -> Matrix4<f64> {
         let mut m = self.powers[TERMS - 1];
         for k in (0..TERMS - 1).rev() {
@@ -57,11 +59,13 @@ impl LinearMode {
     }
 
     /// `w(τ)` from `w0` (τ within a step), by the Taylor series.
+    #[inline(always)]
     pub(crate) fn at(&self, w0: &W, tau: f64) -> W {
         self.propagator(tau) * w0
     }
 
     /// The state of `w`.
+    #[inline(always)]
     pub(crate) fn y_of(&self, w: &W) -> Y {
         let d = &self.d;
         Y::new(
@@ -74,6 +78,7 @@ impl LinearMode {
     }
 
     /// The scaled deviation of state `y`.
+    #[inline(always)]
     pub(crate) fn w_of(&self, y: &Y) -> W {
         let d = &self.d;
         W::new(
@@ -120,9 +125,9 @@ pub(super) struct Series {
     /// full step) of the series' first [`LOW_TERMS`] terms, as rows to dot
     /// with `w0`: `b_j = k + Σ_i bern[i][j] w0_i`. Kept by column, so that
     /// the thirteen coefficients of a step are had in four vector
-    /// products, and padded to an even length with the last one repeated
+    /// products, and padded to a multiple of four with the last one repeated
     /// (the test is of every coefficient, so a repeated one changes
-    /// nothing), so that they go two at a time.
+    /// nothing), so that they go four at a time.
     pub(super) bern: [[f64; LOW_PADDED]; 4],
     /// `max_j ‖bern_j‖₁`, for the rounding of `bern_j·w0`.
     pub(super) bern_norm: f64,
@@ -133,23 +138,23 @@ pub(super) struct Series {
     /// The Bernstein coefficients of the whole series (degree
     /// `TERMS − 1`, over the mode's full step) as rows to dot with `w0`,
     /// kept by column as [`Series::bern`] is: `b_j = k + full_j·w0`, the
-    /// same polynomial the locator converts. Built at the mode's first
-    /// event or turn, with `Σ_k ‖r_k‖₁ h^k` (the rows' magnitude before
-    /// their terms cancel, for the rounding of `full_j·w0`).
-    full: std::sync::OnceLock<(Box<[[f64; TERMS]; 4]>, f64)>,
+    /// same polynomial the locator converts.
+    full: Box<[[f64; TERMS]; 4]>,
+    /// `Σ_k ‖r_k‖₁ h^k`, the full rows' magnitude before their terms
+    /// cancel, for the rounding of `full_j·w0`.
+    magnitude: f64,
     /// The rate's Bernstein rows (degree `TERMS − 2`, in the step's own
     /// time), `n (full_{j+1} − full_j)`, kept by column as [`Series::bern`]
-    /// is, with the full rows' magnitude. Built at the first step that
-    /// needs them.
-    rate_rows: std::sync::OnceLock<(Box<[[f64; TERMS - 1]; 4]>, f64)>,
-    /// s, the mode's full step.
-    h: f64,
+    /// is.
+    rate_rows: Box<[[f64; TERMS - 1]; 4]>,
 }
 
 /// A form over a whole step of its mode from one state: the Bernstein
 /// coefficients of its series' first [`LOW_TERMS`] terms, and bounds on
 /// what they leave out, of the form and of its rate. Over the mode's full
-/// step, so what they show holds for a shorter last step too.
+/// step, so what they show holds for a shorter last step too. Its tests
+/// are of every coefficient, without a branch per coefficient, so that
+/// they go four at a time.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct StepBernstein {
     /// Padded to [`LOW_PADDED`] with the last one repeated.
@@ -162,40 +167,55 @@ pub(super) struct StepBernstein {
 
 impl StepBernstein {
     /// Whether the form, negated when `negated`, is positive over the
-    /// step: every coefficient exceeds the margin.
+    /// step: every coefficient exceeds the margin (a NaN does not).
+    #[inline(always)]
     fn positive(&self, negated: bool) -> bool {
-        // Every coefficient clear of the margin (a NaN is not), without a
-        // branch per coefficient.
-        let mut clear = true;
         if negated {
-            for b in self.b {
-                clear &= -b > self.margin;
-            }
+            self.every(|b| -b > self.margin)
         } else {
-            for b in self.b {
-                clear &= b > self.margin;
-            }
+            self.every(|b| b > self.margin)
+        }
+    }
+
+    /// Whether `ok` holds of every coefficient (padding included).
+    #[inline(always)]
+    fn every(&self, ok: impl Fn(f64) -> bool) -> bool {
+        let mut clear = true;
+        for b in self.b {
+            clear &= ok(b);
         }
         clear
     }
 
-    /// Bounds on the form over the step, `(least, largest)`, and whether
-    /// it is shown monotone there (every coefficient of its rate,
-    /// `n (b_{j+1} − b_j)`, clear of the rate's margin and of one sign),
-    /// in one pass.
-    pub(super) fn bounds(&self) -> (f64, f64, bool) {
+    /// Whether `ok` holds of the least value the form can take over the
+    /// step (its least coefficient less the margin): `ok` must be
+    /// monotone, so that it is asked of every coefficient less the margin
+    /// instead, which rounds the same way.
+    #[inline(always)]
+    pub(super) fn least_is(&self, ok: impl Fn(f64) -> bool) -> bool {
+        self.every(|b| ok(b - self.margin))
+    }
+
+    /// The same of the largest value (its largest coefficient plus the
+    /// margin).
+    #[inline(always)]
+    pub(super) fn largest_is(&self, ok: impl Fn(f64) -> bool) -> bool {
+        self.every(|b| ok(b + self.margin))
+    }
+
+    /// Whether the form is shown monotone over the step: every
+    /// coefficient of its rate, `n (b_{j+1} − b_j)`, clear of the rate's
+    /// margin and of one sign.
+    #[inline(always)]
+    pub(super) fn monotone(&self) -> bool {
         let n = (LOW_TERMS - 1) as f64;
-        let (mut lo, mut hi) = (self.b[0], self.b[0]);
         let (mut rising, mut falling) = (true, true);
         for j in 0..LOW_TERMS - 1 {
-            let next = self.b[j + 1];
-            lo = if next < lo { next } else { lo };
-            hi = if next > hi { next } else { hi };
-            let d = n * (next - self.b[j]);
+            let d = n * (self.b[j + 1] - self.b[j]);
             rising &= d > self.rate_margin;
             falling &= d < -self.rate_margin;
         }
-        (lo - self.margin, hi + self.margin, rising || falling)
+        rising || falling
     }
 }
 
@@ -212,6 +232,7 @@ impl RateBernstein {
     /// The sign changes of the coefficients when every one is clear of
     /// its rounding: the rate's zeros over the step, or more by an even
     /// number (Descartes' rule of signs). `None` when one is not clear.
+    #[inline(always)]
     pub(super) fn turns(&self) -> Option<usize> {
         let mut count = 0;
         for w in self.d.windows(2) {
@@ -274,9 +295,13 @@ impl RateBernstein {
 pub(super) const LOW_TERMS: usize = 13;
 
 /// [`LOW_TERMS`] rounded up to an even number.
-const LOW_PADDED: usize = LOW_TERMS.next_multiple_of(2);
+const LOW_PADDED: usize = LOW_TERMS.next_multiple_of(4);
 
 impl Series {
+    /// The form `c·y + d` along mode `mode`, with every row its steps
+    /// read (built with the mode, once a run: always inlined, so that it
+    /// takes the instruction set of the steps that build it).
+    #[inline(always)]
     pub(super) fn new(mode: &LinearMode, c: [f64; 4], d: f64) -> Series {
         let eq = &mode.eq;
         let k = c[0] * eq[0] + c[1] * eq[1] + c[2] * eq[2] + c[3] * eq[3] + d;
@@ -300,6 +325,19 @@ impl Series {
         let bern = std::array::from_fn(|i| std::array::from_fn(|j| rows[j.min(LOW_TERMS - 1)][i]));
         // (f − f(0))/s = Σ_{k≥1} a_k s^{k−1}: degree LOW_TERMS − 2.
         let bern_after_zero = bernstein_rows(&scaled[1..LOW_TERMS], &AFTER_ZERO_WEIGHTS);
+        // The whole series' rows, `b_j = Σ_{k ≤ j} C(j, k)/C(n, k) r_k h^k`
+        // (n = `TERMS − 1`), and its rate's, `n (b_{j+1} − b_j)`.
+        let mut magnitude = 0.0;
+        for norm in norms {
+            magnitude += norm;
+        }
+        let rows = bernstein_rows(&scaled, &FULL_WEIGHTS);
+        let full: Box<[[f64; TERMS]; 4]> =
+            Box::new(std::array::from_fn(|i| std::array::from_fn(|j| rows[j][i])));
+        let n = (TERMS - 1) as f64;
+        let rate_rows = Box::new(std::array::from_fn(|i| {
+            std::array::from_fn(|j| n * (full[i][j + 1] - full[i][j]))
+        }));
         Series {
             c,
             d,
@@ -311,47 +349,20 @@ impl Series {
             bern,
             bern_norm,
             bern_after_zero,
-            full: std::sync::OnceLock::new(),
-            rate_rows: std::sync::OnceLock::new(),
-            h: mode.h,
+            full,
+            magnitude,
+            rate_rows,
         }
-    }
-
-    /// The Bernstein rows of the whole series over the mode's full step,
-    /// `b_j = Σ_{k ≤ j} C(j, k)/C(n, k) r_k h^k` (n = `TERMS − 1`), and
-    /// their magnitude.
-    fn full(&self) -> &(Box<[[f64; TERMS]; 4]>, f64) {
-        self.full.get_or_init(|| {
-            let mut scaled = [W::zeros(); TERMS];
-            let mut hk = 1.0;
-            let mut magnitude = 0.0;
-            for (k, (s, rk)) in scaled.iter_mut().zip(&self.r).enumerate() {
-                if k > 0 {
-                    hk *= self.h;
-                }
-                *s = rk * hk;
-                magnitude += s.abs().sum();
-            }
-            let rows = bernstein_rows(&scaled, &FULL_WEIGHTS);
-            let by_column = std::array::from_fn(|i| std::array::from_fn(|j| rows[j][i]));
-            (Box::new(by_column), magnitude)
-        })
     }
 
     /// The rate (in the step's own time `s = τ/h`) of the form over a
     /// whole step of the mode from `w0`, exactly: the differences of the
     /// whole series' Bernstein coefficients, `n (b_{j+1} − b_j)`.
+    #[inline(always)]
     pub(super) fn rate_bernstein(&self, w0: &W) -> RateBernstein {
-        let (rows, magnitude) = self.rate_rows.get_or_init(|| {
-            let (full, magnitude) = self.full();
-            let n = (TERMS - 1) as f64;
-            let rows =
-                std::array::from_fn(|i| std::array::from_fn(|j| n * (full[i][j + 1] - full[i][j])));
-            (Box::new(rows), *magnitude)
-        });
         RateBernstein {
-            d: rows_at(0.0, rows, w0),
-            noise: 2.0 * (TERMS - 1) as f64 * 256.0 * f64::EPSILON * magnitude * w0.amax(),
+            d: rows_at(0.0, &self.rate_rows, w0),
+            noise: 2.0 * (TERMS - 1) as f64 * 256.0 * f64::EPSILON * self.magnitude * w0.amax(),
         }
     }
 
@@ -364,13 +375,13 @@ impl Series {
     /// returns the whole step then), for 28 dot products instead of a
     /// conversion to the Bernstein form; anything less clear goes to the
     /// locator.
+    #[inline(always)]
     pub(super) fn isolated_over_step(&self, w0: &W, negated: bool) -> bool {
         let sign = if negated { -1.0 } else { 1.0 };
-        let (rows, magnitude) = self.full();
-        let noise = 256.0 * f64::EPSILON * (self.k.abs() + magnitude * w0.amax());
+        let noise = 256.0 * f64::EPSILON * (self.k.abs() + self.magnitude * w0.amax());
         let mut changes = 0;
         let mut last = 1.0;
-        for b in rows_at(self.k, rows, w0) {
+        for b in rows_at(self.k, &self.full, w0) {
             let b = sign * b;
             if b.abs() <= noise {
                 return false;
@@ -393,6 +404,7 @@ impl Series {
     /// allows, by [`Series::positive_after_zero`]; else by
     /// [`Series::positive_over_step`].
     /// The coefficients, once computed for the step, are kept in `kept`.
+    #[inline(always)]
     pub(super) fn shown_positive(
         &self,
         value: f64,
@@ -408,19 +420,25 @@ impl Series {
         if value.abs() <= rounding {
             self.positive_after_zero(w0, scale, negated)
         } else {
-            let b = kept.get_or_insert_with(|| self.bernstein_at(w0, scale, rounding));
-            b.positive(negated)
+            // Not `get_or_insert_with`: its closure would be compiled
+            // apart, outside the wide steps.
+            if kept.is_none() {
+                *kept = Some(self.bernstein_at(w0, scale, rounding));
+            }
+            kept.as_ref().is_some_and(|b| b.positive(negated))
         }
     }
 
     /// The rounding of a Bernstein coefficient `k + bern_j·w0`
     /// (`‖w0‖∞ = scale`).
+    #[inline(always)]
     fn rounding(&self, scale: f64) -> f64 {
         64.0 * f64::EPSILON * (self.k.abs() + self.bern_norm * scale)
     }
 
     /// The form's Bernstein coefficients over a whole step of the mode
     /// from `w0`, with the bounds on what they leave out.
+    #[inline(always)]
     pub(super) fn step_bernstein(&self, w0: &W) -> StepBernstein {
         let scale = w0.amax();
         self.bernstein_at(w0, scale, self.rounding(scale))
@@ -428,6 +446,7 @@ impl Series {
 
     /// [`Series::step_bernstein`] with `‖w0‖∞` and the coefficients'
     /// rounding known.
+    #[inline(always)]
     fn bernstein_at(&self, w0: &W, scale: f64, rounding: f64) -> StepBernstein {
         StepBernstein {
             b: rows_at(self.k, &self.bern, w0),
@@ -441,6 +460,7 @@ impl Series {
     /// is positive over the rest of a step from `w0` (`‖w0‖∞ = scale`):
     /// `(f(s) − f(0))/s` shown positive as [`Series::positive_over_step`]
     /// shows `f`.
+    #[inline(always)]
     fn positive_after_zero(&self, w0: &W, scale: f64, negated: bool) -> bool {
         let sign = if negated { -1.0 } else { 1.0 };
         let margin =
@@ -454,6 +474,7 @@ impl Series {
     /// polynomial in τ. Its value at τ = 0 is taken from `y0` itself, so
     /// that a state set exactly on a surface starts exactly on its zero,
     /// whatever the rounding of the scaled deviation.
+    #[inline(always)]
     pub(super) fn poly(&self, w0: &W, y0: &Y) -> Poly {
         let mut p = [0.0; TERMS];
         for (p, r) in p.iter_mut().zip(&self.r) {
@@ -502,6 +523,7 @@ const FULL_WEIGHTS: [[f64; TERMS]; TERMS] = bernstein_weights();
 /// The Bernstein rows of degree `N − 1` of the terms `scaled` (each the
 /// row of a power-basis coefficient on `[0, 1]`, dotted with `w0`):
 /// `b_j = Σ_{k ≤ j} C(j, k)/C(n, k) scaled_k`.
+#[inline(always)]
 fn bernstein_rows<const N: usize>(scaled: &[W], weights: &[[f64; N]; N]) -> [W; N] {
     std::array::from_fn(|j| {
         let mut b = W::zeros();
@@ -514,6 +536,7 @@ fn bernstein_rows<const N: usize>(scaled: &[W], weights: &[[f64; N]; N]) -> [W; 
 
 /// The coefficients `k + Σ_i rows[i][j] w0_i` of Bernstein rows kept by
 /// column.
+#[inline(always)]
 fn rows_at<const N: usize>(k: f64, rows: &[[f64; N]; 4], w0: &W) -> [f64; N] {
     let [c0, c1, c2, c3] = rows;
     let (w0, w1, w2, w3) = (w0[0], w0[1], w0[2], w0[3]);
@@ -551,6 +574,7 @@ pub(super) struct Poly {
 
 /// `Σ p_k τ^k` by Horner's rule in τ⁴ on the four residues of `k` mod 4,
 /// four chains at once (their latency, not their arithmetic, bounds it).
+#[inline(always)]
 fn evaluate(p: &[f64; TERMS], tau: f64) -> f64 {
     if tau == 0.0 {
         return p[0];
@@ -568,6 +592,7 @@ fn evaluate(p: &[f64; TERMS], tau: f64) -> f64 {
 
 /// `p` at `s` and `q` at `t`, as [`evaluate`] does each, in one pass of
 /// eight chains.
+#[inline(always)]
 fn evaluate_pair(p: &[f64; TERMS], s: f64, q: &[f64; TERMS], t: f64) -> (f64, f64) {
     let (s2, t2) = (s * s, t * t);
     let (s4, t4) = (s2 * s2, t2 * t2);
@@ -587,6 +612,7 @@ fn evaluate_pair(p: &[f64; TERMS], s: f64, q: &[f64; TERMS], t: f64) -> (f64, f6
 }
 
 impl Poly {
+    #[inline(always)]
     pub(super) fn value(&self, tau: f64) -> f64 {
         evaluate(&self.p, tau)
     }
@@ -595,11 +621,13 @@ impl Poly {
     /// over `|τ| ≤ t` (the noise): a few units in the last place of the
     /// sum of the terms' magnitudes. Below it a value is zero as far as
     /// the arithmetic can tell. Both in one pass.
+    #[inline(always)]
     pub(super) fn value_and_noise(&self, t: f64) -> (f64, f64) {
         let (v, magnitude) = evaluate_pair(&self.p, t, &self.p.map(f64::abs), t);
         (v, 8.0 * f64::EPSILON * magnitude)
     }
 
+    #[inline(always)]
     pub(super) fn derivative(&self) -> Poly {
         let mut p = [0.0; TERMS];
         for k in 1..TERMS {
@@ -615,6 +643,7 @@ impl Poly {
     /// [`Poly::value_and_noise`] at the
     /// bracket's farther end) or the bracket is two floats wide. The
     /// values at the ends are given (as [`Poly::value`] has them).
+    #[inline(always)]
     pub(super) fn root_within(&self, bracket: (f64, f64), values: (f64, f64), floor: f64) -> f64 {
         self.root_between(bracket, values, floor, ROOT_TOLERANCE)
     }
@@ -622,6 +651,7 @@ impl Poly {
     /// [`Poly::root`] with the values at the ends known, to where the
     /// value is below `floor` or the step or the bracket below `rel` of
     /// the bracket's end.
+    #[inline(always)]
     fn root_between(
         &self,
         (mut lo, mut hi): (f64, f64),
@@ -731,6 +761,7 @@ impl Poly {
     /// [`EXTREMUM_TOLERANCE`]: a value there is off by a part in 1e24 of
     /// the step's swing (the rate is zero there), and its sign, the one
     /// other use, holds.
+    #[inline(always)]
     pub(super) fn extremum(&self, h: f64) -> Option<f64> {
         let rate = self.derivative();
         let (r1, noise) = rate.value_and_noise(h);

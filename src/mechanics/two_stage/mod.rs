@@ -50,6 +50,8 @@ pub(crate) mod span;
 pub(crate) mod stepper;
 
 pub use engine::{driven_run, simulate_two_stage, step_closing};
+#[doc(hidden)]
+pub use linear::with_baseline_steps;
 pub(crate) use relay::validate_all;
 pub use relay::{Blade, PoleFace, Release, TwoStage};
 pub use run::{Horizon, TwoStageRun};
