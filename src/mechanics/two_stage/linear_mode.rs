@@ -209,9 +209,10 @@ impl StepBernstein {
     #[inline(always)]
     pub(super) fn monotone(&self) -> bool {
         let n = (LOW_TERMS - 1) as f64;
+        let (ahead, behind) = (&self.b[1..LOW_TERMS], &self.b[..LOW_TERMS - 1]);
         let (mut rising, mut falling) = (true, true);
-        for j in 0..LOW_TERMS - 1 {
-            let d = n * (self.b[j + 1] - self.b[j]);
+        for (next, b) in ahead.iter().zip(behind) {
+            let d = n * (next - b);
             rising &= d > self.rate_margin;
             falling &= d < -self.rate_margin;
         }
@@ -234,15 +235,19 @@ impl RateBernstein {
     /// number (Descartes' rule of signs). `None` when one is not clear.
     #[inline(always)]
     pub(super) fn turns(&self) -> Option<usize> {
+        // Every coefficient asked, without a branch per coefficient, so
+        // that they go four at a time.
+        let mut unclear = false;
         let mut count = 0;
-        for w in self.d.windows(2) {
+        for j in 0..TERMS - 2 {
             // Within the rounding, or a NaN: not clear.
-            if w[0].abs() <= self.noise || w[0].is_nan() {
-                return None;
-            }
-            count += usize::from((w[0] > 0.0) != (w[1] > 0.0));
+            let clear = self.d[j].abs() > self.noise;
+            unclear |= !clear;
+            count += usize::from((self.d[j] > 0.0) != (self.d[j + 1] > 0.0));
         }
-        (self.d[TERMS - 2].abs() > self.noise).then_some(count)
+        let clear = self.d[TERMS - 2].abs() > self.noise;
+        unclear |= !clear;
+        (!unclear).then_some(count)
     }
 
     /// Intervals of the full step (in its own time, `[0, 1]`) outside
@@ -379,22 +384,19 @@ impl Series {
     pub(super) fn isolated_over_step(&self, w0: &W, negated: bool) -> bool {
         let sign = if negated { -1.0 } else { 1.0 };
         let noise = 256.0 * f64::EPSILON * (self.k.abs() + self.magnitude * w0.amax());
-        let mut changes = 0;
-        let mut last = 1.0;
-        for b in rows_at(self.k, &self.full, w0) {
-            let b = sign * b;
-            if b.abs() <= noise {
-                return false;
-            }
-            if (b > 0.0) != (last > 0.0) {
-                changes += 1;
-                if changes > 1 {
-                    return false;
-                }
-            }
-            last = b;
+        // Every coefficient asked, without a branch per coefficient, so
+        // that they go four at a time.
+        let b = rows_at(self.k, &self.full, w0).map(|b| sign * b);
+        let mut unclear = false;
+        // The count starts from a positive value before the first.
+        let first_positive = b[0] > 0.0;
+        let mut changes = usize::from(!first_positive);
+        unclear |= b[0].abs() <= noise;
+        for j in 1..TERMS {
+            unclear |= b[j].abs() <= noise;
+            changes += usize::from((b[j] > 0.0) != (b[j - 1] > 0.0));
         }
-        changes == 1 && last < 0.0
+        !unclear && changes == 1 && b[TERMS - 1] < 0.0
     }
 
     /// Whether the form, negated when `negated`, is shown positive over a
