@@ -1,0 +1,99 @@
+//! The two-stage engine's cost against the one-mass engine's on the same
+//! sequence, timed in turn in one process: `cargo bench --bench
+//! two_stage_ratio [-- ROUNDS]` (300 rounds by default).
+//!
+//! Criterion times its benches one after the other, so on a shared
+//! machine the ratio of `two_stage_18_contacts` to
+//! `kelvin_voigt_reference_18_contacts` (benches/mechanics.rs) carries
+//! whatever the load did between them. Here each round times 200 calls
+//! of the one-mass engine and then 20 of the two-stage one on the same
+//! relays as those benches, so both see the same load; the least and
+//! the median time a call over the rounds, and their ratios, are
+//! printed. Target: the two-stage engine within 10× the one-mass one.
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use chatterspice::mechanics::Drive;
+use chatterspice::mechanics::cycle::Stops;
+use chatterspice::mechanics::two_stage::{Blade, Horizon, Release, TwoStage, simulate_two_stage};
+use chatterspice::{Mechanics, Settings, Surface, simulate};
+
+fn main() {
+    // The paper's reference sequence (docs/model.md), and the same
+    // armature carried on a blade, as benches/mechanics.rs has them.
+    let m = Mechanics {
+        mass: 1.0,
+        stiffness: 1.0,
+        damping: 0.1,
+        force: 1.0,
+        gap: 0.9,
+        initial_position: 0.0,
+        initial_velocity: 0.0,
+        preload: 0.0,
+    };
+    let surface = Surface::KelvinVoigt {
+        stiffness: 100.0,
+        damping: 2.0 * 0.4692,
+    };
+    let settings = Settings {
+        t_end: 100.0,
+        ..Settings::default()
+    };
+    let stops = Stops {
+        make: surface,
+        back: None,
+    };
+    let relay = TwoStage {
+        blade: Some(Blade {
+            mass: 0.2,
+            stiffness: 100.0,
+            damping: 1.0,
+        }),
+        pole_face: None,
+        release: Release::Position,
+    };
+    // `cargo bench` passes `--bench`; a number among the arguments is
+    // the rounds.
+    let rounds = std::env::args()
+        .skip(1)
+        .find_map(|a| a.parse::<usize>().ok())
+        .unwrap_or(300)
+        .max(1);
+    let one_mass = || simulate(black_box(&m), &surface, &settings).expect("the reference runs");
+    let two_stage = || {
+        simulate_two_stage(
+            black_box(&m),
+            &relay,
+            &stops,
+            &settings,
+            Drive::Step,
+            Horizon::Closing,
+        )
+        .expect("the two-stage relay runs")
+    };
+    assert_eq!(one_mass().impacts.len(), 18);
+    assert_eq!(two_stage().contact.impacts.len(), 18);
+    let (mut one, mut two) = (Vec::with_capacity(rounds), Vec::with_capacity(rounds));
+    for _ in 0..rounds {
+        let start = Instant::now();
+        for _ in 0..200 {
+            black_box(one_mass());
+        }
+        one.push(start.elapsed().as_secs_f64() / 200.0);
+        let start = Instant::now();
+        for _ in 0..20 {
+            black_box(two_stage());
+        }
+        two.push(start.elapsed().as_secs_f64() / 20.0);
+    }
+    one.sort_by(f64::total_cmp);
+    two.sort_by(f64::total_cmp);
+    for (what, k) in [("least", 0), ("median", rounds / 2)] {
+        let (a, b) = (one[k] * 1e6, two[k] * 1e6);
+        println!(
+            "{what:>6}: one-mass {a:.2} µs, two-stage {b:.1} µs a call: {:.2}×",
+            b / a
+        );
+    }
+}
