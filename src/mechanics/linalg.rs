@@ -141,6 +141,18 @@ impl<const R: usize, const C: usize> SMatrix<f64, R, C> {
         out
     }
 
+    /// `self·s + b` entry by entry, in place: each entry rounded as
+    /// `self * s + b` rounds it, without the temporaries. Always inlined,
+    /// so that it takes the instruction set of the code that calls it.
+    #[inline(always)]
+    pub fn scale_add(&mut self, s: f64, b: &Self) {
+        for (column, add) in self.columns.iter_mut().zip(&b.columns) {
+            for (x, a) in column.iter_mut().zip(add) {
+                *x = *x * s + a;
+            }
+        }
+    }
+
     /// Rows `start` to `start + N`, copied.
     #[inline]
     pub fn fixed_rows<const N: usize>(&self, start: usize) -> SMatrix<f64, N, C> {
@@ -560,6 +572,10 @@ mod tests {
         assert_eq!((v * 2.0 - v) / 1.0 + Vector4::zeros(), v);
         assert_eq!(Matrix4::identity() * v, v);
         assert_eq!(Vector2::new(3.0, 4.0).norm(), 5.0);
+        let mut m = a;
+        m.scale_add(0.3, &b);
+        assert_eq!(m, a * 0.3 + b);
+        assert_ne!(m, a);
     }
 
     #[test]

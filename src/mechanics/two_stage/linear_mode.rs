@@ -52,8 +52,8 @@ impl LinearMode {
     #[inline(always)]
     fn propagator(&self, tau: f64) -> Matrix4<f64> {
         let mut m = self.powers[TERMS - 1];
-        for k in (0..TERMS - 1).rev() {
-            m = m * tau + self.powers[k];
+        for power in self.powers[..TERMS - 1].iter().rev() {
+            m.scale_add(tau, power);
         }
         m
     }
@@ -112,6 +112,10 @@ pub(super) struct Series {
     d: f64,
     pub(super) k: f64,
     pub(super) r: [W; TERMS],
+    /// The same rows kept by column, so that a step's polynomial,
+    /// `r_k·w0` for every k, is had four terms at a time, each dot
+    /// product in [`W::dot`]'s order.
+    r_columns: [[f64; TERMS]; 4],
     /// `Σ_{k≥1} ‖r_k‖₁ h^k` over the mode's step: the form moves less
     /// than this times `‖w0‖∞` within a step from `w0`.
     pub(super) spread: f64,
@@ -343,11 +347,13 @@ impl Series {
         let rate_rows = Box::new(std::array::from_fn(|i| {
             std::array::from_fn(|j| n * (full[i][j + 1] - full[i][j]))
         }));
+        let r_columns = std::array::from_fn(|i| std::array::from_fn(|k| r[k][i]));
         Series {
             c,
             d,
             k,
             r,
+            r_columns,
             spread,
             tail,
             rate_tail,
@@ -478,9 +484,12 @@ impl Series {
     /// whatever the rounding of the scaled deviation.
     #[inline(always)]
     pub(super) fn poly(&self, w0: &W, y0: &Y) -> Poly {
+        // `r_k·w0` as `W::dot` sums it, `(a₀b₀ + a₂b₂) + (a₁b₁ + a₃b₃)`.
+        let [c0, c1, c2, c3] = &self.r_columns;
+        let (w0, w1, w2, w3) = (w0[0], w0[1], w0[2], w0[3]);
         let mut p = [0.0; TERMS];
-        for (p, r) in p.iter_mut().zip(&self.r) {
-            *p = r.dot(w0);
+        for k in 0..TERMS {
+            p[k] = (c0[k] * w0 + c2[k] * w2) + (c1[k] * w1 + c3[k] * w3);
         }
         let c = &self.c;
         p[0] = c[0] * y0[0] + c[1] * y0[1] + c[2] * y0[2] + c[3] * y0[3] + self.d;
