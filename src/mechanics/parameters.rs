@@ -34,7 +34,7 @@ pub struct Mechanics {
 /// (with the drive as it is). Stuck, with its settle time before `t_end`,
 /// only when proven before any further event; else `end_of_time`, saying
 /// that the contact was closed.
-pub const PROOF_SPAN: f64 = 10.0;
+pub const PROOF_SPAN: f64 = 30.0;
 
 /// When to stop and what is too small to matter (docs/model.md §4).
 #[derive(Debug, Clone, Copy, PartialEq)]
