@@ -273,21 +273,7 @@ pub fn write(
     let done = match kept {
         Some((end, done)) => {
             if in_place.is_none() {
-                // The header and the finished rows, copied as they are.
-                let copied = crate::input::open_regular(&from_csv).and_then(|file| {
-                    std::io::copy(&mut std::io::Read::take(file, end), staged.file())
-                });
-                match copied {
-                    Ok(n) if n == end => {}
-                    Ok(_) => {
-                        return Err(cannot_write(&partial_csv)(std::io::Error::new(
-                            std::io::ErrorKind::UnexpectedEof,
-                            format!("{} was cut while it was copied", from_csv.display()),
-                        ))
-                        .into());
-                    }
-                    Err(e) => return Err(cannot_write(&partial_csv)(e).into()),
-                }
+                copy_finished_rows(&from_csv, end, staged.file(), &partial_csv)?;
             }
             note(&Note::Resuming {
                 from: from_csv.clone(),
@@ -354,6 +340,33 @@ pub fn write(
         rows,
         files: names.iter().map(|n| dir.join(n)).collect(),
     })
+}
+
+/// Copy the header and the finished rows of `from` (its first `end`
+/// bytes) into the staged CSV `to` (at `staged`), as they are: a file cut
+/// short of `end` is an error naming it.
+fn copy_finished_rows(
+    from: &Path,
+    end: u64,
+    to: &mut std::fs::File,
+    staged: &Path,
+) -> Result<(), FilesError> {
+    let cannot_write = |source| {
+        FilesError::from(WriteError::Io {
+            path: staged.to_path_buf(),
+            source,
+        })
+    };
+    let copied = crate::input::open_regular(from)
+        .and_then(|file| std::io::copy(&mut std::io::Read::take(file, end), to));
+    match copied {
+        Ok(n) if n == end => Ok(()),
+        Ok(_) => Err(cannot_write(std::io::Error::new(
+            std::io::ErrorKind::UnexpectedEof,
+            format!("{} was cut while it was copied", from.display()),
+        ))),
+        Err(e) => Err(cannot_write(e)),
+    }
 }
 
 /// Fail before any work if the sweep's files exist (unless `force`), or
