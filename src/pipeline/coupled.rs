@@ -378,234 +378,423 @@ pub fn run_coupled_plan(
     runner: &dyn Runner,
     options: &CouplingOptions,
 ) -> Result<Coupled, CouplingError> {
-    let scenario = plan.scenario();
-    let origin = scenario.origin.clone();
-    let section = scenario
-        .coil
-        .as_ref()
-        .ok_or_else(|| CouplingError::NoCoil {
-            path: origin.clone(),
-        })?;
-    let coil = Coil::from(section);
-    let levels = coil_levels(scenario, &coil);
-    let circuit = scenario
-        .circuit
-        .as_ref()
-        .ok_or_else(|| CouplingError::NoCircuit {
-            path: origin.clone(),
-        })?;
-    let netlist = plan
-        .netlist()
-        .expect("there is a [circuit], so the plan read its netlist");
-    let (netlist_path, netlist_text) = (netlist.path.clone(), netlist.text.as_str());
-    let instances = instances_of(netlist_text, &circuit.coil_subckt);
-    let [coil_instance] = instances.as_slice() else {
-        return Err(CouplingError::CoilInstances {
-            netlist: netlist_path,
-            subckt: circuit.coil_subckt.clone(),
-            found: instances.len(),
-        });
+    let setup = Setup::of(plan)?;
+    let fallback = match lock_step(&setup, runner, options)? {
+        Ok(coupled) => return Ok(coupled),
+        Err(fallback) => fallback,
     };
-    if let Some(nc) = &circuit.nc_subckt {
-        if instances_of(netlist_text, nc).is_empty() {
-            return Err(CouplingError::NcNotInstantiated {
-                netlist: netlist_path,
-                subckt: nc.clone(),
-            });
-        }
-    }
-    let m = &scenario.mechanics;
-    let mechanics = Mechanics {
-        mass: m.mass,
-        stiffness: m.stiffness,
-        damping: m.damping,
-        force: 0.0,
-        gap: m.gap,
-        initial_position: m.initial_position,
-        initial_velocity: m.initial_velocity,
-        preload: m.preload,
-    };
-    coil.validate(m.gap).map_err(|source| CouplingError::Coil {
-        path: origin.clone(),
-        iteration: 0,
-        source,
-    })?;
-    let stops = Stops {
-        make: plan.surface(),
-        back: plan.back_stop(),
-    };
-    let settings = plan.settings();
-    let build = plan.two_stage();
-    let model = ContactModel::from(&scenario.contact);
-    let psi = flux_vector(coil_instance);
-    let volts = voltage_vector(coil_instance);
-    let current = current_vector(coil_instance);
-    // The coil's own vectors too, in case the netlist `.save`s only some.
-    let mut signals: Vec<&str> = scenario.probes.iter().map(|p| p.signal.as_str()).collect();
-    signals.extend([psi.as_str(), volts.as_str(), current.as_str()]);
-    // With [arc], the contact carries the arc in every pass.
-    let arc = scenario.arc.map(|a| a.model());
-    let arc_vectors = instances_of(netlist_text, &circuit.subckt)
-        .first()
-        .map(|instance| ArcVectors::of(instance));
-    if let (Some(_), Some(vectors)) = (&arc, &arc_vectors) {
-        signals.extend(vectors.all());
-    }
+    passes(&setup, runner, options, fallback)
+}
 
-    let fallback = match lock_step_library(options, runner) {
-        Ok(library) => {
-            let relay = super::lockstep::Relay {
-                mechanics,
-                build,
-                stops,
-                settings,
-                coil,
-                contact: model,
-                flux: format!("{coil_instance}.psi").to_ascii_lowercase(),
-                arc,
-            };
-            let lock = super::lockstep::LockStepRunner::new(library, relay);
-            let mut contact = super::lockstep::contact_include(
-                &circuit.subckt,
-                super::lockstep::MAKE_SOURCE,
-                arc.as_ref(),
-                m.gap - m.initial_position,
-            )?;
-            if let Some(nc) = &circuit.nc_subckt {
-                contact.push_str(&super::lockstep::contact_include(
-                    nc,
-                    super::lockstep::BREAK_SOURCE,
-                    None,
-                    0.0,
-                )?);
-            }
-            let deck = netlist::prepare_deck_with_params(
-                &DeckRequest {
-                    netlist_text,
-                    netlist_path: &netlist_path,
-                    include_file_name: CONTACT_FILE,
-                    subckt: &circuit.subckt,
-                    coil: Some((COIL_FILE, &circuit.coil_subckt)),
-                    probes: &signals,
-                    chatter_end: 0.0,
-                    stop_at_least: 0.0,
-                    options: if arc.is_some() {
-                        &[crate::netlist::arc::ARC_OPTIONS]
-                    } else {
-                        &[]
-                    },
-                },
-                &circuit.param_list(),
-            )?;
-            let includes = vec![
-                (CONTACT_FILE.to_owned(), contact),
-                (
-                    COIL_FILE.to_owned(),
-                    netlist::coil::coil_include_external(section, &circuit.coil_subckt)?,
-                ),
-            ];
-            let simulation = super::pass::circuit_pass(
-                &lock,
-                super::pass::Pass {
-                    run: "coupled",
-                    netlist: &netlist_path,
-                    deck: &deck,
-                    includes,
-                    timeout: options.timeout,
-                    keep_workdir: options.keep_workdir,
-                },
-            )
-            .map_err(|e| match e {
-                super::pass::PassError::Spice { source, .. } => CouplingError::Spice {
-                    netlist: netlist_path.clone(),
-                    iteration: 1,
-                    source,
-                },
-                _ => CouplingError::MissingVector {
-                    iteration: 1,
-                    vector: psi.clone(),
-                },
+/// What a coupled run reads from its plan once: the coil and its levels,
+/// the circuit and its netlist, the one coil instance and the vectors
+/// read from it, the relay and its contact, and the signals to save.
+struct Setup<'a> {
+    origin: PathBuf,
+    section: &'a crate::scenario::CoilSection,
+    coil: Coil,
+    levels: CoilLevels,
+    circuit: &'a crate::scenario::CircuitSection,
+    netlist_path: PathBuf,
+    netlist_text: &'a str,
+    coil_instance: String,
+    mechanics: Mechanics,
+    /// m, the contact gap at rest.
+    gap: f64,
+    /// m, where the armature starts.
+    initial_position: f64,
+    stops: Stops,
+    settings: crate::mechanics::Settings,
+    build: crate::mechanics::two_stage::TwoStage,
+    model: ContactModel,
+    /// The coil's flux, voltage and current vectors.
+    psi: String,
+    volts: String,
+    signals: Vec<String>,
+    arc: Option<crate::arc::ArcModel>,
+}
+
+impl<'a> Setup<'a> {
+    fn of(plan: &'a Plan) -> Result<Setup<'a>, CouplingError> {
+        let scenario = plan.scenario();
+        let origin = scenario.origin.clone();
+        let section = scenario
+            .coil
+            .as_ref()
+            .ok_or_else(|| CouplingError::NoCoil {
+                path: origin.clone(),
             })?;
-            let stats = lock.last_stats().unwrap_or_default();
-            let plot = simulation.plot;
-            let flux = series(&plot, &psi).ok_or_else(|| CouplingError::MissingVector {
-                iteration: 1,
-                vector: psi.clone(),
+        let coil = Coil::from(section);
+        let levels = coil_levels(scenario, &coil);
+        let circuit = scenario
+            .circuit
+            .as_ref()
+            .ok_or_else(|| CouplingError::NoCircuit {
+                path: origin.clone(),
             })?;
-            let flux_at = Interpolator::new(&flux);
-            let pull = |t: f64, _x: f64| coil.force_from_flux(flux_at.at(t));
-            let cycle =
-                driven_run(&mechanics, &build, &stops, &settings, &pull).map_err(|source| {
-                    CouplingError::Coil {
-                        path: origin.clone(),
-                        iteration: 1,
-                        source,
-                    }
-                })?;
-            // The rest stop's changes count where the circuit has the
-            // normally-closed contact to see them.
-            let mut change = changes_moved(&stats.make_changes, &cycle.chatter().intervals);
-            if circuit.nc_subckt.is_some() {
-                change = change.max(changes_moved(
-                    &stats.break_changes,
-                    &back_of(&cycle).intervals,
-                ));
-            }
-            if change <= options.tolerance {
-                let iterations = vec![Iteration {
-                    first_impact: cycle.chatter().first_impact,
-                    bounces: cycle.chatter().bounce_count,
-                    change,
-                    ngspice_elapsed: simulation.elapsed.as_secs_f64(),
-                    scheme: Coupling::LockStep,
-                }];
-                let thinning = options.path_tolerance * (coil.air_gap + coil.iron_gap);
-                let (chatter, back, path, strokes, pole_face) = records(cycle, thinning);
-                let switching = switching_of(&plot, &volts, &levels, 1)?;
-                return Ok(Coupled {
-                    operations: operations(&strokes, &chatter.impacts, &switching),
-                    levels,
-                    switching,
-                    chatter,
-                    back,
-                    path,
-                    plot,
-                    coil_instance: coil_instance.clone(),
-                    iterations,
-                    deck,
-                    version: simulation.version,
-                    log: simulation.log,
-                    pole_face,
-                    fallback: None,
+        let netlist = plan
+            .netlist()
+            .expect("there is a [circuit], so the plan read its netlist");
+        let (netlist_path, netlist_text) = (netlist.path.clone(), netlist.text.as_str());
+        let instances = instances_of(netlist_text, &circuit.coil_subckt);
+        let [coil_instance] = instances.as_slice() else {
+            return Err(CouplingError::CoilInstances {
+                netlist: netlist_path,
+                subckt: circuit.coil_subckt.clone(),
+                found: instances.len(),
+            });
+        };
+        if let Some(nc) = &circuit.nc_subckt {
+            if instances_of(netlist_text, nc).is_empty() {
+                return Err(CouplingError::NcNotInstantiated {
+                    netlist: netlist_path,
+                    subckt: nc.clone(),
                 });
             }
-            Some(if change.is_finite() {
-                format!(
-                    "the lock-step run's own events and the mechanics under its flux differ \
-                     by {change:e} s, more than the coupling tolerance ({:e} s): the coupling \
-                     was run again as passes",
-                    options.tolerance
-                )
-            } else {
-                // Seen when another user of the library in this process
-                // (PySpice, a ctypes binding) initialised it before us.
-                "the lock-step run's own events and the mechanics under its flux do not have \
-                 the same contact changes (another user of ngspice's shared library in this \
-                 process, such as PySpice, can cause this): the coupling was run again as \
-                 passes"
-                    .to_owned()
-            })
         }
-        Err(note) => note,
-    };
+        let m = &scenario.mechanics;
+        let mechanics = Mechanics {
+            mass: m.mass,
+            stiffness: m.stiffness,
+            damping: m.damping,
+            force: 0.0,
+            gap: m.gap,
+            initial_position: m.initial_position,
+            initial_velocity: m.initial_velocity,
+            preload: m.preload,
+        };
+        coil.validate(m.gap).map_err(|source| CouplingError::Coil {
+            path: origin.clone(),
+            iteration: 0,
+            source,
+        })?;
+        let stops = Stops {
+            make: plan.surface(),
+            back: plan.back_stop(),
+        };
+        let settings = plan.settings();
+        let build = plan.two_stage();
+        let model = ContactModel::from(&scenario.contact);
+        let psi = flux_vector(coil_instance);
+        let volts = voltage_vector(coil_instance);
+        let current = current_vector(coil_instance);
+        // The coil's own vectors too, in case the netlist `.save`s only some.
+        let mut signals: Vec<&str> = scenario.probes.iter().map(|p| p.signal.as_str()).collect();
+        signals.extend([psi.as_str(), volts.as_str(), current.as_str()]);
+        // With [arc], the contact carries the arc in every pass.
+        let arc = scenario.arc.map(|a| a.model());
+        let arc_vectors = instances_of(netlist_text, &circuit.subckt)
+            .first()
+            .map(|instance| ArcVectors::of(instance));
+        if let (Some(_), Some(vectors)) = (&arc, &arc_vectors) {
+            signals.extend(vectors.all());
+        }
+        Ok(Setup {
+            origin,
+            section,
+            coil,
+            levels,
+            circuit,
+            netlist_path,
+            netlist_text,
+            coil_instance: coil_instance.clone(),
+            mechanics,
+            gap: m.gap,
+            initial_position: m.initial_position,
+            stops,
+            settings,
+            build,
+            model,
+            signals: signals.into_iter().map(str::to_owned).collect(),
+            psi,
+            volts,
+            arc,
+        })
+    }
 
+    /// The signals to save, as the deck takes them.
+    fn probes(&self) -> Vec<&str> {
+        self.signals.iter().map(String::as_str).collect()
+    }
+
+    /// The motion of pass `iteration` (`cycle`, under the flux `flux` of
+    /// its `plot`, the armature's path having been `path`) settled
+    /// against the coil's own circuit as ngspice ran it, before the next
+    /// pass (docs/coupling.md).
+    fn settled(
+        &self,
+        plot: &Plot,
+        flux: &[(f64, f64)],
+        path: &[(f64, f64)],
+        cycle: Trajectory,
+        options: &CouplingOptions,
+        iteration: usize,
+    ) -> Result<Trajectory, CouplingError> {
+        let Some(Vector::Real(time)) = plot.scale() else {
+            return Err(CouplingError::MissingVector {
+                iteration,
+                vector: "time".to_owned(),
+            });
+        };
+        let coil_volts = plot
+            .real(&self.volts)
+            .ok_or_else(|| CouplingError::MissingVector {
+                iteration,
+                vector: self.volts.clone(),
+            })?;
+        let flux_values: Vec<f64> = flux.iter().map(|&(_, v)| v).collect();
+        let run = CircuitRun {
+            time,
+            volts: coil_volts,
+            flux: &flux_values,
+            path,
+        };
+        let thinning = options.path_tolerance * (self.coil.air_gap + self.coil.iron_gap);
+        let (next, _) = settle(
+            &self.coil,
+            &run,
+            cycle,
+            &self.mechanics,
+            &self.build,
+            &self.stops,
+            &self.settings,
+            CouplingTolerances {
+                events: options.tolerance,
+                path: thinning,
+            },
+        )
+        .map_err(|source| CouplingError::Coil {
+            path: self.origin.clone(),
+            iteration,
+            source,
+        })?;
+        Ok(next)
+    }
+
+    /// The user's deck with the contact's and the coil's includes and
+    /// the signals to save, run to at least `end`.
+    fn deck(&self, end: f64) -> Result<Deck, CouplingError> {
+        let probes = self.probes();
+        Ok(netlist::prepare_deck_with_params(
+            &DeckRequest {
+                netlist_text: self.netlist_text,
+                netlist_path: &self.netlist_path,
+                include_file_name: CONTACT_FILE,
+                subckt: &self.circuit.subckt,
+                coil: Some((COIL_FILE, &self.circuit.coil_subckt)),
+                probes: &probes,
+                chatter_end: end,
+                stop_at_least: end,
+                options: if self.arc.is_some() {
+                    &[crate::netlist::arc::ARC_OPTIONS]
+                } else {
+                    &[]
+                },
+            },
+            &self.circuit.param_list(),
+        )?)
+    }
+
+    /// One ngspice run of `deck` with `includes`, as pass `iteration`.
+    fn pass(
+        &self,
+        runner: &dyn Runner,
+        deck: &Deck,
+        includes: Vec<(String, String)>,
+        options: &CouplingOptions,
+        iteration: usize,
+    ) -> Result<super::pass::Simulation, CouplingError> {
+        super::pass::circuit_pass(
+            runner,
+            super::pass::Pass {
+                run: "coupled",
+                netlist: &self.netlist_path,
+                deck,
+                includes,
+                timeout: options.timeout,
+                keep_workdir: options.keep_workdir,
+            },
+        )
+        .map_err(|e| match e {
+            super::pass::PassError::Spice { source, .. } => CouplingError::Spice {
+                netlist: self.netlist_path.clone(),
+                iteration,
+                source,
+            },
+            _ => CouplingError::MissingVector {
+                iteration,
+                vector: self.psi.clone(),
+            },
+        })
+    }
+
+    /// The coil's flux in `plot` and the relay's motion under its pull,
+    /// in pass `iteration`.
+    fn mechanics_under(
+        &self,
+        plot: &Plot,
+        iteration: usize,
+    ) -> Result<(Vec<(f64, f64)>, Trajectory), CouplingError> {
+        let flux = series(plot, &self.psi).ok_or_else(|| CouplingError::MissingVector {
+            iteration,
+            vector: self.psi.clone(),
+        })?;
+        let flux_at = Interpolator::new(&flux);
+        let pull = |t: f64, _x: f64| self.coil.force_from_flux(flux_at.at(t));
+        let cycle = driven_run(
+            &self.mechanics,
+            &self.build,
+            &self.stops,
+            &self.settings,
+            &pull,
+        )
+        .map_err(|source| CouplingError::Coil {
+            path: self.origin.clone(),
+            iteration,
+            source,
+        })?;
+        Ok((flux, cycle))
+    }
+}
+
+/// The coupled run in lock-step, ngspice's shared library calling the
+/// mechanics at every time point: `Ok(Err(note))` where it is not run
+/// that way (`note`: why, or `None` when passes were asked for) or its
+/// result is not kept (its own events and the mechanics under its flux
+/// differ by more than the tolerance), and the passes run instead.
+fn lock_step(
+    setup: &Setup<'_>,
+    runner: &dyn Runner,
+    options: &CouplingOptions,
+) -> Result<Result<Coupled, Option<String>>, CouplingError> {
+    let library = match lock_step_library(options, runner) {
+        Ok(library) => library,
+        Err(note) => return Ok(Err(note)),
+    };
+    let (coil, mechanics, stops, settings, build, model, arc) = (
+        setup.coil,
+        setup.mechanics,
+        setup.stops,
+        setup.settings,
+        setup.build,
+        setup.model,
+        setup.arc,
+    );
+    let (section, circuit, levels) = (setup.section, setup.circuit, setup.levels);
+    let (coil_instance, volts) = (&setup.coil_instance, &setup.volts);
+    let relay = super::lockstep::Relay {
+        mechanics,
+        build,
+        stops,
+        settings,
+        coil,
+        contact: model,
+        flux: format!("{coil_instance}.psi").to_ascii_lowercase(),
+        arc,
+    };
+    let lock = super::lockstep::LockStepRunner::new(library, relay);
+    let mut contact = super::lockstep::contact_include(
+        &circuit.subckt,
+        super::lockstep::MAKE_SOURCE,
+        arc.as_ref(),
+        setup.gap - setup.initial_position,
+    )?;
+    if let Some(nc) = &circuit.nc_subckt {
+        contact.push_str(&super::lockstep::contact_include(
+            nc,
+            super::lockstep::BREAK_SOURCE,
+            None,
+            0.0,
+        )?);
+    }
+    let deck = setup.deck(0.0)?;
+    let includes = vec![
+        (CONTACT_FILE.to_owned(), contact),
+        (
+            COIL_FILE.to_owned(),
+            netlist::coil::coil_include_external(section, &circuit.coil_subckt)?,
+        ),
+    ];
+    let simulation = setup.pass(&lock, &deck, includes, options, 1)?;
+    let stats = lock.last_stats().unwrap_or_default();
+    let plot = simulation.plot;
+    let (_, cycle) = setup.mechanics_under(&plot, 1)?;
+    // The rest stop's changes count where the circuit has the
+    // normally-closed contact to see them.
+    let mut change = changes_moved(&stats.make_changes, &cycle.chatter().intervals);
+    if circuit.nc_subckt.is_some() {
+        change = change.max(changes_moved(
+            &stats.break_changes,
+            &back_of(&cycle).intervals,
+        ));
+    }
+    if change <= options.tolerance {
+        let iterations = vec![Iteration {
+            first_impact: cycle.chatter().first_impact,
+            bounces: cycle.chatter().bounce_count,
+            change,
+            ngspice_elapsed: simulation.elapsed.as_secs_f64(),
+            scheme: Coupling::LockStep,
+        }];
+        let thinning = options.path_tolerance * (coil.air_gap + coil.iron_gap);
+        let (chatter, back, path, strokes, pole_face) = records(cycle, thinning);
+        let switching = switching_of(&plot, volts, &levels, 1)?;
+        return Ok(Ok(Coupled {
+            operations: operations(&strokes, &chatter.impacts, &switching),
+            levels,
+            switching,
+            chatter,
+            back,
+            path,
+            plot,
+            coil_instance: coil_instance.clone(),
+            iterations,
+            deck,
+            version: simulation.version,
+            log: simulation.log,
+            pole_face,
+            fallback: None,
+        }));
+    }
+    Ok(Err(Some(if change.is_finite() {
+        format!(
+            "the lock-step run's own events and the mechanics under its flux differ \
+                 by {change:e} s, more than the coupling tolerance ({:e} s): the coupling \
+                 was run again as passes",
+            options.tolerance
+        )
+    } else {
+        // Seen when another user of the library in this process
+        // (PySpice, a ctypes binding) initialised it before us.
+        "the lock-step run's own events and the mechanics under its flux do not have \
+             the same contact changes (another user of ngspice's shared library in this \
+             process, such as PySpice, can cause this): the coupling was run again as \
+             passes"
+            .to_owned()
+    })))
+}
+
+/// The coupled run as passes: each ngspice run with the contact and the
+/// coil's armature path of the last, until no event moves more than the
+/// tolerance. `fallback`: why lock-step was not run or kept.
+fn passes(
+    setup: &Setup<'_>,
+    runner: &dyn Runner,
+    options: &CouplingOptions,
+    fallback: Option<String>,
+) -> Result<Coupled, CouplingError> {
+    let (coil, settings, model, arc) = (setup.coil, setup.settings, setup.model, setup.arc);
+    let (origin, section, circuit, levels) =
+        (&setup.origin, setup.section, setup.circuit, setup.levels);
+    let netlist_path = setup.netlist_path.clone();
+    let (coil_instance, volts) = (&setup.coil_instance, &setup.volts);
     // Iteration 0, the probe of the driver: the coil with the armature
     // held closed (its inductance while the contact is held and through the
     // release tail, the slow part of the coupling; docs/coupling.md), the
     // contacts as before any motion: NO open, NC closed.
     let mut chatter = steady_chatter(ContactState::Open, settings.t_end);
     let mut back = steady_chatter(ContactState::Closed, settings.t_end);
-    let mut path = vec![(0.0, m.gap)];
+    let mut path = vec![(0.0, setup.gap)];
     let mut iterations: Vec<Iteration> = Vec::new();
     for iteration in 1..=options.max_iterations {
         let waveform =
@@ -622,36 +811,19 @@ pub fn run_coupled_plan(
             // The probe's contact is open at its rest gap, whatever the
             // coil's armature does.
             let gap = if iteration == 1 {
-                GapProfile::from_path(m.gap, &[(0.0, m.initial_position)])
+                GapProfile::from_path(setup.gap, &[(0.0, setup.initial_position)])
             } else {
-                GapProfile::from_path(m.gap, &path)
+                GapProfile::from_path(setup.gap, &path)
             };
             contact = with_arc(contact, arc, &gap)?;
         }
         if let Some(nc) = &circuit.nc_subckt {
             contact
                 .text
-                .push_str(&nc_include(&back, &model, nc, &origin)?);
+                .push_str(&nc_include(&back, &model, nc, origin)?);
         }
         let end = chatter.intervals.last().map_or(0.0, |iv| iv.start);
-        let deck = netlist::prepare_deck_with_params(
-            &DeckRequest {
-                netlist_text,
-                netlist_path: &netlist_path,
-                include_file_name: CONTACT_FILE,
-                subckt: &circuit.subckt,
-                coil: Some((COIL_FILE, &circuit.coil_subckt)),
-                probes: &signals,
-                chatter_end: end,
-                stop_at_least: end,
-                options: if arc.is_some() {
-                    &[crate::netlist::arc::ARC_OPTIONS]
-                } else {
-                    &[]
-                },
-            },
-            &circuit.param_list(),
-        )?;
+        let deck = setup.deck(end)?;
         let mut includes = vec![
             (CONTACT_FILE.to_owned(), contact.text),
             (
@@ -660,45 +832,12 @@ pub fn run_coupled_plan(
             ),
         ];
         includes.extend(contact.data_files);
-        let simulation = super::pass::circuit_pass(
-            runner,
-            super::pass::Pass {
-                run: "coupled",
-                netlist: &netlist_path,
-                deck: &deck,
-                includes,
-                timeout: options.timeout,
-                keep_workdir: options.keep_workdir,
-            },
-        )
-        .map_err(|e| match e {
-            super::pass::PassError::Spice { source, .. } => CouplingError::Spice {
-                netlist: netlist_path.clone(),
-                iteration,
-                source,
-            },
-            _ => CouplingError::MissingVector {
-                iteration,
-                vector: psi.clone(),
-            },
-        })?;
+        let simulation = setup.pass(runner, &deck, includes, options, iteration)?;
         let ngspice_elapsed = simulation.elapsed.as_secs_f64();
         let version = simulation.version;
         let log = simulation.log;
         let plot = simulation.plot;
-        let flux = series(&plot, &psi).ok_or_else(|| CouplingError::MissingVector {
-            iteration,
-            vector: psi.clone(),
-        })?;
-        let flux_at = Interpolator::new(&flux);
-        let pull = |t: f64, _x: f64| coil.force_from_flux(flux_at.at(t));
-        let cycle = driven_run(&mechanics, &build, &stops, &settings, &pull).map_err(|source| {
-            CouplingError::Coil {
-                path: origin.clone(),
-                iteration,
-                source,
-            }
-        })?;
+        let (flux, cycle) = setup.mechanics_under(&plot, iteration)?;
         let change =
             event_change(&chatter, cycle.chatter()).max(event_change(&back, back_of(&cycle)));
         iterations.push(Iteration {
@@ -715,48 +854,12 @@ pub fn run_coupled_plan(
             (chatter, back, path, strokes, pole_face) = records(cycle, thinning);
             (strokes, pole_face)
         } else {
-            let Some(Vector::Real(time)) = plot.scale() else {
-                return Err(CouplingError::MissingVector {
-                    iteration,
-                    vector: "time".to_owned(),
-                });
-            };
-            let coil_volts = plot
-                .real(&volts)
-                .ok_or_else(|| CouplingError::MissingVector {
-                    iteration,
-                    vector: volts.clone(),
-                })?;
-            let flux_values: Vec<f64> = flux.iter().map(|&(_, v)| v).collect();
-            let run = CircuitRun {
-                time,
-                volts: coil_volts,
-                flux: &flux_values,
-                path: &path,
-            };
-            let (next, _) = settle(
-                &coil,
-                &run,
-                cycle,
-                &mechanics,
-                &build,
-                &stops,
-                &settings,
-                CouplingTolerances {
-                    events: options.tolerance,
-                    path: thinning,
-                },
-            )
-            .map_err(|source| CouplingError::Coil {
-                path: origin.clone(),
-                iteration,
-                source,
-            })?;
+            let next = setup.settled(&plot, &flux, &path, cycle, options, iteration)?;
             (chatter, back, path, _, _) = records(next, thinning);
             continue;
         };
         if converged {
-            let switching = switching_of(&plot, &volts, &levels, iteration)?;
+            let switching = switching_of(&plot, volts, &levels, iteration)?;
             return Ok(Coupled {
                 operations: operations(&strokes, &chatter.impacts, &switching),
                 levels,
