@@ -20,28 +20,8 @@ use chatterspice::mechanics::{Drive, simulate_drive};
 use chatterspice::{Mechanics, Settings, Surface, simulate};
 use criterion::{Criterion, criterion_group, criterion_main};
 
-fn reference() -> (Mechanics, Surface, Settings) {
-    (
-        Mechanics {
-            mass: 1.0,
-            stiffness: 1.0,
-            damping: 0.1,
-            force: 1.0,
-            gap: 0.9,
-            initial_position: 0.0,
-            initial_velocity: 0.0,
-            preload: 0.0,
-        },
-        Surface::KelvinVoigt {
-            stiffness: 100.0,
-            damping: 2.0 * 0.4692,
-        },
-        Settings {
-            t_end: 100.0,
-            ..Settings::default()
-        },
-    )
-}
+mod common;
+use common::{on_a_blade, reference};
 
 /// A signal relay that chatters and sticks: the default relay's armature
 /// (0.2 g, 800 N/m, 0.45 mm travel) driven with 1 N onto a Hertzian
@@ -88,15 +68,7 @@ fn bench(c: &mut Criterion) {
         make: s,
         back: None,
     };
-    let relay = TwoStage {
-        blade: Some(Blade {
-            mass: 0.2,
-            stiffness: 100.0,
-            damping: 1.0,
-        }),
-        pole_face: None,
-        release: Release::Position,
-    };
+    let relay = on_a_blade();
     let run = simulate_two_stage(&m, &relay, &stops, &st, Drive::Step, Horizon::Closing).unwrap();
     assert_eq!(
         (run.contact.impacts.len(), run.contact.outcome.as_str()),

@@ -16,43 +16,20 @@ use std::time::Instant;
 
 use chatterspice::mechanics::Drive;
 use chatterspice::mechanics::cycle::Stops;
-use chatterspice::mechanics::two_stage::{Blade, Horizon, Release, TwoStage, simulate_two_stage};
-use chatterspice::{Mechanics, Settings, Surface, simulate};
+use chatterspice::mechanics::two_stage::{Horizon, simulate_two_stage};
+use chatterspice::simulate;
+
+mod common;
+use common::{on_a_blade, reference};
 
 fn main() {
-    // The paper's reference sequence (docs/model.md), and the same
-    // armature carried on a blade, as benches/mechanics.rs has them.
-    let m = Mechanics {
-        mass: 1.0,
-        stiffness: 1.0,
-        damping: 0.1,
-        force: 1.0,
-        gap: 0.9,
-        initial_position: 0.0,
-        initial_velocity: 0.0,
-        preload: 0.0,
-    };
-    let surface = Surface::KelvinVoigt {
-        stiffness: 100.0,
-        damping: 2.0 * 0.4692,
-    };
-    let settings = Settings {
-        t_end: 100.0,
-        ..Settings::default()
-    };
+    // The two sequences benches/mechanics.rs times.
+    let (m, surface, settings) = reference();
     let stops = Stops {
         make: surface,
         back: None,
     };
-    let relay = TwoStage {
-        blade: Some(Blade {
-            mass: 0.2,
-            stiffness: 100.0,
-            damping: 1.0,
-        }),
-        pole_face: None,
-        release: Release::Position,
-    };
+    let relay = on_a_blade();
     // `cargo bench` passes `--bench`; a number among the arguments is
     // the rounds.
     let rounds = std::env::args()

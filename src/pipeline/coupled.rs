@@ -517,6 +517,38 @@ impl<'a> Setup<'a> {
         self.signals.iter().map(String::as_str).collect()
     }
 
+    /// The run's result from the pass it ends on (`iteration`): the
+    /// motion's `records`, ngspice's plot, deck, version and log, and the
+    /// coil's switching read from the plot, with the passes so far and
+    /// why lock-step was not kept.
+    fn coupled(
+        &self,
+        records: PassRecords,
+        (plot, deck, version, log): (Plot, Deck, Option<String>, String),
+        iteration: usize,
+        iterations: Vec<Iteration>,
+        fallback: Option<String>,
+    ) -> Result<Coupled, CouplingError> {
+        let (chatter, back, path, strokes, pole_face) = records;
+        let switching = switching_of(&plot, &self.volts, &self.levels, iteration)?;
+        Ok(Coupled {
+            operations: operations(&strokes, &chatter.impacts, &switching),
+            levels: self.levels,
+            switching,
+            chatter,
+            back,
+            path,
+            plot,
+            coil_instance: self.coil_instance.clone(),
+            iterations,
+            deck,
+            version,
+            log,
+            pole_face,
+            fallback,
+        })
+    }
+
     /// The motion of pass `iteration` (`cycle`, under the flux `flux` of
     /// its `plot`, the armature's path having been `path`) settled
     /// against the coil's own circuit as ngspice ran it, before the next
@@ -680,8 +712,8 @@ fn lock_step(
         setup.model,
         setup.arc,
     );
-    let (section, circuit, levels) = (setup.section, setup.circuit, setup.levels);
-    let (coil_instance, volts) = (&setup.coil_instance, &setup.volts);
+    let (section, circuit) = (setup.section, setup.circuit);
+    let coil_instance = &setup.coil_instance;
     let relay = super::lockstep::Relay {
         mechanics,
         build,
@@ -737,24 +769,10 @@ fn lock_step(
             scheme: Coupling::LockStep,
         }];
         let thinning = options.path_tolerance * (coil.air_gap + coil.iron_gap);
-        let (chatter, back, path, strokes, pole_face) = records(cycle, thinning);
-        let switching = switching_of(&plot, volts, &levels, 1)?;
-        return Ok(Ok(Coupled {
-            operations: operations(&strokes, &chatter.impacts, &switching),
-            levels,
-            switching,
-            chatter,
-            back,
-            path,
-            plot,
-            coil_instance: coil_instance.clone(),
-            iterations,
-            deck,
-            version: simulation.version,
-            log: simulation.log,
-            pole_face,
-            fallback: None,
-        }));
+        let ngspice = (plot, deck, simulation.version, simulation.log);
+        return setup
+            .coupled(records(cycle, thinning), ngspice, 1, iterations, None)
+            .map(Ok);
     }
     Ok(Err(Some(if change.is_finite() {
         format!(
@@ -784,10 +802,8 @@ fn passes(
     fallback: Option<String>,
 ) -> Result<Coupled, CouplingError> {
     let (coil, settings, model, arc) = (setup.coil, setup.settings, setup.model, setup.arc);
-    let (origin, section, circuit, levels) =
-        (&setup.origin, setup.section, setup.circuit, setup.levels);
+    let (origin, section, circuit) = (&setup.origin, setup.section, setup.circuit);
     let netlist_path = setup.netlist_path.clone();
-    let (coil_instance, volts) = (&setup.coil_instance, &setup.volts);
     // Iteration 0, the probe of the driver: the coil with the armature
     // held closed (its inductance while the contact is held and through the
     // release tail, the slow part of the coupling; docs/coupling.md), the
@@ -859,23 +875,9 @@ fn passes(
             continue;
         };
         if converged {
-            let switching = switching_of(&plot, volts, &levels, iteration)?;
-            return Ok(Coupled {
-                operations: operations(&strokes, &chatter.impacts, &switching),
-                levels,
-                switching,
-                chatter,
-                back,
-                path,
-                plot,
-                coil_instance: coil_instance.clone(),
-                iterations,
-                deck,
-                version,
-                log,
-                pole_face,
-                fallback,
-            });
+            let records = (chatter, back, path, strokes, pole_face);
+            let ngspice = (plot, deck, version, log);
+            return setup.coupled(records, ngspice, iteration, iterations, fallback);
         }
     }
     Err(CouplingError::NotConverged {

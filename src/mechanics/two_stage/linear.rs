@@ -616,6 +616,8 @@ fn first_event<const WIDE: bool>(
         if quick {
             continue;
         }
+        // Elsewhere than on x86-64 there are no wide steps.
+        #[cfg(target_arch = "x86_64")]
         let tau = if WIDE {
             // SAFETY: the wide steps run only where the processor has
             // AVX2 and FMA (see `propagate`).
@@ -623,6 +625,8 @@ fn first_event<const WIDE: bool>(
         } else {
             guard_event(polys, guard, h, resolution)
         };
+        #[cfg(not(target_arch = "x86_64"))]
+        let tau = guard_event(polys, guard, h, resolution);
         let Some(tau) = tau else {
             continue;
         };
@@ -655,17 +659,6 @@ fn guard_event_wide(
     resolution: f64,
 ) -> Option<f64> {
     search_guard(polys, guard, h, resolution)
-}
-
-/// Elsewhere than on x86-64 there are no wide steps.
-#[cfg(not(target_arch = "x86_64"))]
-fn guard_event_wide(
-    polys: &mut StepPolys<'_>,
-    guard: Guard,
-    h: f64,
-    resolution: f64,
-) -> Option<f64> {
-    guard_event(polys, guard, h, resolution)
 }
 
 /// [`guard_event`]'s search, inlined into each of its compilations.
