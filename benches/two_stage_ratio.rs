@@ -10,6 +10,12 @@
 //! relays as those benches, so both see the same load; the least and
 //! the median time a call over the rounds, and their ratios, are
 //! printed. Target: the two-stage engine within 10× the one-mass one.
+//!
+//! `two_stage_ratio calls ENGINE N` (ENGINE `one-mass` or `two-stage`)
+//! runs N calls of one engine, untimed, for an instruction counter: the
+//! difference between N = 100 and N = 0 under `valgrind --tool=cachegrind
+//! --cache-sim=no`, divided by 100, is the instructions a call
+//! (docs/model.md, "Speed").
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -30,13 +36,6 @@ fn main() {
         back: None,
     };
     let relay = on_a_blade();
-    // `cargo bench` passes `--bench`; a number among the arguments is
-    // the rounds.
-    let rounds = std::env::args()
-        .skip(1)
-        .find_map(|a| a.parse::<usize>().ok())
-        .unwrap_or(300)
-        .max(1);
     let one_mass = || simulate(black_box(&m), &surface, &settings).expect("the reference runs");
     let two_stage = || {
         simulate_two_stage(
@@ -49,6 +48,26 @@ fn main() {
         )
         .expect("the two-stage relay runs")
     };
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if let Some(at) = args.iter().position(|a| a == "calls") {
+        let (engine, n) = (args.get(at + 1), args.get(at + 2));
+        let n: usize = n.and_then(|n| n.parse().ok()).expect("calls ENGINE N");
+        for _ in 0..n {
+            match engine.map(String::as_str) {
+                Some("one-mass") => drop(black_box(one_mass())),
+                Some("two-stage") => drop(black_box(two_stage())),
+                _ => panic!("calls ENGINE N: ENGINE is one-mass or two-stage"),
+            }
+        }
+        return;
+    }
+    // `cargo bench` passes `--bench`; a number among the arguments is
+    // the rounds.
+    let rounds = args
+        .iter()
+        .find_map(|a| a.parse::<usize>().ok())
+        .unwrap_or(300)
+        .max(1);
     assert_eq!(one_mass().impacts.len(), 18);
     assert_eq!(two_stage().contact.impacts.len(), 18);
     let (mut one, mut two) = (Vec::with_capacity(rounds), Vec::with_capacity(rounds));
