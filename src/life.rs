@@ -1,20 +1,23 @@
 //! Electrical life: how many operations the contacts last at a load,
-//! from the energy their arcs put into them (docs/arcs.md, "Electrical
-//! life").
+//! from what their arcs put into them (docs/arcs.md, "Electrical life").
 //!
-//! Each operation erodes the contacts in proportion to the energy of its
-//! arcs (the bounce-opening arcs of the make and the break arc): with E_op
-//! that energy the life is N = B / E_op, B a constant of the relay fixed
-//! on one printed endurance figure by simulating its test load. A
-//! datasheet's endurance test switches at random phase of an AC supply,
-//! so an AC figure's E_op is the mean over switching phases spread evenly
-//! over the period; a DC figure has one.
+//! Each arc of an operation (the bounce-opening arcs of the make and the
+//! break arc) wears the contacts as its energy E times (Ī / 1 A)^p, Ī its
+//! mean current and p = [`CURRENT_EXPONENT`]: the erosion per joule grows
+//! with the current. With W_op that wear summed over the operation's arcs
+//! and w the operation's wear factor, the life is N = B / (W_op · w), B a
+//! constant of the relay fixed on one printed endurance figure by
+//! simulating its test load. A datasheet's endurance test switches at
+//! random phase of an AC supply, so an AC figure's W_op is the mean over
+//! switching phases spread evenly over the period; a DC figure has one.
 //!
-//! A direct-current operation wears the contacts [`DC_TRANSFER`] times
-//! what its arc energy alone says: every arc of one polarity carries metal
-//! the same way, from one contact to the other, and the transfer adds to
-//! the loss; under alternating current the arcs' polarity changes from one
-//! operation to the next and the transfer cancels on average.
+//! The wear factor carries what the simulated arcs do not: an AC
+//! operation at a supply of V (RMS) counts (V / [`REFERENCE_VOLTAGE`])^q,
+//! q = [`VOLTAGE_EXPONENT`] (the arc that re-strikes after a current zero
+//! at a higher recovery voltage, which the arc model does not strike), and
+//! a DC one [`DC_TRANSFER`] (the material transfer of arcs of one
+//! polarity). p, q and the DC factor are fitted on printed endurance
+//! tables of nineteen relays (docs/arcs.md, "Which erosion law").
 //!
 //! Each figure's test circuit is built here: the supply (DC, or AC of the
 //! figure's RMS voltage and frequency), a resistive load drawing the
@@ -43,13 +46,56 @@ pub const HOLD: f64 = 5e-3;
 /// to) sits on it, within rounding.
 pub const CAPACITY_TOLERANCE: f64 = 0.02;
 
-/// How many times its arc energy a direct-current operation wears the
-/// contacts, against 1 for an alternating one: the net material transfer
-/// of arcs of one polarity added to their erosion. Calibrated on a silver
-/// alloy (AgNi) relay that prints 1e5 operations both at 3 A 250 V AC and
-/// at 5 A 30 V DC, where arc energy alone makes the DC life 3.55 times the
-/// printed one (docs/arcs.md, "Direct current").
-pub const DC_TRANSFER: f64 = 3.5;
+/// How many times its wear a direct-current operation counts, against
+/// an alternating one at [`REFERENCE_VOLTAGE`]: the net material transfer
+/// of arcs of one polarity added to their erosion (under alternating
+/// current the polarity changes from one operation to the next and the
+/// transfer cancels on average). Fitted with [`CURRENT_EXPONENT`] and
+/// [`VOLTAGE_EXPONENT`] on printed tables whose DC figures are at 24-30 V
+/// (docs/arcs.md, "Which erosion law"); the makers print the same life
+/// at the rated DC load as at the rated AC one.
+pub const DC_TRANSFER: f64 = 16.0;
+
+/// The erosion law's current exponent p: an arc of energy E and mean
+/// current Ī wears the contacts as E·(Ī/[`REFERENCE_CURRENT`])^p, the
+/// erosion per joule growing with the arc's current (the molten metal its
+/// roots eject). Fitted on printed endurance tables (docs/arcs.md, "Which
+/// erosion law").
+pub const CURRENT_EXPONENT: f64 = 0.5;
+
+/// The AC wear factor's voltage exponent q: an AC operation at a supply
+/// of V (RMS) counts (V/[`REFERENCE_VOLTAGE`])^q times its wear. The
+/// simulated arc ends at the current zero; at a higher recovery voltage a
+/// real one re-strikes across the hot gap more often and burns longer.
+/// Fitted on printed endurance tables (docs/arcs.md, "Which erosion law").
+pub const VOLTAGE_EXPONENT: f64 = 1.5;
+
+/// V (RMS), the AC supply at which an operation's wear factor is 1.
+pub const REFERENCE_VOLTAGE: f64 = 250.0;
+
+/// The wear factor of an operation: [`DC_TRANSFER`] for direct current,
+/// (V/[`REFERENCE_VOLTAGE`])^q for alternating current of `rms` volts.
+pub fn wear_factor(supply: Supply, rms: f64) -> f64 {
+    match supply {
+        Supply::Dc => DC_TRANSFER,
+        Supply::Ac => (rms / REFERENCE_VOLTAGE).powf(VOLTAGE_EXPONENT),
+    }
+}
+
+/// A, the current at which an arc's wear is its energy.
+pub const REFERENCE_CURRENT: f64 = 1.0;
+
+/// The wear of one arc of energy `energy` (J), charge `charge` (C) and
+/// duration `duration` (s) with the current exponent `exponent`: its
+/// energy times (Ī/[`REFERENCE_CURRENT`])^p, Ī = charge/duration its mean
+/// current (J at the reference current). An arc without duration wears
+/// as its energy.
+pub fn arc_wear(energy: f64, charge: f64, duration: f64, exponent: f64) -> f64 {
+    if !(duration > 0.0 && charge > 0.0) || exponent == 0.0 {
+        return energy;
+    }
+    energy * (charge / duration / REFERENCE_CURRENT).powf(exponent)
+}
 
 /// The default number of switching phases of an AC figure.
 pub const DEFAULT_PHASES: usize = 16;
@@ -75,8 +121,16 @@ pub struct FigureLife {
     pub ratio: Option<f64>,
     /// J, the mean arc energy of one operation at this load.
     pub energy_per_operation: f64,
-    /// How many times its arc energy the operation wears the contacts:
-    /// [`DC_TRANSFER`] for a DC figure, 1 for AC.
+    /// J at the reference current, the mean wear of one operation: the sum
+    /// over its arcs of E·(Ī/[`REFERENCE_CURRENT`])^p ([`arc_wear`]),
+    /// before the `wear_factor`.
+    pub wear_per_operation: f64,
+    /// A, the arcs' mean current weighted by their energy: the Ī of the
+    /// erosion law for the operation as a whole.
+    pub arc_current: f64,
+    /// How many times its wear the operation counts ([`wear_factor`]):
+    /// [`DC_TRANSFER`] for a DC figure, (V/[`REFERENCE_VOLTAGE`])^q for
+    /// an AC one of V volts (RMS).
     pub wear_factor: f64,
     /// How many switching phases were averaged (1 for DC).
     pub phases: usize,
@@ -89,8 +143,8 @@ pub struct FigureLife {
 /// The life at the scenario's own circuit.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct OwnLife {
-    /// Operations: B / E_op (`null`: no arc energy, no electrical wear, or
-    /// `refused`).
+    /// Operations: B / (W_op · w) (`null`: no arc energy, no electrical
+    /// wear, or `refused`).
     pub operations: Option<f64>,
     /// Why the circuit's life cannot be priced (`null` when it can): the
     /// contact does not break the circuit's load within the run.
@@ -99,8 +153,15 @@ pub struct OwnLife {
     pub b10: Option<f64>,
     /// J, the arc energy of the circuit's operation.
     pub energy_per_operation: f64,
-    /// [`DC_TRANSFER`] for a circuit without a sine source, 1 for one
-    /// with (an AC circuit).
+    /// J at the reference current, the wear of that operation
+    /// ([`FigureLife::wear_per_operation`]).
+    pub wear_per_operation: f64,
+    /// A, its arcs' energy-weighted mean current.
+    pub arc_current: f64,
+    /// [`DC_TRANSFER`] for a circuit without a sine source;
+    /// (V/[`REFERENCE_VOLTAGE`])^q for one with, V the largest sine
+    /// amplitude of its sources over √2 (the reference voltage when the
+    /// amplitude is not a number: a parameter).
     pub wear_factor: f64,
 }
 
@@ -109,8 +170,19 @@ pub struct OwnLife {
 pub struct LifeReport {
     /// The figure B was calibrated on (0-based).
     pub calibrated_on: usize,
-    /// J, B = N_printed · E_op of that figure.
+    /// J at the reference current: B = N_printed · W_op · wear factor of
+    /// that figure, W_op its wear per operation.
     pub constant_j: f64,
+    /// The erosion law's current exponent p ([`CURRENT_EXPONENT`]).
+    pub current_exponent: f64,
+    /// The AC wear factor's voltage exponent q ([`VOLTAGE_EXPONENT`]).
+    pub voltage_exponent: f64,
+    /// V (RMS), the AC supply whose wear factor is 1.
+    pub reference_voltage: f64,
+    /// The wear factor of a DC operation ([`DC_TRANSFER`]).
+    pub dc_wear_factor: f64,
+    /// A, the current at which an arc's wear is its energy.
+    pub reference_current: f64,
     /// Every printed figure.
     pub figures: Vec<FigureLife>,
     /// At the scenario's own circuit, when it has one.
@@ -302,12 +374,9 @@ pub fn estimate_at(
             .join("; ");
         return Err(LifeError::NoArcEnergy { path, reasons });
     };
-    let wear = |f: &EnduranceFigure| match f.supply {
-        Supply::Dc => DC_TRANSFER,
-        Supply::Ac => 1.0,
-    };
+    let wear = |f: &EnduranceFigure| wear_factor(f.supply, f.voltage);
     let b = figures[calibrated_on].operations
-        * energies[calibrated_on].mean
+        * energies[calibrated_on].wear
         * wear(&figures[calibrated_on]);
     let mut warnings = Vec::new();
     let rows = figures
@@ -322,7 +391,7 @@ pub fn estimate_at(
                     f.operations
                 ));
             }
-            let predicted = (e.refused.is_none() && e.mean > 0.0).then(|| b / (e.mean * wear(f)));
+            let predicted = (e.refused.is_none() && e.mean > 0.0).then(|| b / (e.wear * wear(f)));
             FigureLife {
                 load: f.label(),
                 operations: f.operations,
@@ -330,6 +399,8 @@ pub fn estimate_at(
                 refused: e.refused.clone(),
                 ratio: predicted.map(|p| p / f.operations),
                 energy_per_operation: e.mean,
+                wear_per_operation: e.wear,
+                arc_current: e.current,
                 wear_factor: wear(f),
                 phases: e.phases,
                 convergence: e.convergence,
@@ -341,6 +412,11 @@ pub fn estimate_at(
     Ok(LifeReport {
         calibrated_on,
         constant_j: b,
+        current_exponent: CURRENT_EXPONENT,
+        voltage_exponent: VOLTAGE_EXPONENT,
+        reference_voltage: REFERENCE_VOLTAGE,
+        dc_wear_factor: DC_TRANSFER,
+        reference_current: REFERENCE_CURRENT,
         figures: rows,
         life,
         weibull_shape: shape,
@@ -418,7 +494,14 @@ fn own_life(
                 b.gap * 1e3
             )
         });
-        (totals.map_or(0.0, |t| t.max_operation_energy), refused)
+        let wear = run.arcs.as_ref().map_or(Wear::default(), |a| {
+            Wear::most_energetic_operation(&a.arcs, CURRENT_EXPONENT)
+        });
+        (
+            totals.map_or(0.0, |t| t.max_operation_energy),
+            wear,
+            refused,
+        )
     };
     let energy = match (&scenario.circuit, own) {
         (None, _) => None,
@@ -429,26 +512,38 @@ fn own_life(
             Some(own_energy(&run))
         }
     };
-    let wear_factor = match &scenario.circuit {
-        // The run has read the netlist already.
-        Some(c)
-            if crate::input::read_to_string(&c.netlist)
-                .is_ok_and(|text| alternating_supply(&text)) =>
-        {
+    // The run has read the netlist already.
+    let supply = scenario.circuit.as_ref().and_then(|c| {
+        crate::input::read_to_string(&c.netlist)
+            .ok()
+            .and_then(|text| alternating_supply(&text))
+    });
+    let wear_factor = match supply {
+        None => DC_TRANSFER,
+        Some(Some(rms)) => wear_factor(Supply::Ac, rms),
+        Some(None) => {
+            if energy.is_some() {
+                warnings.push(format!(
+                    "the circuit's sine source has no numeric amplitude: its AC wear factor is \
+                     taken at {REFERENCE_VOLTAGE} V RMS"
+                ));
+            }
             1.0
         }
-        _ => DC_TRANSFER,
     };
-    Ok(energy.map(|(e, refused)| {
+    Ok(energy.map(|(e, w, refused)| {
         if let Some(why) = &refused {
             warnings.push(format!("no life at the scenario's circuit: {why}"));
         }
-        let operations = (e > 0.0 && refused.is_none()).then(|| b / (e * wear_factor));
+        let operations =
+            (e > 0.0 && w.wear > 0.0 && refused.is_none()).then(|| b / (w.wear * wear_factor));
         OwnLife {
             operations,
             refused,
             b10: operations.zip(shape).map(|(n, beta)| b10(n, beta)),
             energy_per_operation: e,
+            wear_per_operation: w.wear,
+            arc_current: w.current,
             wear_factor,
         }
     }))
@@ -456,22 +551,54 @@ fn own_life(
 
 /// Whether a netlist drives its circuit from alternating current: an
 /// independent source (`V…`, `I…`) with a sine (`SIN(…)`, `sin …`).
-pub fn alternating_supply(netlist: &str) -> bool {
-    netlist.lines().skip(1).any(|line| {
+///
+/// `None`: no sine source (a DC circuit). `Some(Some(v))`: v the largest
+/// amplitude of its sine voltage sources over √2 (V RMS). `Some(None)`:
+/// a sine source, but no sine voltage source with a numeric amplitude
+/// (a current source, or an amplitude given by a parameter).
+pub fn alternating_supply(netlist: &str) -> Option<Option<f64>> {
+    let mut alternating = false;
+    let mut largest: Option<f64> = None;
+    for line in netlist.lines().skip(1) {
         let line = line.trim().to_ascii_lowercase();
-        let mut words = line.split(|c: char| c.is_whitespace() || c == '(');
-        let is_source = line.starts_with('v') || line.starts_with('i');
-        is_source && words.any(|w| w == "sin")
-    })
+        if !(line.starts_with('v') || line.starts_with('i')) {
+            continue;
+        }
+        let words: Vec<&str> = line
+            .split(|c: char| c.is_whitespace() || c == '(' || c == ')' || c == ',')
+            .filter(|w| !w.is_empty())
+            .collect();
+        let Some(at) = words.iter().position(|w| *w == "sin") else {
+            continue;
+        };
+        alternating = true;
+        // SIN(offset amplitude frequency …) of a voltage source.
+        let amplitude = words
+            .get(at + 2)
+            .filter(|_| line.starts_with('v'))
+            .and_then(|w| crate::netlist::parse_number(w))
+            .map(f64::abs)
+            .filter(|a| a.is_finite() && *a > 0.0);
+        if let Some(a) = amplitude {
+            largest = Some(largest.map_or(a, |b: f64| b.max(a)));
+        }
+    }
+    alternating.then(|| largest.map(|a| a / std::f64::consts::SQRT_2))
 }
 
 /// `life`'s report as a table for people.
 pub fn render(report: &LifeReport) -> String {
     use std::fmt::Write;
     let mut out = format!(
-        "erosion constant B = {:.4e} J, calibrated on figure {}\n",
+        "erosion constant B = {:.4e} J, calibrated on figure {}; an arc wears E·(Ī/{} A)^{}, an \
+         operation ×{} on DC, ×(V/{} V)^{} on AC\n",
         report.constant_j,
-        report.calibrated_on + 1
+        report.calibrated_on + 1,
+        report.reference_current,
+        report.current_exponent,
+        report.dc_wear_factor,
+        report.reference_voltage,
+        report.voltage_exponent,
     );
     let width = report
         .figures
@@ -482,7 +609,7 @@ pub fn render(report: &LifeReport) -> String {
         .max(4);
     let _ = writeln!(
         out,
-        "{:>6}  {:<width$} {:>12} {:>12} {:>8} {:>14} {:>5} {:>7} {:>12}",
+        "{:>6}  {:<width$} {:>12} {:>12} {:>8} {:>14} {:>7} {:>7} {:>12}",
         "figure",
         "load",
         "printed",
@@ -496,7 +623,7 @@ pub fn render(report: &LifeReport) -> String {
     for (k, f) in report.figures.iter().enumerate() {
         let _ = writeln!(
             out,
-            "{:>6}  {:<width$} {:>12.4e} {:>12} {:>8} {:>14.4e} {:>5} {:>7} {:>+11.2}%",
+            "{:>6}  {:<width$} {:>12.4e} {:>12} {:>8} {:>14.4e} {:>7} {:>7} {:>+11.2}%",
             k + 1,
             f.load,
             f.operations,
@@ -507,7 +634,7 @@ pub fn render(report: &LifeReport) -> String {
             },
             f.ratio.map_or("-".to_owned(), |r| format!("{r:.3}")),
             f.energy_per_operation,
-            format!("×{}", f.wear_factor),
+            format!("×{:.3}", f.wear_factor),
             f.phases,
             f.convergence * 100.0
         );
@@ -516,7 +643,7 @@ pub fn render(report: &LifeReport) -> String {
         Some(l) => {
             let _ = writeln!(
                 out,
-                "life at the scenario's circuit: {} operations ({:.4e} J per operation, wear ×{}){}",
+                "life at the scenario's circuit: {} operations ({:.4e} J per operation, wear ×{:.3}){}",
                 match (&l.refused, l.operations) {
                     (Some(_), _) => "not priced (see the warning)".to_owned(),
                     (None, Some(n)) => format!("{n:.4e}"),
@@ -568,14 +695,65 @@ fn gamma(x: f64) -> f64 {
     (2.0 * std::f64::consts::PI).sqrt() * t.powf(x + 0.5) * (-t).exp() * a
 }
 
-/// One phase's arc energy (J) and, when its break arc still burned when
-/// the test run ended, how long it had burned (s).
-type PhaseResult = Result<(f64, Option<f64>), LifeError>;
+/// One phase's arc energy (J), its wear and, when its break arc still
+/// burned when the test run ended, how long it had burned (s).
+type PhaseResult = Result<(f64, Wear, Option<f64>), LifeError>;
+
+/// The wear of one operation under the erosion law, and the mean current
+/// it was priced at.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct Wear {
+    /// J at the reference current, Σ [`arc_wear`] over the arcs.
+    wear: f64,
+    /// A, the arcs' energy-weighted mean current.
+    current: f64,
+}
+
+impl Wear {
+    /// The wear of `arcs` (all of one operation) with exponent `p`.
+    fn of<'a>(arcs: impl IntoIterator<Item = &'a crate::arc::ArcEvent>, p: f64) -> Wear {
+        let (mut wear, mut energy, mut weighted) = (0.0, 0.0, 0.0);
+        for a in arcs {
+            wear += arc_wear(a.energy, a.charge, a.duration, p);
+            energy += a.energy;
+            if a.duration > 0.0 {
+                weighted += a.energy * a.charge / a.duration;
+            }
+        }
+        Wear {
+            wear,
+            current: if energy > 0.0 { weighted / energy } else { 0.0 },
+        }
+    }
+
+    /// The wear of the operation of `arcs` with the most arc energy (the
+    /// one `max_operation_energy` reports).
+    fn most_energetic_operation(arcs: &[crate::arc::ArcEvent], p: f64) -> Wear {
+        let last = arcs.iter().map(|a| a.operation).max();
+        let Some(last) = last else {
+            return Wear::default();
+        };
+        (0..=last)
+            .map(|op| {
+                let these = arcs.iter().filter(|a| a.operation == op);
+                let energy: f64 = these.clone().map(|a| a.energy).sum();
+                (energy, Wear::of(these, p))
+            })
+            .fold((f64::NEG_INFINITY, Wear::default()), |best, x| {
+                if x.0 > best.0 { x } else { best }
+            })
+            .1
+    }
+}
 
 /// One figure's simulated test load.
 struct FigureEnergy {
     /// J, the mean arc energy of an operation.
     mean: f64,
+    /// J at the reference current, the mean wear of an operation.
+    wear: f64,
+    /// A, the energy-weighted mean arc current over the phases.
+    current: f64,
     /// Switching phases averaged.
     phases: usize,
     /// How far the mean still moves (see [`FigureLife::convergence`]).
@@ -588,6 +766,8 @@ impl FigureEnergy {
     fn refused(why: String) -> FigureEnergy {
         FigureEnergy {
             mean: 0.0,
+            wear: 0.0,
+            current: 0.0,
             phases: 0,
             convergence: 0.0,
             refused: Some(why),
@@ -669,17 +849,21 @@ fn figure_energy(
                     source: Box::new(e),
                 }
             })?;
-        Ok(run.arcs.as_ref().map_or((0.0, None), |a| {
+        Ok(run.arcs.as_ref().map_or((0.0, Wear::default(), None), |a| {
             (
                 a.totals.energy,
+                Wear::of(&a.arcs, CURRENT_EXPONENT),
                 a.totals.still_burning.as_ref().map(|b| b.duration),
             )
         }))
     };
     let mut energies = Vec::with_capacity(n);
+    let (mut wear, mut weighted) = (0.0, 0.0);
     let mut burning: Option<f64> = None;
-    for (e, still) in in_parallel(n, jobs, run_phase)? {
+    for (e, w, still) in in_parallel(n, jobs, run_phase)? {
         energies.push(e);
+        wear += w.wear / n as f64;
+        weighted += w.current * e;
         if let Some(d) = still {
             burning = Some(burning.map_or(d, |b: f64| b.max(d)));
         }
@@ -703,6 +887,12 @@ fn figure_energy(
     });
     Ok(FigureEnergy {
         mean,
+        wear,
+        current: if mean > 0.0 {
+            weighted / (mean * n as f64)
+        } else {
+            0.0
+        },
         phases: n,
         convergence,
         refused,
@@ -785,14 +975,76 @@ mod tests {
 
     #[test]
     fn a_sine_source_makes_a_circuit_alternating() {
-        assert!(alternating_supply("t\nV1 a 0 SIN(0 325 50)\nR1 a 0 1\n"));
-        assert!(alternating_supply("t\nvs a 0 sin (0 1 60)\n"));
-        assert!(alternating_supply("t\nI2 0 a dc 0 sin(0 1 1k)\n"));
-        assert!(!alternating_supply("t\nV1 a 0 DC 24\nR1 a 0 1\n"));
-        assert!(!alternating_supply("t\nV1 a 0 PULSE(0 5 0 1n 1n 1m 2m)\n"));
+        let rms = |text: &str| alternating_supply(text).flatten().unwrap();
+        assert!((rms("t\nV1 a 0 SIN(0 325 50)\nR1 a 0 1\n") - 325.0 / 2f64.sqrt()).abs() < 1e-9);
+        assert!((rms("t\nvs a 0 sin (0 1 60)\n") - 1.0 / 2f64.sqrt()).abs() < 1e-12);
+        // The largest of two, with a suffix; a phase's sign does not count.
+        let two = "t\nV1 a 0 SIN(0 0.17k 50)\nV2 b 0 sin(0 -339.4 50 0 0 90)\n";
+        assert!((rms(two) - 339.4 / 2f64.sqrt()).abs() < 1e-9);
+        // A current source's sine is AC, at no voltage of its own; so is a
+        // parameter's amplitude.
+        assert_eq!(
+            alternating_supply("t\nI2 0 a dc 0 sin(0 1 1k)\n"),
+            Some(None)
+        );
+        assert_eq!(
+            alternating_supply("t\nV1 a 0 SIN(0 {vpk} 50)\n"),
+            Some(None)
+        );
+        assert_eq!(alternating_supply("t\nV1 a 0 DC 24\nR1 a 0 1\n"), None);
+        assert_eq!(
+            alternating_supply("t\nV1 a 0 PULSE(0 5 0 1n 1n 1m 2m)\n"),
+            None
+        );
         // Not a source; the title line is not a card.
-        assert!(!alternating_supply("t\nBsin a 0 v=sin(time)\n"));
-        assert!(!alternating_supply("V1 a 0 SIN(0 1 50)\nR1 a 0 1\n"));
+        assert_eq!(alternating_supply("t\nBsin a 0 v=sin(time)\n"), None);
+        assert_eq!(alternating_supply("V1 a 0 SIN(0 1 50)\nR1 a 0 1\n"), None);
+    }
+
+    fn arc(operation: usize, energy: f64, charge: f64, duration: f64) -> crate::arc::ArcEvent {
+        crate::arc::ArcEvent {
+            operation,
+            opening: "break".to_owned(),
+            start: 0.0,
+            duration,
+            peak_current: 0.0,
+            energy,
+            charge,
+            gap_at_end: 0.0,
+            ends: "current_below_i_min",
+        }
+    }
+
+    #[test]
+    fn an_arc_wears_as_its_energy_times_its_current_to_the_exponent() {
+        // 0.2 J at a mean current of 4 mC / 1 ms = 4 A.
+        let w = arc_wear(0.2, 4e-3, 1e-3, 1.5);
+        assert!((w - 0.2 * 4f64.powf(1.5) / REFERENCE_CURRENT.powf(1.5)).abs() < 1e-12);
+        // p = 0: wear is energy; an arc without duration wears as its energy.
+        assert_eq!(arc_wear(0.2, 4e-3, 1e-3, 0.0), 0.2);
+        assert_eq!(arc_wear(0.2, 0.0, 0.0, 1.5), 0.2);
+        // Twice the current at the same energy wears 2^p times as much.
+        let ratio = arc_wear(1.0, 8e-3, 1e-3, 1.5) / arc_wear(1.0, 4e-3, 1e-3, 1.5);
+        assert!((ratio - 2f64.powf(1.5)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn an_operation_wears_as_the_sum_over_its_arcs() {
+        let p = 1.0;
+        // Operation 0: a 10 A, 0.1 J arc and a 2 A, 0.3 J one; operation 1:
+        // one 1 A arc of 0.5 J, the most energy but the least wear.
+        let arcs = [
+            arc(0, 0.1, 1e-3, 1e-4),
+            arc(0, 0.3, 2e-3, 1e-3),
+            arc(1, 0.5, 1e-3, 1e-3),
+        ];
+        let first = Wear::of(&arcs[..2], p);
+        assert!((first.wear - (0.1 * 10.0 + 0.3 * 2.0)).abs() < 1e-12);
+        // Energy-weighted: (0.1·10 + 0.3·2) / 0.4 = 4 A.
+        assert!((first.current - 4.0).abs() < 1e-12);
+        let most = Wear::most_energetic_operation(&arcs, p);
+        assert!((most.wear - 0.5).abs() < 1e-12 && (most.current - 1.0).abs() < 1e-12);
+        assert_eq!(Wear::most_energetic_operation(&[], p), Wear::default());
     }
 
     #[test]

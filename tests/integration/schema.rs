@@ -518,16 +518,28 @@ fn life_calibrates_on_one_figure_and_predicts_the_others() {
     assert_valid("life", &doc, "life");
     let figures = doc["figures"].as_array().unwrap();
     let e1 = figures[0]["energy_per_operation"].as_f64().unwrap();
-    assert!(e1 > 0.0, "{doc}");
+    let w1 = figures[0]["wear_per_operation"].as_f64().unwrap();
+    assert!(e1 > 0.0 && w1 > 0.0, "{doc}");
     let b = doc["constant_j"].as_f64().unwrap();
-    // A DC operation wears the contacts DC_TRANSFER times its arc energy,
-    // an AC one once.
+    // A DC operation counts DC_TRANSFER times its wear, an AC one
+    // (V/250 V)^q: at 125 V, 2^-q.
     let dc = chatterspice::life::DC_TRANSFER;
+    let q = chatterspice::life::VOLTAGE_EXPONENT;
+    assert_eq!(doc["dc_wear_factor"].as_f64(), Some(dc));
+    assert_eq!(doc["voltage_exponent"].as_f64(), Some(q));
     assert_eq!(figures[0]["wear_factor"].as_f64(), Some(dc));
-    assert_eq!(figures[2]["wear_factor"].as_f64(), Some(1.0));
-    assert!((b / (1.0e5 * e1 * dc) - 1.0).abs() < 1e-12);
+    let ac = figures[2]["wear_factor"].as_f64().unwrap();
+    assert!((ac - 0.5f64.powf(q)).abs() < 1e-12, "{doc}");
+    assert!((b / (1.0e5 * w1 * dc) - 1.0).abs() < 1e-12);
+    let w3 = figures[2]["wear_per_operation"].as_f64().unwrap();
+    assert!((figures[2]["predicted"].as_f64().unwrap() * w3 * ac / b - 1.0).abs() < 1e-12);
+    // An arc wears E·(Ī/1 A)^p: the wear of an operation lies between its
+    // energy times the least and the largest of its arcs' currents to the
+    // p, so the 10 A figure's wear per joule exceeds the 1 A one's.
+    let p = doc["current_exponent"].as_f64().unwrap();
+    assert_eq!(p, chatterspice::life::CURRENT_EXPONENT);
     let e3 = figures[2]["energy_per_operation"].as_f64().unwrap();
-    assert!((figures[2]["predicted"].as_f64().unwrap() * e3 / b - 1.0).abs() < 1e-12);
+    assert!(w3 / e3 > w1 / e1, "{doc}");
     assert!((figures[0]["ratio"].as_f64().unwrap() - 1.0).abs() < 1e-12);
     // The same load, printed four times longer: predicted at the first's.
     assert!(
@@ -543,12 +555,12 @@ fn life_calibrates_on_one_figure_and_predicts_the_others() {
         "{doc}"
     );
     let own = &doc["life"];
-    let e_own = own["energy_per_operation"].as_f64().unwrap();
-    assert!(e_own > 0.0);
+    let w_own = own["wear_per_operation"].as_f64().unwrap();
+    assert!(own["energy_per_operation"].as_f64().unwrap() > 0.0 && w_own > 0.0);
     let n = own["operations"].as_f64().unwrap();
     // The circuit is DC: no sine source.
     assert_eq!(own["wear_factor"].as_f64(), Some(dc));
-    assert!((n * e_own * dc / b - 1.0).abs() < 1e-12);
+    assert!((n * w_own * dc / b - 1.0).abs() < 1e-12);
     let expected_b10 = chatterspice::life::b10(n, 2.0);
     assert!((own["b10"].as_f64().unwrap() / expected_b10 - 1.0).abs() < 1e-12);
 
