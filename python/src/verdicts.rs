@@ -362,8 +362,10 @@ pub fn py_envelope<'py>(
 /// scenario's own circuit predicted.
 ///
 /// Returns the JSON of ``chatterspice life --format json`` as a dict:
-/// ``calibrated_on``, ``constant_j`` (J), ``figures`` (each with
-/// ``operations``, ``predicted``, ``ratio``, ``energy_per_operation``),
+/// ``calibrated_on``, ``constant_j`` (J at 1 A), the erosion law's
+/// constants, ``figures`` (each with ``operations``, ``predicted``,
+/// ``ratio``, ``energy_per_operation``, ``wear_per_operation``,
+/// ``wear_factor``),
 /// ``life`` at the scenario's circuit (``operations``, ``b10``) and
 /// ``weibull_shape``.
 ///
