@@ -590,9 +590,10 @@ pub fn alternating_supply(netlist: &str) -> Option<Option<f64>> {
 pub fn render(report: &LifeReport) -> String {
     use std::fmt::Write;
     let mut out = format!(
-        "erosion constant B = {:.4e} J, calibrated on figure {}; an arc wears E·(Ī/{} A)^{}, an \
+        "erosion constant B = {:.4e} J (at {} A), calibrated on figure {}; an arc wears E·(Ī/{} A)^{}, an \
          operation ×{} on DC, ×(V/{} V)^{} on AC\n",
         report.constant_j,
+        report.reference_current,
         report.calibrated_on + 1,
         report.reference_current,
         report.current_exponent,
