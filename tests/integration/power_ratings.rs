@@ -225,6 +225,44 @@ fn run_and_check_carry_the_life_of_their_circuit() {
         run["life"]["life"]["energy_per_operation"].as_f64(),
         Some(e)
     );
+    // Its wear, priced here from the run's own arcs: each arc's energy
+    // times its mean current (charge over duration) to the p, summed over
+    // that operation.
+    let p_exp = life["current_exponent"].as_f64().unwrap();
+    let arcs = run["arcs"].as_array().unwrap();
+    let per_operation = |op: u64| -> (f64, f64) {
+        arcs.iter()
+            .filter(|a| a["operation"].as_u64() == Some(op))
+            .fold((0.0, 0.0), |(e, w), a| {
+                let energy = a["energy"].as_f64().unwrap();
+                let duration = a["duration"].as_f64().unwrap();
+                let current = a["charge"].as_f64().unwrap() / duration;
+                let wear = if duration > 0.0 && current > 0.0 {
+                    energy * current.powf(p_exp)
+                } else {
+                    energy
+                };
+                (e + energy, w + wear)
+            })
+    };
+    let last = arcs
+        .iter()
+        .filter_map(|a| a["operation"].as_u64())
+        .max()
+        .unwrap();
+    let (_, wear) = (0..=last)
+        .map(per_operation)
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .unwrap();
+    let reported = run["life"]["life"]["wear_per_operation"].as_f64().unwrap();
+    assert!(
+        (reported / wear - 1.0).abs() < 1e-9,
+        "{reported} against {wear}"
+    );
+    assert!(
+        wear > e,
+        "the arcs carry more than 1 A: {wear} against {e} J"
+    );
     let table = cli()
         .args(["run", p, "--life-phases", "2"])
         .output()
