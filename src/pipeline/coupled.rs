@@ -399,10 +399,6 @@ struct Setup<'a> {
     netlist_text: &'a str,
     coil_instance: String,
     mechanics: Mechanics,
-    /// m, the contact gap at rest.
-    gap: f64,
-    /// m, where the armature starts.
-    initial_position: f64,
     stops: Stops,
     settings: crate::mechanics::Settings,
     build: crate::mechanics::two_stage::TwoStage,
@@ -452,22 +448,17 @@ impl<'a> Setup<'a> {
                 });
             }
         }
-        let m = &scenario.mechanics;
+        // The coil makes the force.
         let mechanics = Mechanics {
-            mass: m.mass,
-            stiffness: m.stiffness,
-            damping: m.damping,
             force: 0.0,
-            gap: m.gap,
-            initial_position: m.initial_position,
-            initial_velocity: m.initial_velocity,
-            preload: m.preload,
+            ..scenario.armature()
         };
-        coil.validate(m.gap).map_err(|source| CouplingError::Coil {
-            path: origin.clone(),
-            iteration: 0,
-            source,
-        })?;
+        coil.validate(mechanics.gap)
+            .map_err(|source| CouplingError::Coil {
+                path: origin.clone(),
+                iteration: 0,
+                source,
+            })?;
         let stops = Stops {
             make: plan.surface(),
             back: plan.back_stop(),
@@ -499,8 +490,6 @@ impl<'a> Setup<'a> {
             netlist_text,
             coil_instance: coil_instance.clone(),
             mechanics,
-            gap: m.gap,
-            initial_position: m.initial_position,
             stops,
             settings,
             build,
@@ -729,7 +718,7 @@ fn lock_step(
         &circuit.subckt,
         super::lockstep::MAKE_SOURCE,
         arc.as_ref(),
-        setup.gap - setup.initial_position,
+        setup.mechanics.gap - setup.mechanics.initial_position,
     )?;
     if let Some(nc) = &circuit.nc_subckt {
         contact.push_str(&super::lockstep::contact_include(
@@ -810,7 +799,7 @@ fn passes(
     // contacts as before any motion: NO open, NC closed.
     let mut chatter = steady_chatter(ContactState::Open, settings.t_end);
     let mut back = steady_chatter(ContactState::Closed, settings.t_end);
-    let mut path = vec![(0.0, setup.gap)];
+    let mut path = vec![(0.0, setup.mechanics.gap)];
     let mut iterations: Vec<Iteration> = Vec::new();
     for iteration in 1..=options.max_iterations {
         let waveform =
@@ -827,9 +816,12 @@ fn passes(
             // The probe's contact is open at its rest gap, whatever the
             // coil's armature does.
             let gap = if iteration == 1 {
-                GapProfile::from_path(setup.gap, &[(0.0, setup.initial_position)])
+                GapProfile::from_path(
+                    setup.mechanics.gap,
+                    &[(0.0, setup.mechanics.initial_position)],
+                )
             } else {
-                GapProfile::from_path(setup.gap, &path)
+                GapProfile::from_path(setup.mechanics.gap, &path)
             };
             contact = with_arc(contact, arc, &gap)?;
         }
