@@ -26,16 +26,11 @@ fn the_coupled_run_agrees_with_the_direct_solver() {
     let coupled = run_coupled(&scenario, &ng, &CouplingOptions::default())
         .unwrap_or_else(|e| panic!("{}", common::chain(&e)));
 
-    let m = &scenario.mechanics;
     let mechanics = Mechanics {
-        mass: m.mass,
-        stiffness: m.stiffness,
-        damping: m.damping,
         force: 0.0,
-        gap: m.gap,
         initial_position: 0.0,
         initial_velocity: 0.0,
-        preload: m.preload,
+        ..scenario.armature()
     };
     let direct = simulate_direct(
         &Coil::from(scenario.coil.as_ref().unwrap()),
@@ -140,16 +135,11 @@ fn a_two_stage_relay_coupled_to_its_coil_agrees_with_the_direct_solver() {
     let scenario = Scenario::parse(&text, &origin).unwrap();
     let coupled = run_coupled(&scenario, &ng, &CouplingOptions::default())
         .unwrap_or_else(|e| panic!("{}", common::chain(&e)));
-    let m = &scenario.mechanics;
     let mechanics = Mechanics {
-        mass: m.mass,
-        stiffness: m.stiffness,
-        damping: m.damping,
         force: 0.0,
-        gap: m.gap,
         initial_position: 0.0,
         initial_velocity: 0.0,
-        preload: m.preload,
+        ..scenario.armature()
     };
     let (direct, run) = direct_closing(
         &Coil::from(scenario.coil.as_ref().unwrap()),
